@@ -1,0 +1,96 @@
+"""The illusion interface and registry.
+
+An illusion is a small pydantic model (its ``type`` is the stable name used in case files, the API and exports)
+with a ``severity`` 1-5, a ``seed``, placement on the road and a five-row ``SEVERITY`` table. ``compile`` turns it
+into real scene elements (meshes, road-surface layers, lights, sun and wetness changes), never a 2D overlay.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+if TYPE_CHECKING:
+    from ..case import Case
+    from ..road_layout import RoadNetwork
+    from ..scene import Environment, Mesh, PointLight, SurfaceLayer
+
+Category = Literal["road_damage", "traffic", "shadow", "reflection"]
+CATEGORIES: tuple[Category, ...] = ("road_damage", "traffic", "shadow", "reflection")
+
+# Where an illusion lands by default: this far ahead of the ego's start, so the first frames see it.
+DEFAULT_AHEAD_M = 22.0
+
+
+@dataclass
+class CompileContext:
+    """What an illusion may read (case, road) and add to (meshes, layers, lights, environment)."""
+
+    case: Case
+    network: RoadNetwork
+    env: Environment
+    meshes: list[Mesh] = field(default_factory=list)
+    layers: list[SurfaceLayer] = field(default_factory=list)
+    lights: list[PointLight] = field(default_factory=list)
+    source: int = -1  # index of the illusion being compiled
+
+    def rng(self, seed: int) -> np.random.Generator:
+        """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""
+        return np.random.default_rng([self.case.seed, self.source + 1, seed])
+
+    def add_mesh(self, mesh: Mesh) -> None:
+        mesh.source = self.source
+        self.meshes.append(mesh)
+
+    def add_layer(self, layer: SurfaceLayer) -> None:
+        layer.source = self.source
+        self.layers.append(layer)
+
+    def add_light(self, light: PointLight) -> None:
+        light.source = self.source
+        self.lights.append(light)
+
+
+class Illusion(BaseModel):
+    """Base of every illusion type. Subclasses set ``type`` (a Literal), ``CATEGORY`` and ``SEVERITY``."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    CATEGORY: ClassVar[Category]
+    # Five rows, level 1 (subtle) to 5 (most deceptive): what each level sets.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]]
+
+    type: str
+    severity: int = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
+    seed: int = Field(0, ge=0, le=2**32 - 1)
+    s: float | None = Field(
+        None, ge=0, description="distance along the road where it starts (m); empty = just ahead of the ego start"
+    )
+
+    def level(self) -> dict[str, Any]:
+        """The severity table row of this illusion's level."""
+        return self.SEVERITY[self.severity - 1]
+
+    def start_s(self, case: Case) -> float:
+        """Where along the road the illusion starts."""
+        return self.s if self.s is not None else case.ego.start_s + DEFAULT_AHEAD_M
+
+    def compile(self, ctx: CompileContext) -> None:  # pragma: no cover - every registered type overrides
+        raise TypeError(f"{type(self).__name__} does not define compile()")
+
+
+REGISTRY: dict[str, type[Illusion]] = {}
+
+
+def register(cls: type[Illusion]) -> type[Illusion]:
+    """Class decorator: add an illusion type to the registry under its ``type`` literal."""
+    name = cls.model_fields["type"].default
+    if not isinstance(name, str) or name in REGISTRY:
+        raise ValueError(f"illusion {cls.__name__} needs a unique default 'type', got {name!r}")
+    if len(cls.SEVERITY) != 5:
+        raise ValueError(f"illusion {name} needs a five-row SEVERITY table")
+    REGISTRY[name] = cls
+    return cls

@@ -1,0 +1,3 @@
+"""reflection illusions."""
+
+from __future__ import annotations

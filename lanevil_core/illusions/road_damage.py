@@ -1,0 +1,3 @@
+"""road_damage illusions."""
+
+from __future__ import annotations

@@ -1,0 +1,3 @@
+"""shadow illusions."""
+
+from __future__ import annotations

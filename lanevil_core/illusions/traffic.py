@@ -1,0 +1,3 @@
+"""traffic illusions."""
+
+from __future__ import annotations

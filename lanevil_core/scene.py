@@ -1,0 +1,142 @@
+"""The compiled scene: what the renderer draws, built once per case.
+
+Data flows one way: ``Case`` (declarative) -> ``compile_scene`` (road surface, roadside props, illusions
+-> meshes, surface layers, lights, environment) -> renderer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .typed import Float32Array, FloatArray, IntArray
+
+if TYPE_CHECKING:
+    from .case import Case
+    from .road_layout import RoadNetwork
+
+# Object ids in the per-pixel id buffer.
+ID_SKY = 0
+ID_ROAD = 1  # carriageway asphalt (any road piece)
+ID_ROADSIDE = 2  # shoulders, kerbs, sidewalks, terrain
+FIRST_OBJECT_ID = 16
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh in the world frame, flat-shaded with one linear-RGB albedo per face.
+
+    Attributes:
+        vertices: (n, 3) float64 world positions.
+        faces: (m, 3) int32 vertex indices, counter-clockwise seen from outside.
+        colors: (m, 3) float32 linear albedo in [0, 1].
+        name: human-readable name (shown in the editor and exports).
+        kind: what it is (``building``, ``tree``, ``vehicle``, ``pedestrian``, ``pole`` ...).
+        casts_shadow: whether it is drawn into the sun's shadow map.
+        gloss: specular strength in [0, 1] (car paint ~0.6, metal ~0.4, matte 0).
+        emission: (m, 3) float32 emitted linear radiance per face (lamps, headlights), or None.
+        visible: drawn in the camera (False = shadow caster only, e.g. a structure above the view).
+        source: the illusion index that added it, or -1 for the road and roadside.
+    """
+
+    vertices: FloatArray
+    faces: IntArray
+    colors: Float32Array
+    name: str = "object"
+    kind: str = "prop"
+    casts_shadow: bool = True
+    gloss: float = 0.0
+    emission: Float32Array | None = None
+    visible: bool = True
+    source: int = -1
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64)
+        self.faces = np.ascontiguousarray(self.faces, dtype=np.int32)
+        colors = np.asarray(self.colors, dtype=np.float32)
+        if colors.ndim == 1:
+            colors = np.broadcast_to(colors, (len(self.faces), 3))
+        self.colors = np.ascontiguousarray(colors)
+        if self.emission is not None:
+            emission = np.asarray(self.emission, dtype=np.float32)
+            if emission.ndim == 1:
+                emission = np.broadcast_to(emission, (len(self.faces), 3))
+            self.emission = np.ascontiguousarray(emission)
+
+
+@dataclass
+class SurfaceLayer:
+    """A texture lying on a road piece's surface, addressed in that piece's road frame.
+
+    Texel (row i, col j) covers s in [s0 + i*texel, s0 + (i+1)*texel), t in [t0 + j*texel, ...).
+
+    Attributes:
+        piece: index of the road piece (0 = main road).
+        s0, t0: road-frame corner of texel (0, 0) (m).
+        texel: texel size (m).
+        rgba: (h, w, 4) float32: linear albedo and coverage alpha; blended over the asphalt.
+        wet: (h, w) float32 puddle depth/coverage in [0, 1] (mirror-like water), or None.
+        over_paint: drawn over lane paint (sealant, skid marks) instead of under it (cracks in the asphalt).
+    """
+
+    piece: int
+    s0: float
+    t0: float
+    texel: float
+    rgba: Float32Array
+    wet: Float32Array | None = None
+    over_paint: bool = False
+    name: str = "layer"
+    source: int = -1
+
+
+@dataclass
+class PointLight:
+    """A lamp: position, linear RGB colour and intensity (radiance scale at 1 m)."""
+
+    p_world: FloatArray
+    color: Float32Array
+    intensity: float
+    name: str = "lamp"
+    source: int = -1
+
+
+@dataclass
+class Environment:
+    """Lighting and atmosphere, derived from the case's weather and sun (illusions may change it).
+
+    ``sun_dir_world`` points from the ground towards the sun.
+    """
+
+    sun_dir_world: FloatArray
+    sun_intensity: float  # direct sun irradiance scale (0 at night)
+    sun_color: Float32Array
+    sky_zenith: Float32Array
+    sky_horizon: Float32Array
+    ambient: float  # sky irradiance scale
+    wetness: float  # road wetness in [0, 1]
+    puddles: float  # puddle coverage in [0, 1]
+    fog_density: float  # extinction per metre
+    fog_distance: float  # fog starts here (m)
+    cloudiness: float  # [0, 1]
+    penumbra: float  # shadow softness in metres of blur at 1 m occluder distance
+    exposure: float
+    night: bool
+
+
+@dataclass
+class CompiledScene:
+    """Everything the renderer and the label generator need for any frame of a case."""
+
+    case: Case
+    network: RoadNetwork
+    env: Environment
+    meshes: list[Mesh] = field(default_factory=list)
+    layers: list[SurfaceLayer] = field(default_factory=list)
+    lights: list[PointLight] = field(default_factory=list)
+
+    def object_names(self) -> dict[int, str]:
+        """Object id (as in the id buffer) -> mesh name."""
+        return {FIRST_OBJECT_ID + i: mesh.name for i, mesh in enumerate(self.meshes)}

@@ -1,0 +1,48 @@
+"""Array aliases and choice types shared across the library.
+
+Shapes are written in docstrings as ``(n, 3) float64``; these aliases name the dtype.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+Float32Array = npt.NDArray[np.float32]
+IntArray = npt.NDArray[np.int32]
+UInt8Array = npt.NDArray[np.uint8]
+BoolArray = npt.NDArray[np.bool_]
+
+RoadType = Literal["straight", "bend", "s_curve", "uphill", "downhill", "t_junction", "crossroad"]
+ROAD_TYPES: tuple[RoadType, ...] = (
+    "straight", "bend", "s_curve", "uphill", "downhill", "t_junction", "crossroad",
+)
+
+LineType = Literal[
+    "white_solid",
+    "white_dashed",
+    "white_double_solid",
+    "yellow_solid",
+    "yellow_dashed",
+    "yellow_double_solid",
+    "white_solid_dashed",
+    "yellow_solid_dashed",
+    "botts_dots",
+]
+LINE_TYPES: tuple[LineType, ...] = (
+    "white_solid", "white_dashed", "white_double_solid",
+    "yellow_solid", "yellow_dashed", "yellow_double_solid",
+    "white_solid_dashed", "yellow_solid_dashed", "botts_dots",
+)
+
+SceneKind = Literal["urban", "suburban", "highway", "rural", "tunnel_approach"]
+SCENE_KINDS: tuple[SceneKind, ...] = ("urban", "suburban", "highway", "rural", "tunnel_approach")
+
+Turn = Literal["left", "right"]
+
+# Surface materials of the road cross-section (index = material id in the renderer).
+Material = Literal["asphalt", "concrete", "grass", "gravel", "kerb", "dirt"]
+MATERIALS: tuple[Material, ...] = ("asphalt", "concrete", "grass", "gravel", "kerb", "dirt")
