@@ -7,7 +7,7 @@ Data flows one way: ``Case`` (declarative) -> ``compile_scene`` (road surface, r
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -136,6 +136,7 @@ class CompiledScene:
     meshes: list[Mesh] = field(default_factory=list)
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)
+    cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)  # renderer's packed arrays
 
     def object_names(self) -> dict[int, str]:
         """Object id (as in the id buffer) -> mesh name."""

@@ -1,0 +1,52 @@
+"""Lighting and atmosphere from a case's weather and sun numbers."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .case import Case
+from .scene import Environment
+from .typed import FloatArray
+
+
+def sun_direction(azimuth_deg: float, altitude_deg: float) -> FloatArray:
+    """(3,) unit vector from the ground towards the sun (azimuth CCW from +X, altitude above the horizon)."""
+    az, alt = np.radians(azimuth_deg), np.radians(altitude_deg)
+    return np.array([np.cos(alt) * np.cos(az), np.cos(alt) * np.sin(az), np.sin(alt)])
+
+
+def _mix(a: FloatArray, b: FloatArray, k: float) -> np.ndarray:
+    return (np.asarray(a) * (1.0 - k) + np.asarray(b) * k).astype(np.float32)
+
+
+def environment_for(case: Case) -> Environment:
+    """Sun, sky, wetness and fog of a case (before illusions change them)."""
+    weather, sun = case.weather, case.sun
+    cloud = weather.cloudiness / 100.0
+    altitude = sun.altitude
+    night = altitude <= -2.0
+    day = float(np.clip((altitude + 2.0) / 12.0, 0.0, 1.0))  # twilight ramp
+    low = float(np.clip(1.0 - altitude / 30.0, 0.0, 1.0))  # warm light near the horizon
+    sun_color = _mix([1.0, 0.97, 0.92], [1.0, 0.62, 0.32], low * 0.8)
+    clear_zenith, clear_horizon = np.array([0.16, 0.32, 0.75]), np.array([0.62, 0.74, 0.92])
+    grey = np.array([0.55, 0.57, 0.6])
+    zenith = _mix(clear_zenith, grey * 0.8, cloud) * day + np.array([0.004, 0.006, 0.015]) * (1 - day)
+    horizon = _mix(_mix(clear_horizon, [0.95, 0.7, 0.5], low * 0.6 * (1 - cloud)), grey, cloud)
+    horizon = horizon * day + np.array([0.01, 0.012, 0.02]) * (1 - day)
+    direct = sun.intensity * day * (1.0 - 0.85 * cloud)
+    return Environment(
+        sun_dir_world=sun_direction(sun.azimuth, max(altitude, 0.5)),
+        sun_intensity=float(direct),
+        sun_color=sun_color,
+        sky_zenith=zenith.astype(np.float32),
+        sky_horizon=horizon.astype(np.float32),
+        ambient=float(0.25 + 0.35 * cloud) * day + 0.01 * (1 - day),
+        wetness=float(np.clip(max(weather.wetness, weather.precipitation) / 100.0, 0.0, 1.0)),
+        puddles=weather.precipitation_deposits / 100.0,
+        fog_density=0.0004 + weather.fog_density / 100.0 * 0.03,
+        fog_distance=weather.fog_distance,
+        cloudiness=cloud,
+        penumbra=0.004 + 0.03 * cloud + 0.01 / max(sun.intensity, 0.1),
+        exposure=1.0 if not night else 4.0,
+        night=night,
+    )

@@ -1,0 +1,138 @@
+"""Light transport pieces (numba): sky radiance, sun shadows, Fresnel and glossy highlights."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._jit import kernel
+
+SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
+SKY_SCALE = 1.6
+COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
+
+
+@kernel
+def sky_radiance(d: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
+                 zenith: np.ndarray, horizon: np.ndarray, cloudiness: float, out: np.ndarray) -> None:
+    """Radiance of the sky seen along unit world direction ``d`` (gradient, sun disk and glow)."""
+    e = max(d[2], 0.0)
+    k = np.sqrt(e)
+    for c in range(3):
+        out[c] = SKY_SCALE * (horizon[c] * (1.0 - k) + zenith[c] * k)
+    if d[2] < 0.0:  # below the horizon (seen past the terrain's edge): darker haze
+        for c in range(3):
+            out[c] *= 0.85
+    cos_sun = d[0] * sun_dir[0] + d[1] * sun_dir[1] + d[2] * sun_dir[2]
+    if cos_sun > 0.0 and sun_intensity > 0.0:
+        clear = 1.0 - cloudiness
+        disk = 60.0 * clear if cos_sun > 0.99996 else 0.0
+        c2 = cos_sun * cos_sun
+        c4 = c2 * c2
+        c8 = c4 * c4
+        c16 = c8 * c8
+        halo = np.exp(400.0 * np.log(cos_sun)) if cos_sun > 0.97 else 0.0
+        glow = halo * 3.0 * clear + c16 * 0.35 * (0.3 + 0.7 * clear)
+        for c in range(3):
+            out[c] += sun_color[c] * sun_intensity * (disk + glow)
+
+
+@kernel
+def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: float) -> float:
+    """Bilinear percentage-closer test at map coordinates (u, v) (texels)."""
+    size = depth.shape[1]
+    x = u - 0.5
+    y = v - 0.5
+    x0 = int(np.floor(x))
+    y0 = int(np.floor(y))
+    fx = x - x0
+    fy = y - y0
+    lit = 0.0
+    for dy in range(2):
+        for dx in range(2):
+            xi = min(max(x0 + dx, 0), size - 1)
+            yi = min(max(y0 + dy, 0), size - 1)
+            w = (fx if dx else 1.0 - fx) * (fy if dy else 1.0 - fy)
+            if depth[c, yi, xi] >= d - bias:
+                lit += w
+    return lit
+
+
+@kernel
+def sun_visibility(p: np.ndarray, normal: np.ndarray, maps: np.ndarray, coarse: np.ndarray, params: np.ndarray,
+                   R_light: np.ndarray, penumbra: float) -> float:
+    """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges."""
+    q0 = p[0] + normal[0] * 0.02
+    q1 = p[1] + normal[1] * 0.02
+    q2 = p[2] + normal[2] * 0.02
+    u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
+    v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
+    d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    size = maps.shape[1]
+    for c in range(maps.shape[0]):
+        scale = params[c, 2]
+        x = (u - params[c, 0]) * scale
+        y = (v - params[c, 1]) * scale
+        if x < 2 or y < 2 or x > size - 2 or y > size - 2:
+            continue
+        bias = 1.5 / scale
+        # Nearest caster within a coarse cell and its neighbours: no caster above the point -> fully lit.
+        cx = int(x) >> COARSE_SHIFT
+        cy = int(y) >> COARSE_SHIFT
+        cn = coarse.shape[1]
+        nearest = np.inf
+        for j in range(max(cy - 1, 0), min(cy + 2, cn)):
+            for i in range(max(cx - 1, 0), min(cx + 2, cn)):
+                nearest = min(nearest, coarse[c, j, i])
+        if nearest >= d - bias:
+            return 1.0
+        # Blocker search: the nearest caster depth around the point sets the penumbra width.
+        search = max(2.0, min(0.6 * scale, 7.0))
+        blocker = 0.0
+        count = 0
+        for j in range(-1, 2):
+            for i in range(-1, 2):
+                xi = min(max(int(x + i * search * 0.5), 0), size - 1)
+                yi = min(max(int(y + j * search * 0.5), 0), size - 1)
+                z = maps[c, yi, xi]
+                if z < d - bias:
+                    blocker += z
+                    count += 1
+        if count == 0:
+            return 1.0
+        blocker /= count
+        radius = max(0.7, min(penumbra * (d - blocker) * scale, search))
+        lit = 0.0
+        for j in range(-2, 3):
+            for i in range(-2, 3):
+                lit += _shadow_tap(maps, c, x + i * radius * 0.5, y + j * radius * 0.5, d, bias)
+        return lit / 25.0
+    return 1.0
+
+
+@kernel(inline="always")
+def fresnel_schlick(cos_theta: float, f0: float) -> float:
+    m = 1.0 - max(min(cos_theta, 1.0), 0.0)
+    return f0 + (1.0 - f0) * m * m * m * m * m
+
+
+@kernel(inline="always")
+def glossy_lobe(n_dot_h: float, roughness: float) -> float:
+    """Normalized Blinn-Phong lobe standing in for GGX: narrow and tall for smooth water, wide for asphalt."""
+    alpha = max(roughness * roughness, 1e-4)
+    exponent = 2.0 / alpha - 2.0
+    return (exponent + 2.0) / (2.0 * np.pi) * max(n_dot_h, 0.0) ** exponent
+
+
+@kernel
+def min_pool(maps: np.ndarray, shift: int) -> np.ndarray:
+    """(C, S >> shift, S >> shift): the nearest caster depth in each 2**shift square of every cascade."""
+    cascades, size, _ = maps.shape
+    cells = size >> shift
+    out = np.full((cascades, cells, cells), np.inf, np.float32)
+    for c in range(cascades):
+        for y in range(size):
+            for x in range(size):
+                v = maps[c, y, x]
+                if v < out[c, y >> shift, x >> shift]:
+                    out[c, y >> shift, x >> shift] = v
+    return out

@@ -1,0 +1,201 @@
+"""Flat arrays of a compiled scene, built once per scene and shared by every frame's render."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..case import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, DOUBLE_LINE_SPACING_M, Marking
+from ..road_layout import RoadNetwork
+from ..road_mesh import road_surface
+from ..scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
+from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+
+# Linear albedo of the cross-section materials (index = typed.MATERIALS).
+MATERIAL_ALBEDO = np.array([
+    [0.055, 0.055, 0.058],  # asphalt
+    [0.30, 0.29, 0.27],  # concrete
+    [0.07, 0.12, 0.035],  # grass
+    [0.16, 0.145, 0.13],  # gravel
+    [0.38, 0.37, 0.35],  # kerb
+    [0.13, 0.10, 0.07],  # dirt
+], np.float32)
+
+WHITE_PAINT = (0.70, 0.70, 0.67)
+YELLOW_PAINT = (0.72, 0.46, 0.04)
+STOP_LINE_M = 0.4
+
+# Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots), on, period, r, g, b
+STRIPE_COLUMNS = 11
+
+
+@dataclass
+class LayerAtlas:
+    """Every surface layer's mip pyramid in one flat buffer.
+
+    Attributes:
+        texels: (n, 5) float32 premultiplied rgb, alpha, wet of all levels of all layers.
+        table: (k, 9) float64 per (layer, level): piece, s0, t0, texel, rows, cols, offset, over_paint, level.
+        first_level: (layers + 1,) int32 index of each layer's level 0 in ``table``.
+    """
+
+    texels: Float32Array
+    table: FloatArray
+    first_level: IntArray
+
+
+@dataclass
+class PackedScene:
+    """Triangles of the road surface and all objects, with per-face and per-vertex attributes."""
+
+    vertices: FloatArray  # (n, 3) world
+    faces: IntArray  # (m, 3)
+    vertex_st: Float32Array  # (n, 2) road-frame s, t (road vertices only)
+    vertex_piece: IntArray  # (n,) road piece or -1
+    face_material: IntArray  # (m,) MATERIALS index for road faces, -1 for objects
+    face_object: IntArray  # (m,) id-buffer value
+    face_color: Float32Array  # (m, 3)
+    face_emission: Float32Array  # (m, 3)
+    face_gloss: Float32Array  # (m,)
+    face_normal: Float32Array  # (m, 3) world, unit
+    camera_faces: IntArray  # faces drawn in the camera
+    shadow_faces: IntArray  # faces drawn into the sun's shadow map
+    mirror_faces: IntArray  # object faces that wet roads mirror
+    stripes: FloatArray  # (k, STRIPE_COLUMNS)
+    layers: LayerAtlas
+    lights: FloatArray  # (l, 7): x, y, z, r, g, b, intensity
+
+
+def _color(marking: Marking) -> tuple[float, float, float]:
+    return YELLOW_PAINT if marking.type.startswith("yellow") else WHITE_PAINT
+
+
+def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: float) -> list[list[float]]:
+    """Stripes of one marking; for double lines the pair is centred on the boundary, the first on the left."""
+    offset = (marking.width + DOUBLE_LINE_SPACING_M) / 2
+    rgb = list(_color(marking))
+    period = marking.dash + marking.gap
+
+    def stripe(t_c: float, pattern: int, width: float = marking.width, on: float = marking.dash,
+               per: float = period) -> list[float]:
+        return [piece, t_c, width / 2, s0, s1, pattern, on, per, *rgb]
+
+    kind = marking.type.split("_", 1)[1] if marking.type != "botts_dots" else "dots"
+    if kind == "solid":
+        return [stripe(t, 0)]
+    if kind == "dashed":
+        return [stripe(t, 1)]
+    if kind == "double_solid":
+        return [stripe(t + offset, 0), stripe(t - offset, 0)]
+    if kind == "solid_dashed":
+        return [stripe(t + offset, 0), stripe(t - offset, 1)]
+    return [stripe(t, 2, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M)]
+
+
+def paint_stripes(network: RoadNetwork, markings: list[Marking]) -> FloatArray:
+    """Every painted stripe of the network as rows of the stripe table."""
+    rows: list[list[float]] = []
+    for index, piece in enumerate(network.pieces):
+        last = len(piece.boundaries_t) - 1
+        for k, (t, marking) in enumerate(zip(piece.boundaries_t, markings)):
+            side = 1 if k == 0 else (-1 if k == last else 0)
+            spans = [(piece.s_start, piece.line.length)]
+            for g0, g1, g_side in piece.gaps:  # edge lines break where a junction arm leaves
+                if side and g_side == side:
+                    spans = [(a, b) for a0, b0 in spans for a, b in ((a0, min(b0, g0)), (max(a0, g1), b0)) if b > a]
+            for s0, s1 in spans:
+                rows += _stripes_of_boundary(index, float(t), marking, s0, s1)
+        if index:  # a stop line across the arm's lanes that lead into the junction
+            s0 = piece.s_start + 1.5
+            rows.append([index, -piece.half_width / 2, piece.half_width / 2, s0, s0 + STOP_LINE_M, 0,
+                         1.0, 1.0, *WHITE_PAINT])
+    return np.array(rows, np.float64).reshape(-1, STRIPE_COLUMNS)
+
+
+def _mips(rgba: np.ndarray, wet: np.ndarray | None) -> list[np.ndarray]:
+    rgba = np.asarray(rgba, np.float32)
+    premultiplied = np.concatenate([rgba[..., :3] * rgba[..., 3:4], rgba[..., 3:4]], axis=-1)
+    level = np.concatenate([premultiplied, (wet if wet is not None else np.zeros(rgba.shape[:2], np.float32))[..., None]],
+                           axis=-1).astype(np.float32)
+    levels = [level]
+    while min(level.shape[:2]) > 2 and len(levels) < 10:
+        h, w = (level.shape[0] // 2) * 2, (level.shape[1] // 2) * 2
+        level = level[:h, :w].reshape(h // 2, 2, w // 2, 2, 5).mean(axis=(1, 3))
+        levels.append(level)
+    return levels
+
+
+def layer_atlas(scene: CompiledScene) -> LayerAtlas:
+    chunks, table, first = [], [], [0]
+    offset = 0
+    for layer in scene.layers:
+        for lvl, mip in enumerate(_mips(layer.rgba, layer.wet)):
+            rows, cols = mip.shape[:2]
+            table.append([layer.piece, layer.s0, layer.t0, layer.texel * 2**lvl, rows, cols, offset,
+                          float(layer.over_paint), lvl])
+            chunks.append(mip.reshape(-1, 5))
+            offset += rows * cols
+        first.append(len(table))
+    texels = np.concatenate(chunks) if chunks else np.zeros((1, 5), np.float32)
+    return LayerAtlas(np.ascontiguousarray(texels, np.float32), np.array(table, np.float64).reshape(-1, 9),
+                      np.array(first, np.int32))
+
+
+def _face_normals(vertices: FloatArray, faces: IntArray) -> Float32Array:
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    return (normal / np.where(length > 0, length, 1.0)).astype(np.float32)
+
+
+def pack_scene(scene: CompiledScene) -> PackedScene:
+    """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
+    cached = scene.cache.get("packed")
+    if cached is not None:
+        return cached
+    road = road_surface(scene.network)
+    verts, faces, st, piece = [road.vertices], [road.faces], [road.st], [road.piece]
+    mat = [road.material]
+    obj = [np.where(road.carriageway, ID_ROAD, ID_ROADSIDE).astype(np.int32)]
+    color = [MATERIAL_ALBEDO[road.material]]
+    emission = [np.zeros((len(road.faces), 3), np.float32)]
+    gloss = [np.zeros(len(road.faces), np.float32)]
+    shadow, visible, mirror = [np.zeros(len(road.faces), bool)], [np.ones(len(road.faces), bool)], [
+        np.zeros(len(road.faces), bool)]
+    offset = len(road.vertices)
+    for index, mesh in enumerate(scene.meshes):
+        m = len(mesh.faces)
+        verts.append(mesh.vertices)
+        faces.append(mesh.faces + offset)
+        st.append(np.zeros((len(mesh.vertices), 2)))
+        piece.append(np.full(len(mesh.vertices), -1, np.int32))
+        mat.append(np.full(m, -1, np.int32))
+        obj.append(np.full(m, FIRST_OBJECT_ID + index, np.int32))
+        color.append(mesh.colors)
+        emission.append(mesh.emission if mesh.emission is not None else np.zeros((m, 3), np.float32))
+        gloss.append(np.full(m, mesh.gloss, np.float32))
+        shadow.append(np.full(m, mesh.casts_shadow, bool))
+        visible.append(np.full(m, mesh.visible, bool))
+        mirror.append(np.full(m, mesh.visible and mesh.kind not in ("building", "terrain"), bool))
+        offset += len(mesh.vertices)
+    all_v = np.concatenate(verts)
+    all_f = np.concatenate(faces).astype(np.int32)
+    lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
+                      np.float64).reshape(-1, 7)
+    packed = PackedScene(
+        vertices=all_v, faces=all_f, vertex_st=np.concatenate(st).astype(np.float32),
+        vertex_piece=np.concatenate(piece), face_material=np.concatenate(mat),
+        face_object=np.concatenate(obj), face_color=np.concatenate(color).astype(np.float32),
+        face_emission=np.concatenate(emission).astype(np.float32), face_gloss=np.concatenate(gloss),
+        face_normal=_face_normals(all_v, all_f),
+        camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),
+        shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
+        mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),
+        stripes=paint_stripes(scene.network, scene.case.road.markings), layers=layer_atlas(scene), lights=lights,
+    )
+    scene.cache["packed"] = packed
+    return packed
+
+
+__all__ = ["MATERIALS", "PackedScene", "pack_scene"]

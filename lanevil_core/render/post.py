@@ -1,0 +1,94 @@
+"""Image-space steps after shading: mirror blur, silhouette antialiasing, tone mapping to sRGB bytes."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._jit import kernel
+
+LUT_SIZE = 4096
+WHITE_POINT = 4.0
+
+
+def _srgb_lut() -> np.ndarray:
+    y = np.linspace(0.0, 1.0, LUT_SIZE)
+    srgb = np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1 / 2.4) - 0.055)
+    return np.clip(np.round(srgb * 255.0), 0, 255).astype(np.uint8)
+
+
+SRGB_LUT = _srgb_lut()
+
+
+@kernel
+def tonemap(hdr: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+    """Extended Reinhard curve then sRGB encoding through a lookup table."""
+    height, width, _ = hdr.shape
+    inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
+    top = lut.size - 1
+    for row in range(height):
+        for col in range(width):
+            for c in range(3):
+                x = max(hdr[row, col, c] * exposure, 0.0)
+                y = x * (1.0 + x * inv_w2) / (1.0 + x)
+                out[row, col, c] = lut[min(int(y * top + 0.5), top)]
+
+
+@kernel
+def smooth_silhouettes(hdr: np.ndarray, ids: np.ndarray, out: np.ndarray) -> None:
+    """Blend pixels on object-id boundaries with their 4-neighbourhood to soften staircase edges."""
+    height, width, _ = hdr.shape
+    for row in range(height):
+        for col in range(width):
+            i = ids[row, col]
+            edge = False
+            if col + 1 < width and ids[row, col + 1] != i:
+                edge = True
+            elif row + 1 < height and ids[row + 1, col] != i:
+                edge = True
+            elif col > 0 and ids[row, col - 1] != i:
+                edge = True
+            elif row > 0 and ids[row - 1, col] != i:
+                edge = True
+            for c in range(3):
+                if not edge:
+                    out[row, col, c] = hdr[row, col, c]
+                    continue
+                acc = 0.0
+                cnt = 0.0
+                if col + 1 < width:
+                    acc += min(hdr[row, col + 1, c], 8.0)
+                    cnt += 1.0
+                if col > 0:
+                    acc += min(hdr[row, col - 1, c], 8.0)
+                    cnt += 1.0
+                if row + 1 < height:
+                    acc += min(hdr[row + 1, col, c], 8.0)
+                    cnt += 1.0
+                if row > 0:
+                    acc += min(hdr[row - 1, col, c], 8.0)
+                    cnt += 1.0
+                out[row, col, c] = 0.5 * min(hdr[row, col, c], 8.0) + 0.5 * acc / cnt
+
+
+@kernel
+def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int) -> None:
+    """Box-blur a mirror image along columns in place (wet roads smear reflections vertically)."""
+    height, width, _ = img.shape
+    column = np.empty((height, 3))
+    for col in range(width):
+        for row in range(height):
+            for c in range(3):
+                column[row, c] = img[row, col, c]
+        for row in range(height):
+            if depth[row, col] == np.inf:
+                continue
+            lo = max(row - radius, 0)
+            hi = min(row + radius, height - 1)
+            for c in range(3):
+                acc = 0.0
+                cnt = 0
+                for r in range(lo, hi + 1):
+                    if depth[r, col] < np.inf:
+                        acc += column[r, c]
+                        cnt += 1
+                img[row, col, c] = acc / cnt

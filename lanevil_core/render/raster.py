@@ -1,0 +1,219 @@
+"""Triangle rasterization with a depth buffer (numba).
+
+The rasterizer knows nothing about what it draws: it takes vertices already in a view frame and writes, per
+pixel, the nearest face id, its depth and perspective-correct barycentric weights (a pytorch3d-style
+``Fragments``). Pixel (col, row) is sampled at its centre (col + 0.5, row + 0.5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import kernel
+
+from ..typed import Float32Array, IntArray
+
+
+@dataclass(frozen=True)
+class Fragments:
+    """Per-pixel result of rasterization.
+
+    Attributes:
+        face: (H, W) int32 face index, -1 where nothing was drawn.
+        depth: (H, W) float32 view depth (camera z, or distance along the light for orthographic views); inf if empty.
+        bary: (H, W, 2) float32 perspective-correct weights of the face's 2nd and 3rd vertex.
+    """
+
+    face: IntArray
+    depth: Float32Array
+    bary: Float32Array
+
+
+@kernel(inline="always")
+def _edge(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> float:
+    return (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+
+
+@kernel
+def _fill(
+    sx: np.ndarray, sy: np.ndarray, sw: np.ndarray, b1: np.ndarray, b2: np.ndarray, depth_v: np.ndarray,
+    face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool,
+) -> None:
+    """Scan-convert one screen-space triangle (vertices 0, 1, 2 of the small arrays)."""
+    height, width = depth_buf.shape
+    area = _edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2])
+    if area == 0.0 or not np.isfinite(area):
+        return
+    inv_area = 1.0 / area
+    y_min = max(int(np.floor(min(sy[0], sy[1], sy[2]) - 0.5)) + 1, 0)
+    y_max = min(int(np.floor(max(sy[0], sy[1], sy[2]) - 0.5)), height - 1)
+    x_lo_f = min(sx[0], sx[1], sx[2])
+    x_hi_f = max(sx[0], sx[1], sx[2])
+    for row in range(y_min, y_max + 1):
+        py = row + 0.5
+        # Solve the three edge inequalities for the covered x interval of this row.
+        lo, hi = x_lo_f - 0.5, x_hi_f + 0.5
+        ok = True
+        for e in range(3):
+            i, j = e, (e + 1) % 3
+            ax, ay, bx, by = sx[i], sy[i], sx[j], sy[j]
+            # edge(px) * sign(area) >= 0  with  edge = A*px + B,  A = -(by - ay)
+            a_coef = -(by - ay) * inv_area
+            b_coef = ((bx - ax) * (py - ay) + (by - ay) * ax) * inv_area
+            if a_coef > 0.0:
+                lo = max(lo, -b_coef / a_coef)
+            elif a_coef < 0.0:
+                hi = min(hi, -b_coef / a_coef)
+            elif b_coef < 0.0:
+                ok = False
+        if not ok or hi < lo:
+            continue
+        c0 = max(int(np.ceil(lo - 0.5)), 0)
+        c1 = min(int(np.floor(hi - 0.5)), width - 1)
+        for col in range(c0, c1 + 1):
+            px = col + 0.5
+            l0 = _edge(sx[1], sy[1], sx[2], sy[2], px, py) * inv_area
+            l1 = _edge(sx[2], sy[2], sx[0], sy[0], px, py) * inv_area
+            l2 = 1.0 - l0 - l1
+            if perspective:
+                w = l0 * sw[0] + l1 * sw[1] + l2 * sw[2]
+                if w <= 0.0:
+                    continue
+                z = 1.0 / w
+                p0, p1, p2 = l0 * sw[0] * z, l1 * sw[1] * z, l2 * sw[2] * z
+            else:
+                p0, p1, p2 = l0, l1, l2
+                z = l0 * depth_v[0] + l1 * depth_v[1] + l2 * depth_v[2]
+            if z < depth_buf[row, col]:
+                depth_buf[row, col] = z
+                face_buf[row, col] = face_index
+                bary_buf[row, col, 0] = p0 * b1[0] + p1 * b1[1] + p2 * b1[2]
+                bary_buf[row, col, 1] = p0 * b2[0] + p1 * b2[1] + p2 * b2[2]
+
+
+@kernel
+def _raster_perspective(
+    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, fx: float, fy: float, cx: float, cy: float,
+    near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+) -> None:
+    height, width = depth_buf.shape
+    # Clipped polygon: up to 4 vertices, each with position and its weights of the original vertices 1 and 2.
+    px = np.empty(4)
+    py = np.empty(4)
+    pz = np.empty(4)
+    pb1 = np.empty(4)
+    pb2 = np.empty(4)
+    sx = np.empty(3)
+    sy = np.empty(3)
+    sw = np.empty(3)
+    tb1 = np.empty(3)
+    tb2 = np.empty(3)
+    dz = np.empty(3)
+    ref_b1 = (0.0, 1.0, 0.0)
+    ref_b2 = (0.0, 0.0, 1.0)
+    for k in range(face_ids.size):
+        f = face_ids[k]
+        i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+        z0, z1, z2 = v_view[i0, 2], v_view[i1, 2], v_view[i2, 2]
+        if z0 <= near and z1 <= near and z2 <= near:
+            continue
+        # Cheap frustum rejection on x and y.
+        if (v_view[i0, 0] > z0 * (width - cx) / fx + 1e-9 and v_view[i1, 0] > z1 * (width - cx) / fx
+                and v_view[i2, 0] > z2 * (width - cx) / fx and z0 > near and z1 > near and z2 > near):
+            continue
+        if (v_view[i0, 0] < -z0 * cx / fx and v_view[i1, 0] < -z1 * cx / fx and v_view[i2, 0] < -z2 * cx / fx
+                and z0 > near and z1 > near and z2 > near):
+            continue
+        if (v_view[i0, 1] > z0 * (height - cy) / fy and v_view[i1, 1] > z1 * (height - cy) / fy
+                and v_view[i2, 1] > z2 * (height - cy) / fy and z0 > near and z1 > near and z2 > near):
+            continue
+        if (v_view[i0, 1] < -z0 * cy / fy and v_view[i1, 1] < -z1 * cy / fy and v_view[i2, 1] < -z2 * cy / fy
+                and z0 > near and z1 > near and z2 > near):
+            continue
+        # Sutherland-Hodgman against z = near.
+        n = 0
+        idx = (i0, i1, i2)
+        for e in range(3):
+            a, b = idx[e], idx[(e + 1) % 3]
+            za, zb = v_view[a, 2], v_view[b, 2]
+            if za > near:
+                px[n], py[n], pz[n] = v_view[a, 0], v_view[a, 1], za
+                pb1[n], pb2[n] = ref_b1[e], ref_b2[e]
+                n += 1
+            if (za > near) != (zb > near):
+                u = (near - za) / (zb - za)
+                e1 = (e + 1) % 3
+                px[n] = v_view[a, 0] + u * (v_view[b, 0] - v_view[a, 0])
+                py[n] = v_view[a, 1] + u * (v_view[b, 1] - v_view[a, 1])
+                pz[n] = near
+                pb1[n] = ref_b1[e] + u * (ref_b1[e1] - ref_b1[e])
+                pb2[n] = ref_b2[e] + u * (ref_b2[e1] - ref_b2[e])
+                n += 1
+        for t in range(1, n - 1):
+            for m, q in enumerate((0, t, t + 1)):
+                inv = 1.0 / pz[q]
+                sx[m] = fx * px[q] * inv + cx
+                sy[m] = fy * py[q] * inv + cy
+                sw[m] = inv
+                tb1[m], tb2[m] = pb1[q], pb2[q]
+                dz[m] = pz[q]
+            _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, True)
+
+
+@kernel
+def _raster_orthographic(
+    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float,
+    face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+) -> None:
+    height, width = depth_buf.shape
+    sx = np.empty(3)
+    sy = np.empty(3)
+    sw = np.ones(3)
+    tb1 = np.array([0.0, 1.0, 0.0])
+    tb2 = np.array([0.0, 0.0, 1.0])
+    dz = np.empty(3)
+    for k in range(face_ids.size):
+        f = face_ids[k]
+        for m in range(3):
+            i = faces[f, m]
+            sx[m] = (v_view[i, 0] - u0) * scale
+            sy[m] = (v_view[i, 1] - v0) * scale
+            dz[m] = v_view[i, 2]
+        if max(sx[0], sx[1], sx[2]) < 0 or min(sx[0], sx[1], sx[2]) > width:
+            continue
+        if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
+            continue
+        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False)
+
+
+def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Array]:
+    return (np.full((height, width), -1, np.int32), np.full((height, width), np.inf, np.float32),
+            np.zeros((height, width, 2), np.float32))
+
+
+def rasterize_perspective(
+    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
+    fx: float, fy: float, cx: float, cy: float, near: float,
+) -> Fragments:
+    """Rasterize faces ``face_ids`` of a mesh whose vertices (n, 3) are in an OpenCV camera frame.
+
+    Faces crossing the near plane are clipped; depth is camera z.
+    """
+    width, height = size
+    face_buf, depth_buf, bary_buf = _buffers(height, width)
+    _raster_perspective(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), fx, fy, cx, cy,
+                        near, face_buf, depth_buf, bary_buf)
+    return Fragments(face_buf, depth_buf, bary_buf)
+
+
+def rasterize_orthographic(
+    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
+) -> Fragments:
+    """Rasterize along +z of a view frame: pixel = (x - u0, y - v0) * scale; depth = view z (no clipping)."""
+    width, height = size
+    face_buf, depth_buf, bary_buf = _buffers(height, width)
+    _raster_orthographic(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), scale, u0, v0,
+                         face_buf, depth_buf, bary_buf)
+    return Fragments(face_buf, depth_buf, bary_buf)

@@ -1,0 +1,148 @@
+"""Render one frame of a compiled scene: camera -> raster -> shadow maps -> shade -> post."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..camera import PinholeCamera, ego_camera
+from ..scene import ID_SKY, CompiledScene, Environment
+from ..typed import Float32Array, IntArray, UInt8Array
+from .packed import MATERIAL_ALBEDO, PackedScene, pack_scene
+from .post import SRGB_LUT, blur_columns, smooth_silhouettes, tonemap
+from .raster import rasterize_perspective
+from .shading import road_coordinates, shade, shade_mirror
+from .shadow_map import ShadowMaps, build_shadow_maps
+from .textures import noise_textures
+
+MIRROR_BLUR_PX_AT_1280 = 6
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A rendered frame.
+
+    Attributes:
+        rgb: (H, W, 3) uint8 sRGB image.
+        depth: (H, W) float32 camera z (m), inf for sky.
+        object_id: (H, W) int32: scene.ID_SKY, ID_ROAD, ID_ROADSIDE or FIRST_OBJECT_ID + mesh index.
+        camera: the camera it was rendered with.
+        timings: milliseconds per stage.
+    """
+
+    rgb: UInt8Array
+    depth: Float32Array
+    object_id: IntArray
+    camera: PinholeCamera
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def _env_vector(env: Environment) -> np.ndarray:
+    return np.array([env.sun_intensity, env.ambient, env.wetness, env.puddles, env.fog_density, env.fog_distance,
+                     env.cloudiness, env.penumbra], np.float64)
+
+
+def _stripe_ranges(packed: PackedScene, pieces: int) -> np.ndarray:
+    ranges = np.zeros((pieces, 2), np.int64)
+    stripe_piece = packed.stripes[:, 0].astype(int)
+    for p in range(pieces):
+        idx = np.flatnonzero(stripe_piece == p)
+        if idx.size:
+            ranges[p] = (idx[0], idx[-1] + 1)
+    return ranges
+
+
+def _no_shadows() -> ShadowMaps:
+    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1), np.inf, np.float32),
+                      np.array([[0.0, 0.0, 1.0]]), np.eye(3))
+
+
+def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera) -> tuple[np.ndarray, np.ndarray]:
+    """Objects mirrored about the ground under them, rasterized and flat-shaded, blurred along columns."""
+    k = camera.intrinsics
+    env = scene.env
+    ground = scene.cache.get("mirror_ground")
+    if ground is None:
+        ground = _ground_heights(packed)
+        scene.cache["mirror_ground"] = ground
+    v_world = packed.vertices.copy()
+    v_world[:, 2] = 2.0 * ground - v_world[:, 2]
+    frags = rasterize_perspective(camera.world_to_camera(v_world), packed.faces, packed.mirror_faces,
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+    img = np.zeros((k.height, k.width, 3), np.float64)
+    lamp = 0.05 * len(scene.lights) if env.night else 0.0
+    shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission, packed.face_normal,
+                 env.sun_dir_world, env.sun_color.astype(np.float64), _env_vector(env),
+                 env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64), lamp, img)
+    blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)))
+    return img, frags.depth
+
+
+def _ground_heights(packed: PackedScene) -> np.ndarray:
+    """Per vertex: the lowest z of its connected object (the ground it stands on)."""
+    ground = np.zeros(len(packed.vertices))
+    obj_faces = packed.mirror_faces
+    if obj_faces.size == 0:
+        return ground
+    face_obj = packed.face_object[obj_faces]
+    for obj in np.unique(face_obj):
+        vids = np.unique(packed.faces[obj_faces[face_obj == obj]])
+        ground[vids] = packed.vertices[vids, 2].min()
+    return ground
+
+
+def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
+    wet_layers = any(layer.wet is not None and float(layer.wet.max()) > 0 for layer in scene.layers)
+    return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
+
+
+def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None) -> Frame:
+    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV)."""
+    timings: dict[str, float] = {}
+    clock = time.perf_counter()
+
+    def lap(name: str) -> None:
+        nonlocal clock
+        now = time.perf_counter()
+        timings[name] = (now - clock) * 1e3
+        clock = now
+
+    packed = pack_scene(scene)
+    camera = ego_camera(scene.case, scene.network, frame, size)
+    k = camera.intrinsics
+    env = scene.env
+    lap("setup")
+    frags = rasterize_perspective(camera.world_to_camera(packed.vertices), packed.faces, packed.camera_faces,
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+    lap("raster")
+    shadows = (build_shadow_maps(packed, camera, env.sun_dir_world)
+               if env.sun_intensity > 0 and packed.shadow_faces.size else _no_shadows())
+    lap("shadow_map")
+    if _needs_mirror(scene, packed):
+        refl_rgb, refl_depth = _mirror_pass(packed, scene, camera)
+    else:
+        refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
+    lap("mirror")
+    st_buf = np.zeros((k.height, k.width, 2), np.float64)
+    piece_buf = np.empty((k.height, k.width), np.int32)
+    road_coordinates(frags.face, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
+                     packed.face_material, st_buf, piece_buf)
+    hdr = np.empty((k.height, k.width, 3), np.float64)
+    fine, coarse = noise_textures()
+    shade(frags.face, frags.depth, st_buf, piece_buf, camera.R_world_camera, camera.p_world_camera,
+          k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
+          packed.face_normal, MATERIAL_ALBEDO, packed.stripes, _stripe_ranges(packed, len(scene.network.pieces)),
+          packed.layers.texels, packed.layers.table, packed.layers.first_level, packed.lights, fine, coarse,
+          _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
+          env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
+          shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world, refl_rgb, refl_depth, hdr)
+    lap("shade")
+    object_id = np.where(frags.face >= 0, packed.face_object[np.maximum(frags.face, 0)], ID_SKY).astype(np.int32)
+    smoothed = np.empty_like(hdr)
+    smooth_silhouettes(hdr, object_id, smoothed)
+    rgb = np.empty((k.height, k.width, 3), np.uint8)
+    tonemap(smoothed, env.exposure, SRGB_LUT, rgb)
+    lap("post")
+    return Frame(rgb, frags.depth, object_id, camera, timings)

@@ -1,0 +1,123 @@
+"""Procedural road-surface material, evaluated per pixel in road coordinates with analytic antialiasing.
+
+Every pattern is box-filtered over the pixel's footprint in (s, t) so thin paint and cracks stay stable from
+frame to frame instead of shimmering.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._jit import kernel
+
+
+@kernel(inline="always")
+def box_overlap(x: float, width: float, lo: float, hi: float) -> float:
+    """Fraction of the interval [x - width/2, x + width/2] that lies inside [lo, hi]."""
+    a = max(x - 0.5 * width, lo)
+    b = min(x + 0.5 * width, hi)
+    return max(b - a, 0.0) / width
+
+
+@kernel(inline="always")
+def _periodic_integral(x: float, on: float, period: float) -> float:
+    """Integral from 0 to x of a pattern that is 1 on [0, on) of every period."""
+    k = np.floor(x / period)
+    r = x - k * period
+    return k * on + min(r, on)
+
+
+@kernel(inline="always")
+def dash_coverage(s: float, width: float, on: float, period: float) -> float:
+    """Share of [s - width/2, s + width/2] covered by dashes of length ``on`` repeating every ``period``."""
+    a, b = s - 0.5 * width, s + 0.5 * width
+    return (_periodic_integral(b, on, period) - _periodic_integral(a, on, period)) / width
+
+
+@kernel
+def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprint_m: float) -> float:
+    """Bilinear sample of a tiled mip stack (levels, n, n) at road position (s, t)."""
+    levels, n = stack.shape[0], stack.shape[1]
+    level = 0
+    ratio = footprint_m / texel_m
+    while ratio > 1.0 and level < levels - 1:
+        ratio *= 0.5
+        level += 1
+    x = s / texel_m
+    y = t / texel_m
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = x - x0
+    fy = y - y0
+    mask = n - 1  # n is a power of two, so wrapping is a bit mask even for negative coordinates
+    i0 = int(x0) & mask
+    j0 = int(y0) & mask
+    i1 = (i0 + 1) & mask
+    j1 = (j0 + 1) & mask
+    a = stack[level, i0, j0] * (1 - fy) + stack[level, i0, j1] * fy
+    b = stack[level, i1, j0] * (1 - fy) + stack[level, i1, j1] * fy
+    return a * (1 - fx) + b * fx
+
+
+@kernel
+def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
+          rgb: np.ndarray) -> float:
+    """Blend the paint of stripes[lo:hi] over ``rgb`` in place; return the total paint coverage."""
+    total = 0.0
+    for k in range(lo, hi):
+        t_c, half = stripes[k, 1], stripes[k, 2]
+        if abs(t - t_c) > half + ft:
+            continue
+        cov = box_overlap(t, ft, t_c - half, t_c + half)
+        s0, s1 = stripes[k, 3], stripes[k, 4]
+        cov *= box_overlap(s, fs, s0, s1)
+        if cov <= 0.0:
+            continue
+        pattern = stripes[k, 5]
+        if pattern > 0.5:
+            cov *= dash_coverage(s - s0, fs, stripes[k, 6], stripes[k, 7])
+        for c in range(3):
+            rgb[c] = rgb[c] * (1.0 - cov) + stripes[k, 8 + c] * cov
+        total += cov
+    return min(total, 1.0)
+
+
+@kernel
+def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piece: int, s: float, t: float,
+                  footprint_m: float, over_paint: bool, rgb: np.ndarray, sample: np.ndarray) -> float:
+    """Blend every surface layer of ``piece`` (under or over paint) over ``rgb``; return the puddle wetness."""
+    wet = 0.0
+    for layer in range(first.size - 1):
+        row0 = first[layer]
+        if int(table[row0, 0]) != piece or (table[row0, 7] > 0.5) != over_paint:
+            continue
+        s0, t0, texel0 = table[row0, 1], table[row0, 2], table[row0, 3]
+        rows0, cols0 = table[row0, 4], table[row0, 5]
+        if s < s0 or t < t0 or s >= s0 + rows0 * texel0 or t >= t0 + cols0 * texel0:
+            continue
+        level = row0
+        ratio = footprint_m / texel0
+        while ratio > 1.0 and level < first[layer + 1] - 1:
+            ratio *= 0.5
+            level += 1
+        texel = table[level, 3]
+        rows, cols, offset = int(table[level, 4]), int(table[level, 5]), int(table[level, 6])
+        y = (s - s0) / texel - 0.5
+        x = (t - t0) / texel - 0.5
+        y0 = min(max(int(np.floor(y)), 0), rows - 1)
+        x0 = min(max(int(np.floor(x)), 0), cols - 1)
+        y1 = min(y0 + 1, rows - 1)
+        x1 = min(x0 + 1, cols - 1)
+        fy = min(max(y - y0, 0.0), 1.0)
+        fx = min(max(x - x0, 0.0), 1.0)
+        a = offset + y0 * cols
+        b = offset + y1 * cols
+        for c in range(5):
+            top = texels[a + x0, c] * (1 - fx) + texels[a + x1, c] * fx
+            bottom = texels[b + x0, c] * (1 - fx) + texels[b + x1, c] * fx
+            sample[c] = top * (1 - fy) + bottom * fy
+        alpha = sample[3]
+        for c in range(3):
+            rgb[c] = rgb[c] * (1.0 - alpha) + sample[c]  # premultiplied
+        wet = max(wet, sample[4])
+    return wet
