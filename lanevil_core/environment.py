@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from .case import Case
 from .scene import Environment
 from .typed import FloatArray
+
+if TYPE_CHECKING:  # the case model imports the illusions, which use sun_direction
+    from .case import Case
 
 
 def sun_direction(azimuth_deg: float, altitude_deg: float) -> FloatArray:

@@ -6,7 +6,7 @@ Data flows one way: ``Case`` (declarative) -> ``compile_scene`` (road surface, r
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -64,6 +64,10 @@ class Mesh:
             if emission.ndim == 1:
                 emission = np.broadcast_to(emission, (len(self.faces), 3))
             self.emission = np.ascontiguousarray(emission)
+
+    def renamed(self, name: str) -> Mesh:
+        """The same mesh under another name."""
+        return replace(self, name=name)
 
 
 @dataclass
@@ -124,6 +128,7 @@ class Environment:
     penumbra: float  # shadow softness in metres of blur at 1 m occluder distance
     exposure: float
     night: bool
+    headlights: float = 0.0  # intensity of the ego's two headlights (0 = off)
 
 
 @dataclass

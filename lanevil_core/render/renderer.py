@@ -17,7 +17,7 @@ from .shading import road_coordinates, shade, shade_mirror
 from .shadow_map import ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
-MIRROR_BLUR_PX_AT_1280 = 6
+MIRROR_BLUR_PX_AT_1280 = 10
 
 
 @dataclass(frozen=True)
@@ -93,6 +93,17 @@ def _ground_heights(packed: PackedScene) -> np.ndarray:
     return ground
 
 
+def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment) -> np.ndarray:
+    """The scene's lamps plus, when on, the ego's headlights (they move with the camera)."""
+    if env.headlights <= 0.0:
+        return packed.lights
+    R = camera.R_world_camera
+    forward, right, down = R[:, 2], R[:, 0], R[:, 1]
+    lamps = [camera.p_world_camera + forward * 1.5 + right * side * 0.75 + down * 2.3 for side in (-1.0, 1.0)]
+    rows = np.array([[*p, 1.0, 0.95, 0.85, env.headlights] for p in lamps])
+    return np.concatenate([packed.lights, rows])
+
+
 def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
     wet_layers = any(layer.wet is not None and float(layer.wet.max()) > 0 for layer in scene.layers)
     return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
@@ -134,7 +145,8 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
     shade(frags.face, frags.depth, st_buf, piece_buf, camera.R_world_camera, camera.p_world_camera,
           k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
           packed.face_normal, MATERIAL_ALBEDO, packed.stripes, _stripe_ranges(packed, len(scene.network.pieces)),
-          packed.layers.texels, packed.layers.table, packed.layers.first_level, packed.lights, fine, coarse,
+          packed.layers.texels, packed.layers.table, packed.layers.first_level, _frame_lights(packed, camera, env),
+          fine, coarse,
           _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
           env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
           shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world, refl_rgb, refl_depth, hdr)

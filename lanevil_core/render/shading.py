@@ -16,7 +16,8 @@ from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA = range(8)
-ASPHALT, KERB = 0, 4
+ASPHALT, CONCRETE, KERB = 0, 1, 4
+WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 
@@ -143,7 +144,9 @@ def shade(
                 for c in range(3):
                     rgb[c] = face_color[f, c]
                 roughness = 0.25
-            surface_wet = max(env_f[WETNESS] if material >= 0 else 0.0, wet)
+            # Paved surfaces hold a water film; grass, gravel and dirt soak it up.
+            paved = material == ASPHALT or material == CONCRETE or material == KERB
+            surface_wet = max(env_f[WETNESS] if paved else 0.0, wet)
             if surface_wet > 0.0:
                 darken = 1.0 - 0.5 * surface_wet
                 for c in range(3):
@@ -196,7 +199,7 @@ def shade(
             mirror = surface_wet if material >= 0 else gloss
             if mirror > 0.0:
                 fres = fresnel_schlick(n_dot_v, 0.02 if material >= 0 else 0.05)
-                strength = fres * (wet + (surface_wet - wet) * 0.7 if material >= 0 else gloss)
+                strength = fres * (wet + (surface_wet - wet) * WET_FILM_MIRROR if material >= 0 else gloss)
                 dot = d_world[0] * n[0] + d_world[1] * n[1] + d_world[2] * n[2]
                 for i in range(3):
                     r[i] = d_world[i] - 2.0 * dot * n[i]
