@@ -1,0 +1,106 @@
+"""``lanevil illusions``, ``lanevil sheet`` and ``lanevil library``: the illusion registry and the stock cases."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from .case import write_atomic
+from .cli import Command, UsageError, parse_size
+from .illusions import REGISTRY, Illusion
+
+
+def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
+    """Name, category, tunable parameters (with ranges and defaults) and the severity table of one type."""
+    schema = cls.model_json_schema()
+    parameters = {}
+    for field, spec in schema.get("properties", {}).items():
+        if field == "type":
+            continue
+        keys = ("type", "anyOf", "enum", "default", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",
+                "description")
+        parameters[field] = {key: spec[key] for key in keys if key in spec}
+    return {"name": cls.model_fields["type"].default, "category": cls.CATEGORY,
+            "description": (cls.__doc__ or "").strip().splitlines()[0], "parameters": parameters,
+            "severity": [dict(row) for row in cls.SEVERITY]}
+
+
+def _range(spec: dict[str, Any]) -> str:
+    for option in spec.get("anyOf", []):  # optional fields: the range of the non-null choice
+        if option.get("type") != "null":
+            spec = option
+    lo = spec.get("minimum", spec.get("exclusiveMinimum"))
+    hi = spec.get("maximum", spec.get("exclusiveMaximum"))
+    if "enum" in spec:
+        return "|".join(map(str, spec["enum"]))
+    return f"{lo}..{hi}" if lo is not None or hi is not None else ""
+
+
+def _format(infos: list[dict[str, Any]]) -> str:
+    lines = []
+    for info in infos:
+        lines.append(f"{info['name']}  [{info['category']}]  {info['description']}")
+        params = ", ".join(f"{name}={spec.get('default')!r} ({_range(spec)})".replace(" ()", "")
+                           for name, spec in info["parameters"].items())
+        lines.append(f"  parameters: {params}")
+        for level, row in enumerate(info["severity"], start=1):
+            lines.append(f"  level {level}: " + ", ".join(f"{k}={v}" for k, v in row.items()))
+    return "\n".join(lines)
+
+
+def _illusions_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print the registry as JSON")
+
+
+def _run_illusions(args: argparse.Namespace) -> int:
+    infos = [illusion_info(cls) for cls in REGISTRY.values()]
+    print(json.dumps(infos, indent=2) if args.json else _format(infos))
+    return 0
+
+
+def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, required=True, help="output image (PNG)")
+    parser.add_argument("--size", type=parse_size, default=(320, 180), help="cell size WIDTHxHEIGHT (default 320x180)")
+    parser.add_argument("--frame", type=int, default=0, help="frame of every case (default 0)")
+    parser.add_argument("--types", default=None, help="comma-separated illusion types (default: all 14)")
+
+
+def _run_sheet(args: argparse.Namespace) -> int:
+    from .export import png_bytes
+    from .sheet import contact_sheet
+
+    types = None
+    if args.types:
+        types = [name.strip() for name in args.types.split(",") if name.strip()]
+        unknown = [name for name in types if name not in REGISTRY]
+        if unknown:
+            raise UsageError(f"--types: unknown illusion type {unknown[0]!r}; see 'lanevil illusions'")
+    if not 0 <= args.frame < 50:
+        raise UsageError("--frame must lie in 0..49 (every stock case has at least 50 frames)")
+    write_atomic(args.out, png_bytes(contact_sheet(args.size, args.frame, types)))
+    print(args.out)
+    return 0
+
+
+def _library_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, default=Path("scenes"), help="folder to write into (default scenes)")
+
+
+def _run_library(args: argparse.Namespace) -> int:
+    from .stock import write_library
+
+    written = write_library(args.out)
+    print(f"{len(written)} cases in {args.out}")
+    return 0
+
+
+COMMANDS: dict[str, Command] = {
+    "illusions": Command("list the illusion registry with parameters and severity tables", _illusions_arguments,
+                         _run_illusions),
+    "sheet": Command("render a contact sheet: one row per illusion, original and levels 1-5", _sheet_arguments,
+                     _run_sheet),
+    "library": Command("write the stock case library (clean cases and every illusion at levels 1-5)",
+                       _library_arguments, _run_library),
+}
