@@ -1,16 +1,55 @@
-"""The one numba decorator of the renderer's hot loops.
+"""The one numba decorator of the renderer's hot loops, and a guard for numba's on-disk cache.
 
 Fast-math lets LLVM fuse and vectorise arithmetic; ``nnan``/``ninf`` stay off because depth buffers use inf
 for "nothing here". Results are deterministic for a given machine and build.
+
+Numba keys a cached kernel on its own source file only, so a kernel that inlines helpers from another module
+would keep running stale machine code after that module changes. The guard below drops the package's cache
+whenever any renderer source changes.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+from pathlib import Path
 from typing import Any, Callable
 
 import numba as nb
 
 FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def _sources_digest() -> str:
+    digest = hashlib.sha256()
+    for path in sorted(_PACKAGE.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _drop_stale_cache() -> None:
+    cache_dir = _PACKAGE / "__pycache__"
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return  # a user-chosen cache location is the user's to manage
+    stamp = cache_dir / "lanevil-kernels.sha256"
+    digest = _sources_digest()
+    try:
+        if stamp.read_text() == digest:
+            return
+    except OSError:
+        pass
+    try:
+        cache_dir.mkdir(exist_ok=True)
+        for path in list(cache_dir.glob("*.nbi")) + list(cache_dir.glob("*.nbc")):
+            path.unlink(missing_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # a read-only install: numba then compiles in memory
+        pass
+
+
+_drop_stale_cache()
 
 
 def kernel(fn: Callable[..., Any] | None = None, *, inline: str = "never") -> Any:

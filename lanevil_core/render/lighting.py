@@ -8,10 +8,11 @@ from ._jit import kernel
 
 SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
 SKY_SCALE = 1.6
+PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 
 
-@kernel
+@kernel(inline="always")
 def sky_radiance(d: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
                  zenith: np.ndarray, horizon: np.ndarray, cloudiness: float, out: np.ndarray) -> None:
     """Radiance of the sky seen along unit world direction ``d`` (gradient, sun disk and glow)."""
@@ -36,7 +37,7 @@ def sky_radiance(d: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, sun_
             out[c] += sun_color[c] * sun_intensity * (disk + glow)
 
 
-@kernel
+@kernel(inline="always")
 def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: float) -> float:
     """Bilinear percentage-closer test at map coordinates (u, v) (texels)."""
     size = depth.shape[1]
@@ -57,7 +58,7 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
     return lit
 
 
-@kernel
+@kernel(inline="always")
 def sun_visibility(p: np.ndarray, normal: np.ndarray, maps: np.ndarray, coarse: np.ndarray, params: np.ndarray,
                    R_light: np.ndarray, penumbra: float) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges."""
@@ -85,27 +86,15 @@ def sun_visibility(p: np.ndarray, normal: np.ndarray, maps: np.ndarray, coarse: 
                 nearest = min(nearest, coarse[c, j, i])
         if nearest >= d - bias:
             return 1.0
-        # Blocker search: the nearest caster depth around the point sets the penumbra width.
-        search = max(2.0, min(0.6 * scale, 7.0))
-        blocker = 0.0
-        count = 0
+        # The caster right above the point (else the nearest one around) sets the penumbra width.
+        z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
+        blocker = z_center if z_center < d - bias else nearest
+        radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
+        lit = 0.0
         for j in range(-1, 2):
             for i in range(-1, 2):
-                xi = min(max(int(x + i * search * 0.5), 0), size - 1)
-                yi = min(max(int(y + j * search * 0.5), 0), size - 1)
-                z = maps[c, yi, xi]
-                if z < d - bias:
-                    blocker += z
-                    count += 1
-        if count == 0:
-            return 1.0
-        blocker /= count
-        radius = max(0.7, min(penumbra * (d - blocker) * scale, search))
-        lit = 0.0
-        for j in range(-2, 3):
-            for i in range(-2, 3):
-                lit += _shadow_tap(maps, c, x + i * radius * 0.5, y + j * radius * 0.5, d, bias)
-        return lit / 25.0
+                lit += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
+        return lit / 9.0
     return 1.0
 
 

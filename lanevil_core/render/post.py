@@ -1,4 +1,4 @@
-"""Image-space steps after shading: mirror blur, silhouette antialiasing, tone mapping to sRGB bytes."""
+"""Image-space steps after shading: mirror blur, silhouette antialiasing and tone mapping to sRGB bytes."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from ._jit import kernel
 
 LUT_SIZE = 4096
 WHITE_POINT = 4.0
+CLAMP = 8.0  # bright highlights are clamped before edge blending so a sun glint does not bleed
 
 
 def _srgb_lut() -> np.ndarray:
@@ -19,55 +20,45 @@ def _srgb_lut() -> np.ndarray:
 SRGB_LUT = _srgb_lut()
 
 
+@kernel(inline="always")
+def _encode(x: float, inv_w2: float, lut: np.ndarray) -> np.uint8:
+    """Extended Reinhard curve, then sRGB encoding through a lookup table."""
+    x = max(x, 0.0)
+    y = x * (1.0 + x * inv_w2) / (1.0 + x)
+    top = lut.size - 1
+    return lut[min(int(y * top + 0.5), top)]
+
+
 @kernel
-def tonemap(hdr: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
-    """Extended Reinhard curve then sRGB encoding through a lookup table."""
+def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+    """Tone-map to sRGB bytes; pixels on an object-id boundary are first blended with their 4-neighbourhood
+    (a cheap silhouette antialias: the procedural road is already filtered, object edges are not)."""
     height, width, _ = hdr.shape
     inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
-    top = lut.size - 1
-    for row in range(height):
-        for col in range(width):
-            for c in range(3):
-                x = max(hdr[row, col, c] * exposure, 0.0)
-                y = x * (1.0 + x * inv_w2) / (1.0 + x)
-                out[row, col, c] = lut[min(int(y * top + 0.5), top)]
-
-
-@kernel
-def smooth_silhouettes(hdr: np.ndarray, ids: np.ndarray, out: np.ndarray) -> None:
-    """Blend pixels on object-id boundaries with their 4-neighbourhood to soften staircase edges."""
-    height, width, _ = hdr.shape
     for row in range(height):
         for col in range(width):
             i = ids[row, col]
-            edge = False
-            if col + 1 < width and ids[row, col + 1] != i:
-                edge = True
-            elif row + 1 < height and ids[row + 1, col] != i:
-                edge = True
-            elif col > 0 and ids[row, col - 1] != i:
-                edge = True
-            elif row > 0 and ids[row - 1, col] != i:
-                edge = True
+            edge = ((col + 1 < width and ids[row, col + 1] != i) or (row + 1 < height and ids[row + 1, col] != i)
+                    or (col > 0 and ids[row, col - 1] != i) or (row > 0 and ids[row - 1, col] != i))
             for c in range(3):
-                if not edge:
-                    out[row, col, c] = hdr[row, col, c]
-                    continue
-                acc = 0.0
-                cnt = 0.0
-                if col + 1 < width:
-                    acc += min(hdr[row, col + 1, c], 8.0)
-                    cnt += 1.0
-                if col > 0:
-                    acc += min(hdr[row, col - 1, c], 8.0)
-                    cnt += 1.0
-                if row + 1 < height:
-                    acc += min(hdr[row + 1, col, c], 8.0)
-                    cnt += 1.0
-                if row > 0:
-                    acc += min(hdr[row - 1, col, c], 8.0)
-                    cnt += 1.0
-                out[row, col, c] = 0.5 * min(hdr[row, col, c], 8.0) + 0.5 * acc / cnt
+                x = hdr[row, col, c]
+                if edge:
+                    acc = 0.0
+                    cnt = 0.0
+                    if col + 1 < width:
+                        acc += min(hdr[row, col + 1, c], CLAMP)
+                        cnt += 1.0
+                    if col > 0:
+                        acc += min(hdr[row, col - 1, c], CLAMP)
+                        cnt += 1.0
+                    if row + 1 < height:
+                        acc += min(hdr[row + 1, col, c], CLAMP)
+                        cnt += 1.0
+                    if row > 0:
+                        acc += min(hdr[row - 1, col, c], CLAMP)
+                        cnt += 1.0
+                    x = 0.5 * min(x, CLAMP) + 0.5 * acc / cnt
+                out[row, col, c] = _encode(x * exposure, inv_w2, lut)
 
 
 @kernel

@@ -40,8 +40,12 @@ def _edge(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> f
 def _fill(
     sx: np.ndarray, sy: np.ndarray, sw: np.ndarray, b1: np.ndarray, b2: np.ndarray, depth_v: np.ndarray,
     face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool,
+    attributes: bool = True,
 ) -> None:
-    """Scan-convert one screen-space triangle (vertices 0, 1, 2 of the small arrays)."""
+    """Scan-convert one screen-space triangle (vertices 0, 1, 2 of the small arrays).
+
+    With ``attributes`` False only the depth buffer is written (shadow maps).
+    """
     height, width = depth_buf.shape
     area = _edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2])
     if area == 0.0 or not np.isfinite(area):
@@ -88,6 +92,8 @@ def _fill(
                 z = l0 * depth_v[0] + l1 * depth_v[1] + l2 * depth_v[2]
             if z < depth_buf[row, col]:
                 depth_buf[row, col] = z
+                if not attributes:
+                    continue
                 face_buf[row, col] = face_index
                 bary_buf[row, col, 0] = p0 * b1[0] + p1 * b1[1] + p2 * b1[2]
                 bary_buf[row, col, 1] = p0 * b2[0] + p1 * b2[1] + p2 * b2[2]
@@ -185,7 +191,7 @@ def _raster_orthographic(
             continue
         if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
             continue
-        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False)
+        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False)
 
 
 def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Array]:
@@ -208,12 +214,12 @@ def rasterize_perspective(
     return Fragments(face_buf, depth_buf, bary_buf)
 
 
-def rasterize_orthographic(
+def depth_orthographic(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
-) -> Fragments:
-    """Rasterize along +z of a view frame: pixel = (x - u0, y - v0) * scale; depth = view z (no clipping)."""
+) -> Float32Array:
+    """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping)."""
     width, height = size
-    face_buf, depth_buf, bary_buf = _buffers(height, width)
+    depth_buf = np.full((height, width), np.inf, np.float32)
     _raster_orthographic(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), scale, u0, v0,
-                         face_buf, depth_buf, bary_buf)
-    return Fragments(face_buf, depth_buf, bary_buf)
+                         np.empty((1, 1), np.int32), depth_buf, np.empty((1, 1, 2), np.float32))
+    return depth_buf

@@ -11,7 +11,7 @@ from ..camera import PinholeCamera, ego_camera
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
 from .packed import MATERIAL_ALBEDO, PackedScene, pack_scene
-from .post import SRGB_LUT, blur_columns, smooth_silhouettes, tonemap
+from .post import SRGB_LUT, blur_columns, finish
 from .raster import rasterize_perspective
 from .shading import road_coordinates, shade, shade_mirror
 from .shadow_map import ShadowMaps, build_shadow_maps
@@ -152,9 +152,7 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
           shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world, refl_rgb, refl_depth, hdr)
     lap("shade")
     object_id = np.where(frags.face >= 0, packed.face_object[np.maximum(frags.face, 0)], ID_SKY).astype(np.int32)
-    smoothed = np.empty_like(hdr)
-    smooth_silhouettes(hdr, object_id, smoothed)
     rgb = np.empty((k.height, k.width, 3), np.uint8)
-    tonemap(smoothed, env.exposure, SRGB_LUT, rgb)
+    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb)
     lap("post")
     return Frame(rgb, frags.depth, object_id, camera, timings)

@@ -14,7 +14,7 @@ from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
 from .packed import PackedScene
 from .lighting import COARSE_SHIFT, min_pool
-from .raster import rasterize_orthographic
+from .raster import depth_orthographic
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)
 CASCADE_SIZE = 1024
@@ -73,8 +73,7 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
         texel = 2.0 ** np.ceil(np.log2(extent / size))  # power-of-two texels keep snapping stable
         u0 = np.floor((0.5 * (lo[0] + hi[0]) - 0.5 * size * texel) / texel) * texel
         v0 = np.floor((0.5 * (lo[1] + hi[1]) - 0.5 * size * texel) / texel) * texel
-        frags = rasterize_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0)
-        depth[c] = frags.depth
+        depth[c] = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0)
         params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
     return ShadowMaps(depth, min_pool(depth, COARSE_SHIFT), params, R_light_world)

@@ -34,7 +34,7 @@ def dash_coverage(s: float, width: float, on: float, period: float) -> float:
     return (_periodic_integral(b, on, period) - _periodic_integral(a, on, period)) / width
 
 
-@kernel
+@kernel(inline="always")
 def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprint_m: float) -> float:
     """Bilinear sample of a tiled mip stack (levels, n, n) at road position (s, t)."""
     levels, n = stack.shape[0], stack.shape[1]
@@ -59,7 +59,7 @@ def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprin
     return a * (1 - fx) + b * fx
 
 
-@kernel
+@kernel(inline="always")
 def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
           rgb: np.ndarray) -> float:
     """Blend the paint of stripes[lo:hi] over ``rgb`` in place; return the total paint coverage."""
@@ -82,7 +82,7 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
     return min(total, 1.0)
 
 
-@kernel
+@kernel(inline="always")
 def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piece: int, s: float, t: float,
                   footprint_m: float, over_paint: bool, rgb: np.ndarray, sample: np.ndarray) -> float:
     """Blend every surface layer of ``piece`` (under or over paint) over ``rgb``; return the puddle wetness."""
