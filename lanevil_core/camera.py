@@ -30,8 +30,9 @@ class Intrinsics:
     @classmethod
     def from_fov(cls, width: int, height: int, fov_deg: float) -> Intrinsics:
         """Square pixels, principal point at the image centre, horizontal FOV ``fov_deg``."""
-        fx = 0.5 * width / np.tan(np.radians(fov_deg) / 2)
-        return cls(width, height, float(fx), float(fx), width / 2.0, height / 2.0)
+        # Rounded so that 90 degrees gives exactly width / 2 (tan(pi/4) is not exactly 1 in floating point).
+        fx = round(0.5 * width / float(np.tan(np.radians(fov_deg) / 2)), 9)
+        return cls(width, height, fx, fx, width / 2.0, height / 2.0)
 
     @property
     def K(self) -> FloatArray:

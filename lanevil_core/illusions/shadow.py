@@ -1,3 +1,297 @@
-"""shadow illusions."""
+"""Shadow illusions: structures beside and above the road whose sun shadows fall across the lanes.
+
+Each illusion builds real meshes (``structures``) and sets the sun; the shadows themselves come only from the
+renderer's sun shadow map. Severity lowers the sun (longer shadows), raises its intensity and narrows the
+penumbra (harder, darker edges) and makes the structure denser or bigger.
+
+The sun's default azimuth is chosen from the road heading at the illusion: the sun stands on the structure's side,
+``sun_ahead`` degrees from square-on towards the ego's direction of travel, so shadows reach across the lanes and
+back towards the camera.
+"""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field
+
+from ..primitives import pose_on_road, transformed
+from ..structures import clear_runs, fence, ground_height, outside_gaps, overhead_rail, power_lines, streetlight
+from .base import Category, CompileContext, Illusion, register
+
+if TYPE_CHECKING:
+    from ..case import Case
+    from ..road_geometry import ReferenceLine
+    from ..road_layout import RoadPiece
+
+Side = Literal["left", "right"]
+Albedo = Annotated[float, Field(ge=0.0, le=1.0)]
+BEYOND_DRIVE_M = 40.0  # structures reach this far past the ego's last position
+ROAD_END_MARGIN_M = 5.0
+MAX_AHEAD_DEG = 75.0  # the sun never stands further ahead than this when its azimuth is solved for
+UPRIGHT_KINDS = ("streetlight", "pole")  # props already standing beside the road that our posts must not hit
+UPRIGHT_CLEARANCE_M = 1.5
+
+
+class SunShadowIllusion(Illusion):
+    """Fields and sun handling shared by the shadow illusions (not registered itself)."""
+
+    CATEGORY: ClassVar[Category] = "shadow"
+
+    sun_altitude: float | None = Field(
+        None, ge=2, le=89, description="sun altitude (degrees); empty = from the severity table"
+    )
+    sun_azimuth: float | None = Field(
+        None, ge=-360, le=360,
+        description="sun azimuth (degrees, CCW from world +X); empty = chosen from the road heading so shadows "
+        "fall across the lanes",
+    )
+    sun_intensity: float | None = Field(
+        None, ge=0, le=3, description="direct sun luminance (1 = clear noon); empty = from the severity table"
+    )
+
+    def altitude(self) -> float:
+        """Sun altitude (degrees): the override or the table's."""
+        return float(self.level()["sun_altitude"] if self.sun_altitude is None else self.sun_altitude)
+
+    def apply_sun(self, ctx: CompileContext, s_road: float, side_sign: float, ahead: float | None = None) -> None:
+        """Set the environment's sun from the table row or the overrides.
+
+        ``side_sign`` is +1 when the shadow-casting structure stands left of the road, -1 when right; ``ahead``
+        (degrees from square-on towards the direction of travel) defaults to the table's ``sun_ahead``.
+        """
+        from ..environment import sun_direction  # imported here: environment imports the case model
+
+        level = self.level()
+        altitude = self.altitude()
+        azimuth = self.sun_azimuth
+        if azimuth is None:
+            heading_deg = float(np.degrees(ctx.network.main.line.heading_at(s_road)))
+            ahead = level["sun_ahead"] if ahead is None else ahead
+            azimuth = heading_deg + side_sign * (90.0 - ahead)
+        ctx.env.sun_dir_world = sun_direction(azimuth, altitude)
+        ctx.env.sun_intensity = float(level["sun_intensity"] if self.sun_intensity is None else self.sun_intensity)
+        ctx.env.penumbra = float(level["penumbra"])
+
+    def extent(self, case: Case, length: float | None) -> tuple[float, float]:
+        """(s0, s1) along the main road: from ``start_s`` over ``length``, or to past the end of the drive."""
+        s0 = self.start_s(case)
+        s1 = s0 + length if length is not None else case.ego_s(case.ego.frames - 1) + BEYOND_DRIVE_M
+        s1 = min(s1, case.road.length - ROAD_END_MARGIN_M)
+        return s0, max(s1, s0 + 1.0)
+
+
+def side_sign(side: Side) -> float:
+    """+1 for the left of the road, -1 for the right."""
+    return 1.0 if side == "left" else -1.0
+
+
+def roadside_t(piece: RoadPiece, offset: float, sign: float) -> float:
+    """t of a point ``offset`` metres beyond the paved edge (carriageway plus an asphalt shoulder)."""
+    paved = piece.half_width
+    if piece.strips and piece.strips[0].material == "asphalt":
+        paved += piece.strips[0].width
+    return sign * (paved + offset)
+
+
+def blocked(ctx: CompileContext, piece: RoadPiece) -> list[tuple[float, float, int]]:
+    """``piece.gaps`` plus a short gap around the foot of every lamp or pole already standing beside the piece."""
+    gaps = list(piece.gaps)
+    for mesh in ctx.meshes:
+        if mesh.kind in UPRIGHT_KINDS:
+            s_road, t_road, h_road = _road_frame(piece.line, mesh.vertices)
+            feet = (h_road < -0.05) & (np.abs(t_road) < piece.half_width + 15.0)  # only footings dip below the road
+            for s_foot, side in {(round(float(a), 1), 1 if b > 0 else -1) for a, b in zip(s_road[feet], t_road[feet])}:
+                gaps.append((s_foot - UPRIGHT_CLEARANCE_M, s_foot + UPRIGHT_CLEARANCE_M, side))
+    return gaps
+
+
+def _road_frame(line: ReferenceLine, p_world: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(n,) s, t, h of world points (n, 3): nearest 1 m sample of the line, refined along its tangent."""
+    xy, s_samples = line.xy[::10], line.s[::10]
+    s_near = s_samples[np.argmin(((p_world[:, None, :2] - xy[None]) ** 2).sum(-1), axis=1)]
+    origin, tangent, _ = line.frame(s_near)
+    flat = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
+    s_road = s_near + ((p_world[:, :2] - origin[:, :2]) * flat).sum(1)
+    origin, _, left = line.frame(s_road)
+    return s_road, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
+
+
+@register
+class StreetlightShadow(SunShadowIllusion):
+    """Rows of street lamps whose long low-sun shadows stripe the lanes."""
+
+    # Lower sun, brighter and harder light, taller, thicker and closer-spaced poles as the level rises.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"sun_altitude": 45.0, "sun_ahead": 25.0, "sun_intensity": 0.8, "penumbra": 0.020, "spacing": 35.0,
+         "pole_height": 7.0, "pole_radius": 0.11, "arm": 1.2},
+        {"sun_altitude": 38.0, "sun_ahead": 33.0, "sun_intensity": 0.95, "penumbra": 0.015, "spacing": 30.0,
+         "pole_height": 8.0, "pole_radius": 0.12, "arm": 1.5},
+        {"sun_altitude": 31.0, "sun_ahead": 40.0, "sun_intensity": 1.1, "penumbra": 0.011, "spacing": 26.0,
+         "pole_height": 9.0, "pole_radius": 0.14, "arm": 1.8},
+        {"sun_altitude": 25.0, "sun_ahead": 48.0, "sun_intensity": 1.3, "penumbra": 0.008, "spacing": 23.0,
+         "pole_height": 10.0, "pole_radius": 0.16, "arm": 2.0},
+        {"sun_altitude": 20.0, "sun_ahead": 55.0, "sun_intensity": 1.5, "penumbra": 0.005, "spacing": 20.0,
+         "pole_height": 11.0, "pole_radius": 0.18, "arm": 2.2},
+    )
+
+    type: Literal["streetlight_shadow"] = "streetlight_shadow"
+    side: Literal["left", "right", "both"] = Field("right", description="which roadside the lamps stand on")
+    length: float | None = Field(
+        None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
+    )
+    offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
+    spacing: float | None = Field(None, ge=10, le=100, description="distance between lamps (m); empty = from the table")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        piece = ctx.network.main
+        s0, s1 = self.extent(ctx.case, self.length)
+        spacing = self.spacing if self.spacing is not None else level["spacing"]
+        signs = (-1.0, 1.0) if self.side == "both" else (side_sign(self.side),)
+        self.apply_sun(ctx, s0, signs[0])
+        gaps = blocked(ctx, piece)
+        for k, sign in enumerate(signs):
+            s_poles = np.arange(s0 + 0.5 * spacing * k, s1, spacing)
+            t_pole = roadside_t(piece, self.offset, sign)
+            yaw = 0.0 if sign < 0 else np.pi  # the arm reaches over the road
+            lamp = streetlight(level["pole_height"], level["arm"], pole_radius=level["pole_radius"])
+            for index, s_pole in enumerate(s_poles[outside_gaps(s_poles, t_pole, gaps)]):
+                pose = pose_on_road(piece.line, float(s_pole), t_pole, yaw, ground_height(piece, t_pole))
+                mesh = transformed(lamp, pose)
+                mesh.name = f"streetlight {'left' if sign > 0 else 'right'} {index + 1}"
+                ctx.add_mesh(mesh)
+
+
+@register
+class FenceShadow(SunShadowIllusion):
+    """A slatted fence beside the road whose low-sun shadow lays stripes across the lanes."""
+
+    # Lower sun from further ahead (longer stripes nearer the lane direction), taller and denser slats.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"sun_altitude": 32.0, "sun_ahead": 20.0, "sun_intensity": 0.8, "penumbra": 0.020, "height": 1.6,
+         "slat_width": 0.10, "slat_gap": 0.40},
+        {"sun_altitude": 26.0, "sun_ahead": 28.0, "sun_intensity": 0.95, "penumbra": 0.015, "height": 2.0,
+         "slat_width": 0.12, "slat_gap": 0.32},
+        {"sun_altitude": 21.0, "sun_ahead": 36.0, "sun_intensity": 1.1, "penumbra": 0.011, "height": 2.4,
+         "slat_width": 0.13, "slat_gap": 0.26},
+        {"sun_altitude": 17.0, "sun_ahead": 44.0, "sun_intensity": 1.3, "penumbra": 0.008, "height": 2.8,
+         "slat_width": 0.14, "slat_gap": 0.21},
+        {"sun_altitude": 14.0, "sun_ahead": 50.0, "sun_intensity": 1.5, "penumbra": 0.005, "height": 3.2,
+         "slat_width": 0.15, "slat_gap": 0.18},
+    )
+
+    type: Literal["fence_shadow"] = "fence_shadow"
+    side: Side = Field("right", description="which roadside the fence stands on")
+    length: float | None = Field(
+        None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
+    )
+    offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
+    color: tuple[Albedo, Albedo, Albedo] = Field((0.13, 0.085, 0.05), description="linear albedo of the slats")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        piece = ctx.network.main
+        sign = side_sign(self.side)
+        s0, s1 = self.extent(ctx.case, self.length)
+        self.apply_sun(ctx, s0, sign)
+        t_fence = roadside_t(piece, self.offset, sign)
+        for index, (a, b) in enumerate(clear_runs(s0, s1, t_fence, blocked(ctx, piece))):
+            ctx.add_mesh(fence(piece.line, a, b, t_fence, level["height"], level["slat_width"], level["slat_gap"],
+                               ground=ground_height(piece, t_fence), color=self.color, name=f"fence {index + 1}"))
+
+
+@register
+class RailShadow(SunShadowIllusion):
+    """An elevated slotted rail deck over the road: a shaded road with bright lines where light comes through."""
+
+    # Slots turn from across the road to along it (bright lines parallel to the lanes), the deck grows longer.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"sun_altitude": 60.0, "sun_ahead": 70.0, "sun_intensity": 0.8, "penumbra": 0.012, "deck_length": 8.0,
+         "slots_along": "t", "slot_width": 0.45, "slot_pitch": 1.8, "deck_depth": 0.25},
+        {"sun_altitude": 55.0, "sun_ahead": 70.0, "sun_intensity": 0.95, "penumbra": 0.009, "deck_length": 12.0,
+         "slots_along": "t", "slot_width": 0.45, "slot_pitch": 1.5, "deck_depth": 0.25},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.1, "penumbra": 0.007, "deck_length": 16.0,
+         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
+        {"sun_altitude": 45.0, "sun_ahead": 75.0, "sun_intensity": 1.3, "penumbra": 0.005, "deck_length": 22.0,
+         "slots_along": "s", "slot_width": 0.27, "slot_pitch": 1.2, "deck_depth": 0.35},
+        {"sun_altitude": 40.0, "sun_ahead": 78.0, "sun_intensity": 1.5, "penumbra": 0.003, "deck_length": 28.0,
+         "slots_along": "s", "slot_width": 0.30, "slot_pitch": 1.1, "deck_depth": 0.35},
+    )
+
+    type: Literal["rail_shadow"] = "rail_shadow"
+    side: Side = Field("right", description="side the sun leans towards (the shadow shifts the other way)")
+    deck_length: float | None = Field(
+        None, ge=3, le=80, description="length of the deck along the road (m); empty = from the table"
+    )
+    clearance: float = Field(5.5, ge=4.5, le=15, description="height of the deck's underside above the road (m)")
+    margin: float = Field(3.0, ge=0.5, le=15, description="how far the deck reaches beyond each paved edge (m)")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        piece = ctx.network.main
+        deck_length = self.deck_length if self.deck_length is not None else level["deck_length"]
+        s_center = min(self.start_s(ctx.case) + deck_length / 2,
+                       ctx.case.road.length - ROAD_END_MARGIN_M - deck_length / 2)
+        self.apply_sun(ctx, s_center, side_sign(self.side))
+        span = 2.0 * abs(roadside_t(piece, self.margin, 1.0))
+        ctx.add_mesh(overhead_rail(piece.line, s_center, span, deck_length, level["slot_width"], level["slot_pitch"],
+                                   self.clearance, slots_along=level["slots_along"], deck_depth=level["deck_depth"],
+                                   gaps=piece.gaps, name="overhead rail"))
+
+
+@register
+class WireShadow(SunShadowIllusion):
+    """Power lines beside and across the road: thin dark lines on the lanes and bright bands between pairs."""
+
+    # More and thicker wires under a harder sun; wires start to cross the road, then diagonally. The sun's
+    # azimuth is solved so the wires along the road shadow the ego's lane (see ``_sun_ahead``).
+    # cross_every: every n-th pole sends wires across the road (0 = none; smaller = more crossings).
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"sun_altitude": 55.0, "sun_intensity": 0.8, "penumbra": 0.010, "n_wires": 2, "wire_radius": 0.020,
+         "wire_spacing": 1.2, "height": 8.0, "cross_every": 0, "cross_skew": 0.0},
+        {"sun_altitude": 52.0, "sun_intensity": 0.95, "penumbra": 0.008, "n_wires": 2, "wire_radius": 0.028,
+         "wire_spacing": 1.0, "height": 8.5, "cross_every": 3, "cross_skew": 0.0},
+        {"sun_altitude": 50.0, "sun_intensity": 1.1, "penumbra": 0.006, "n_wires": 3, "wire_radius": 0.035,
+         "wire_spacing": 0.9, "height": 9.0, "cross_every": 2, "cross_skew": 6.0},
+        {"sun_altitude": 47.0, "sun_intensity": 1.3, "penumbra": 0.004, "n_wires": 3, "wire_radius": 0.045,
+         "wire_spacing": 0.8, "height": 9.0, "cross_every": 1, "cross_skew": 10.0},
+        {"sun_altitude": 45.0, "sun_intensity": 1.5, "penumbra": 0.003, "n_wires": 4, "wire_radius": 0.055,
+         "wire_spacing": 0.7, "height": 9.5, "cross_every": 1, "cross_skew": 12.0},
+    )
+
+    type: Literal["wire_shadow"] = "wire_shadow"
+    side: Side = Field("right", description="which roadside the main pole row stands on")
+    length: float | None = Field(
+        None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
+    )
+    offset: float = Field(1.0, ge=0.3, le=30, description="lateral distance of the poles beyond the paved edge (m)")
+    wire_radius: float | None = Field(
+        None, ge=0.02, le=0.2, description="half the wire thickness (m); empty = from the table"
+    )
+    pole_spacing: float = Field(35.0, ge=15, le=80, description="distance between poles (m)")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        piece = ctx.network.main
+        sign = side_sign(self.side)
+        s0, s1 = self.extent(ctx.case, self.length)
+        t_row = roadside_t(piece, self.offset, sign)
+        sag = 0.25 + 0.01 * self.pole_spacing
+        self.apply_sun(ctx, s0, sign, self._sun_ahead(ctx, t_row, level["height"] - sag / 2))
+        t_poles = (t_row, roadside_t(piece, self.offset, -sign)) if level["cross_every"] else (t_row,)
+        radius = self.wire_radius if self.wire_radius is not None else level["wire_radius"]
+        ctx.add_mesh(power_lines(piece.line, s0, s1, t_poles, level["n_wires"], radius, level["height"],
+                                 pole_spacing=self.pole_spacing, wire_spacing=level["wire_spacing"], sag=sag,
+                                 cross_every=level["cross_every"], cross_skew=level["cross_skew"] * -sign,
+                                 ground=ground_height(piece, t_row), gaps=blocked(ctx, piece),
+                                 name="power lines"))
+
+    def _sun_ahead(self, ctx: CompileContext, t_row: float, height: float) -> float:
+        """Degrees ahead of square-on that put the shadow of wires ``height`` m up at ``t_row`` on the centre of
+        the ego's lane (as far across as the sun's altitude allows)."""
+        t_target = ctx.network.lane_center_t(ctx.case.ego.lane)
+        reach = abs(t_row - t_target)
+        along = reach * np.tan(np.radians(self.altitude())) / height  # cos(ahead) that lands the shadow there
+        return float(np.degrees(np.arccos(np.clip(along, np.cos(np.radians(MAX_AHEAD_DEG)), 1.0))))

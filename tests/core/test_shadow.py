@@ -1,0 +1,202 @@
+"""Shadow illusions: severity tables, determinism, JSON round trip, sun placement and where the shadows fall."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from lanevil_core.case import Case, case_json, parse_case
+from lanevil_core.compile import compile_scene
+from lanevil_core.illusions import REGISTRY
+from lanevil_core.road_geometry import ReferenceLine
+from lanevil_core.scene import CompiledScene
+
+SHADOW_TYPES = ("streetlight_shadow", "fence_shadow", "rail_shadow", "wire_shadow")
+LEVELS = (1, 2, 3, 4, 5)
+
+
+def compiled(illusion: dict, **case_fields) -> CompiledScene:
+    """The compiled scene of a case holding one illusion (no roadside props unless asked: faster)."""
+    case_fields.setdefault("scene", {"density": 0.0})
+    return compile_scene(Case(illusions=[illusion], **case_fields))
+
+
+def own_vertices(scene: CompiledScene) -> np.ndarray:
+    """(n, 3) world vertices of every mesh the illusion (index 0) added."""
+    meshes = [mesh.vertices for mesh in scene.meshes if mesh.source == 0]
+    assert meshes, "the illusion added no mesh"
+    return np.concatenate(meshes)
+
+
+def road_coords(line: ReferenceLine, p_world: np.ndarray) -> np.ndarray:
+    """(n, 3) s, t, h of world points: nearest 1 m sample of the reference line, then projection."""
+    s_out = np.empty(len(p_world))
+    xy, s_samples = line.xy[::10], line.s[::10]
+    for chunk in np.array_split(np.arange(len(p_world)), max(1, len(p_world) // 2000)):
+        d2 = ((p_world[chunk, None, :2] - xy[None, :, :2]) ** 2).sum(-1)
+        s_out[chunk] = s_samples[np.argmin(d2, axis=1)]
+    origin, tangent, left = line.frame(s_out)
+    flat = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
+    delta = p_world - origin
+    s = s_out + (delta[:, :2] * flat).sum(1)
+    origin = line.frame(s)[0]
+    return np.stack([s, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]], axis=1)
+
+
+def shadow_points(scene: CompiledScene) -> np.ndarray:
+    """(n, 2) x, y where the sun ray through each raised vertex of the illusion meets the flat road z = 0."""
+    p_world = own_vertices(scene)
+    p_world = p_world[p_world[:, 2] > 0.3]
+    sun = scene.env.sun_dir_world
+    return (p_world - sun * (p_world[:, 2:3] / sun[2]))[:, :2]
+
+
+@pytest.mark.parametrize("name", SHADOW_TYPES)
+def test_severity_tables_are_monotone(name: str) -> None:
+    table = REGISTRY[name].SEVERITY
+    assert REGISTRY[name].CATEGORY == "shadow"
+    assert all(row.keys() == table[0].keys() for row in table)
+    altitude = [row["sun_altitude"] for row in table]
+    intensity = [row["sun_intensity"] for row in table]
+    penumbra = [row["penumbra"] for row in table]
+    assert all(a >= b for a, b in zip(altitude, altitude[1:]))
+    assert all(a <= b for a, b in zip(intensity, intensity[1:]))
+    assert all(a >= b for a, b in zip(penumbra, penumbra[1:]))
+    assert altitude[0] > altitude[-1] and intensity[0] < intensity[-1]
+
+
+@pytest.mark.parametrize("severity", LEVELS)
+@pytest.mark.parametrize("name", SHADOW_TYPES)
+def test_every_level_compiles_deterministically(name: str, severity: int) -> None:
+    first = compiled({"type": name, "severity": severity, "seed": 7})
+    again = compiled({"type": name, "severity": severity, "seed": 7})
+    mine = [mesh for mesh in first.meshes if mesh.source == 0]
+    assert mine and len(mine) == sum(mesh.source == 0 for mesh in again.meshes)
+    for a, b in zip(mine, [mesh for mesh in again.meshes if mesh.source == 0]):
+        assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+        assert np.array_equal(a.colors, b.colors) and a.name == b.name
+    assert np.array_equal(first.env.sun_dir_world, again.env.sun_dir_world)
+    assert first.env.sun_intensity == REGISTRY[name].SEVERITY[severity - 1]["sun_intensity"]
+    assert first.env.penumbra == REGISTRY[name].SEVERITY[severity - 1]["penumbra"]
+    altitude = np.degrees(np.arcsin(first.env.sun_dir_world[2]))
+    assert altitude == pytest.approx(REGISTRY[name].SEVERITY[severity - 1]["sun_altitude"])
+
+
+@pytest.mark.parametrize("name", SHADOW_TYPES)
+def test_json_round_trip(name: str) -> None:
+    case = Case(illusions=[{"type": name, "severity": 4, "seed": 3, "s": 40.0, "side": "left",
+                            "sun_altitude": 33.0, "sun_intensity": 1.2}])
+    back = parse_case(case_json(case))
+    assert back == case
+    assert back.illusions[0].type == name and back.illusions[0].sun_altitude == 33.0
+    assert parse_case({"illusions": [{"type": name}]}).illusions[0].severity == 3
+
+
+def test_sun_overrides_win_over_the_table() -> None:
+    scene = compiled({"type": "fence_shadow", "severity": 5, "sun_altitude": 33.0, "sun_azimuth": 100.0,
+                      "sun_intensity": 0.7})
+    sun = scene.env.sun_dir_world
+    assert np.degrees(np.arcsin(sun[2])) == pytest.approx(33.0)
+    assert np.degrees(np.arctan2(sun[1], sun[0])) == pytest.approx(100.0)
+    assert scene.env.sun_intensity == 0.7
+
+
+def test_ambient_stays_from_the_case() -> None:
+    plain = compile_scene(Case(weather={"cloudiness": 40.0}))
+    shaded = compiled({"type": "streetlight_shadow", "severity": 5}, weather={"cloudiness": 40.0})
+    assert shaded.env.ambient == plain.env.ambient
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+@pytest.mark.parametrize("name", SHADOW_TYPES)
+def test_default_sun_stands_on_the_structure_side_and_ahead(name: str, side: str) -> None:
+    scene = compiled({"type": name, "side": side, "s": 90.0}, road={"type": "bend", "radius": 80.0})
+    _, tangent, left = scene.network.main.line.frame(90.0)
+    sun = scene.env.sun_dir_world
+    assert np.sign(sun @ left) == (1.0 if side == "left" else -1.0)
+    assert sun @ tangent > 0.0
+
+
+@pytest.mark.parametrize("name", ["streetlight_shadow", "fence_shadow", "wire_shadow"])
+@pytest.mark.parametrize("severity", [3, 5])
+def test_shadows_fall_on_the_ego_lane_in_view(name: str, severity: int) -> None:
+    case = Case(illusions=[{"type": name, "severity": severity}])
+    x, y = shadow_points(compiled(case.illusions[0].model_dump())).T  # straight road along +X: x = s, y = t
+    ego_lane = (y > -case.road.lane_width) & (y < 0.0)
+    in_view = (x > case.ego.start_s + 5.0) & (x < case.ego_s(case.ego.frames - 1) + 30.0)
+    assert (ego_lane & in_view).sum() > 20
+
+
+@pytest.mark.parametrize("name", ["streetlight_shadow", "fence_shadow"])
+def test_shadows_reach_further_across_with_severity(name: str) -> None:
+    reach = [shadow_points(compiled({"type": name, "severity": level}))[:, 1].max() for level in LEVELS]
+    assert all(a < b for a, b in zip(reach, reach[1:]))
+    assert reach[-1] > 0.0  # the strongest level crosses the centre line
+
+
+@pytest.mark.parametrize("severity", LEVELS)
+def test_wire_shadows_run_along_the_ego_lane(severity: int) -> None:
+    scene = compiled({"type": "wire_shadow", "severity": severity})
+    wires = own_vertices(scene)
+    wires = wires[(wires[:, 2] > 6.0) & (wires[:, 1] < -5.0)]  # the row along the right side
+    sun = scene.env.sun_dir_world
+    t_shadow = wires[:, 1] - sun[1] * wires[:, 2] / sun[2]
+    assert -3.5 < np.median(t_shadow) < 0.0
+
+
+def test_rail_deck_shades_the_whole_carriageway() -> None:
+    case = Case(illusions=[{"type": "rail_shadow", "severity": 5}])
+    scene = compiled(case.illusions[0].model_dump())
+    x, y = shadow_points(scene).T
+    half = scene.network.main.half_width
+    assert y.min() < -half and y.max() > half
+    assert x.min() < case.ego.start_s + 22.0  # the shadow reaches back towards the ego
+
+
+@pytest.mark.parametrize("road", [{"type": "bend", "radius": 60.0, "turn": "right"}, {"type": "uphill"},
+                                  {"type": "crossroad", "junction_s": 60.0}])
+@pytest.mark.parametrize("name", SHADOW_TYPES)
+def test_nothing_stands_on_a_carriageway(name: str, road: dict) -> None:
+    scene = compiled({"type": name, "severity": 5, "s": 45.0, "side": "left"}, road=road)
+    p_world = own_vertices(scene)
+    for piece in scene.network.pieces:
+        s, t, h = road_coords(piece.line, p_world).T
+        on_road = (np.abs(t) < piece.half_width) & (s > piece.s_start) & (s < piece.line.length)
+        assert on_road.sum() == 0 or h[on_road].min() > 4.4  # only decks and wires pass over a road
+
+
+def test_streetlights_leave_the_junction_mouth_free() -> None:
+    scene = compiled({"type": "streetlight_shadow", "severity": 5, "side": "both"},
+                     road={"type": "t_junction", "junction_s": 80.0})
+    piece = scene.network.main
+    names = [mesh.name for mesh in scene.meshes if mesh.source == 0]
+    assert len(names) == len(set(names)) > 6
+    for mesh in (m for m in scene.meshes if m.source == 0 and "right" in m.name):
+        s, t, _ = road_coords(piece.line, mesh.vertices[:1]).T
+        assert not any(g0 <= s[0] <= g1 for g0, g1, side in piece.gaps if side == -1)
+
+
+@pytest.mark.parametrize("bad", [{"type": "wire_shadow", "wire_radius": 0.01},
+                                 {"type": "fence_shadow", "side": "middle"},
+                                 {"type": "rail_shadow", "clearance": 2.0},
+                                 {"type": "streetlight_shadow", "sun_altitude": 95.0}])
+def test_bad_fields_are_refused(bad: dict) -> None:
+    field = next(key for key in bad if key != "type")
+    with pytest.raises(ValidationError, match=field):
+        Case(illusions=[bad])
+
+
+@pytest.mark.parametrize("name", ["streetlight_shadow", "fence_shadow", "wire_shadow"])
+def test_posts_keep_clear_of_the_lamps_already_there(name: str) -> None:
+    scene = compiled({"type": name, "severity": 5}, scene={"kind": "urban", "density": 1.0})
+    piece = scene.network.main
+    lamps = np.concatenate([m.vertices for m in scene.meshes if m.source == -1 and m.kind in ("streetlight", "pole")])
+    mine = own_vertices(scene)
+    s_lamp, t_lamp, h_lamp = road_coords(piece.line, lamps).T
+    s_mine, t_mine, h_mine = road_coords(piece.line, mine).T
+    lamp_feet = np.stack([s_lamp, t_lamp], 1)[h_lamp < -0.05]
+    my_feet = np.stack([s_mine, t_mine], 1)[h_mine < -0.05]
+    assert len(lamp_feet) and len(my_feet)
+    gap = np.sqrt(((lamp_feet[:, None] - my_feet[None]) ** 2).sum(-1)).min()
+    assert gap > 0.5
