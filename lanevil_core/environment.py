@@ -13,6 +13,10 @@ if TYPE_CHECKING:  # the case model imports the illusions, which use sun_directi
     from .case import Case
 
 
+NIGHT_EXPOSURE = 2.2
+HEADLIGHT_INTENSITY = 35.0  # radiance scale at 1 m of each of the ego's two headlights (on at night)
+
+
 def sun_direction(azimuth_deg: float, altitude_deg: float) -> FloatArray:
     """(3,) unit vector from the ground towards the sun (azimuth CCW from +X, altitude above the horizon)."""
     az, alt = np.radians(azimuth_deg), np.radians(altitude_deg)
@@ -51,6 +55,7 @@ def environment_for(case: Case) -> Environment:
         fog_distance=weather.fog_distance,
         cloudiness=cloud,
         penumbra=0.004 + 0.03 * cloud + 0.01 / max(sun.intensity, 0.1),
-        exposure=1.0 if not night else 4.0,
+        exposure=1.0 if not night else NIGHT_EXPOSURE,
         night=night,
+        headlights=HEADLIGHT_INTENSITY if night else 0.0,
     )

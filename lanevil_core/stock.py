@@ -90,7 +90,7 @@ _BASES: dict[str, tuple[dict[str, Any], str, str, float]] = {
     "rail_shadow": ({"type": "straight"}, "urban", "ClearNoon", 0.0),
     "wire_shadow": ({"type": "bend", "turn": "right", "radius": 260.0}, "rural", "ClearNoon", 0.0),
     "sunlight_reflection": ({"type": "straight"}, "suburban", "ClearNoon", 30.0),
-    "streetlight_reflection": ({"type": "t_junction", "junction_s": 90.0}, "suburban", "ClearNoon", 30.0),
+    "streetlight_reflection": ({"type": "t_junction", "junction_s": 90.0}, "suburban", "ClearNight", 30.0),
     "vehicle_reflection": ({"type": "downhill", "grade": 0.04}, "suburban", "ClearNoon", 30.0),
 }
 

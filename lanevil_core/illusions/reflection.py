@@ -11,7 +11,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from ..environment import sun_direction
+from ..environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, sun_direction
 from ..primitives import pose_on_road, transformed
 from ..props import car, van
 from ..scene import PointLight, SurfaceLayer
@@ -22,7 +22,6 @@ PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
 LAMP_COLORS: dict[str, tuple[float, float, float]] = {"white": (1.0, 0.95, 0.88), "yellow": (1.0, 0.62, 0.22)}
 LAMP_INTENSITY = 45.0  # radiance scale at 1 m: lights a road 8 m below to about the level of an overcast day
-HEADLIGHT_INTENSITY = 35.0
 VEHICLE_AHEAD_M = 13.0  # the first glossy vehicle stands this far ahead of the ego start
 
 
@@ -127,7 +126,7 @@ class StreetlightReflection(Illusion):
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         env = ctx.env
-        env.night, env.sun_intensity, env.exposure = True, 0.0, 2.2
+        env.night, env.sun_intensity, env.exposure = True, 0.0, NIGHT_EXPOSURE
         env.ambient = min(env.ambient, 0.01)
         env.sky_zenith = np.array([0.001, 0.0015, 0.004], np.float32)
         env.sky_horizon = np.array([0.006, 0.006, 0.009], np.float32)

@@ -1,3 +1,343 @@
-"""road_damage illusions."""
+"""Road damage: cracks, repairs and sealant, tyre marks on the main road's surface, and guard rails beside it.
+
+Surface damage becomes ``SurfaceLayer`` textures on road piece 0 (cracks lie under the paint, sealant and rubber
+over it); guard rails are W-beam meshes swept along the road, whose bright top edge and shadow run parallel to the
+lane lines.
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field
+
+from .. import surface_textures as tex
+from ..scene import SurfaceLayer
+from .base import Category, CompileContext, Illusion, register
+
+if TYPE_CHECKING:
+    from ..case import Case
+    from ..typed import Float32Array
+
+MAX_LAYER_TEXELS = 4_000_000  # one SurfaceLayer's texture at most; longer damage is split along s
+PAINT_CLEARANCE_M = 0.12  # lateral gap from a lane line's centre to damage that runs "right beside" it
+# Default start of surface damage ahead of the ego: the 1280x720, 90 deg camera 3 m up first sees the road ~6 m
+# ahead of the vehicle, so damage starting here is in view from the first frame.
+NEAR_AHEAD_M = 6.0
+
+
+@dataclass(frozen=True)
+class _Area:
+    """The textured part of the main road: s from ``s0``, t from ``t0``, (rows, cols) texels of ``texel`` m."""
+
+    s0: float
+    t0: float
+    texel: float
+    shape: tuple[int, int]
+
+    def local_t(self, t_road: float) -> float:
+        """Texture column coordinate (m from the texture corner) of road-frame ``t_road``."""
+        return t_road - self.t0
+
+
+class _SurfaceDamage(Illusion):
+    """Shared placement of damage drawn on the main road's surface, across the carriageway where the ego looks."""
+
+    CATEGORY: ClassVar[Category] = "road_damage"
+    TEXEL: ClassVar[float] = 0.03
+
+    extent: float = Field(80.0, gt=0, le=400, description="length along the road (m)")
+    margin: float = Field(0.5, ge=0, le=5, description="reach beyond each carriageway edge (m)")
+
+    def start_s(self, case: Case) -> float:
+        """Where along the road the damage starts: by default where the ego camera's view of the road begins."""
+        return self.s if self.s is not None else case.ego.start_s + NEAR_AHEAD_M
+
+    def _area(self, ctx: CompileContext) -> _Area | None:
+        """Where the texture lies, or None when nothing of the road is left past the start."""
+        main = ctx.network.main
+        s0 = self.start_s(ctx.case)
+        s1 = min(s0 + self.extent, main.line.length)
+        t0 = -main.half_width - self.margin
+        rows = int(np.floor((s1 - s0) / self.TEXEL))
+        cols = int(np.ceil(2 * (main.half_width + self.margin) / self.TEXEL))
+        return _Area(s0, t0, self.TEXEL, (rows, cols)) if rows >= 2 else None
+
+    def _emit(self, ctx: CompileContext, area: _Area, rgba: Float32Array, wet: Float32Array | None,
+              over_paint: bool, name: str) -> None:
+        """Add the texture as layers of at most MAX_LAYER_TEXELS each, skipping stretches with nothing drawn."""
+        rows_per_layer = max(MAX_LAYER_TEXELS // area.shape[1], 1)
+        for part, start in enumerate(range(0, area.shape[0], rows_per_layer)):
+            rows = slice(start, min(start + rows_per_layer, area.shape[0]))
+            chunk_wet = None if wet is None else np.ascontiguousarray(wet[rows])
+            if not rgba[rows, :, 3].any() and (chunk_wet is None or not chunk_wet.any()):
+                continue
+            ctx.add_layer(SurfaceLayer(piece=0, s0=area.s0 + start * area.texel, t0=area.t0, texel=area.texel,
+                                       rgba=np.ascontiguousarray(rgba[rows]), wet=chunk_wet, over_paint=over_paint,
+                                       name=f"{name} {part + 1}"))
+
+
+def _setting(illusion: Illusion, key: str) -> Any:
+    """The field ``key`` where the user set it, else the value of the illusion's severity row."""
+    value = getattr(illusion, key)
+    return illusion.level()[key] if value is None else value
+
+
+def _ego_center_t(ctx: CompileContext) -> float:
+    return ctx.network.lane_center_t(ctx.case.ego.lane)
+
+
+def _lines_near_ego(ctx: CompileContext) -> list[float]:
+    """t of every lane boundary, nearest to the ego lane's centre first."""
+    center = _ego_center_t(ctx)
+    return sorted((float(t) for t in ctx.network.main.boundaries_t), key=lambda t: (abs(t - center), t))
+
+
+def _lanes_near_ego(ctx: CompileContext) -> list[float]:
+    """t of every lane centre (both directions), the ego lane first, then outwards."""
+    bounds = ctx.network.main.boundaries_t
+    centers = 0.5 * (bounds[1:] + bounds[:-1])
+    ego = _ego_center_t(ctx)
+    return sorted((float(t) for t in centers), key=lambda t: (abs(t - ego), t))
+
+
+def _beside(lines_t: list[float], count: int, gaps: np.ndarray) -> list[float]:
+    """``count`` positions just beside the given lines, alternately on their -t and +t sides."""
+    return [lines_t[k % len(lines_t)] + (-1.0 if k % 2 == 0 else 1.0) * float(gaps[k % len(gaps)])
+            for k in range(count)]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@register
+class RoadCrack(_SurfaceDamage):
+    """Thin dark branching cracks in the asphalt, under the paint: transverse, longitudinal and alligator."""
+
+    TEXEL: ClassVar[float] = 0.02
+    # density: cracks per 100 m^2; along_lines: long cracks right beside the lane lines nearest the ego.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"density": 0.8, "width": 0.020, "darkness": 0.65, "along_lines": 0, "alligator_share": 0.00},
+        {"density": 1.3, "width": 0.024, "darkness": 0.72, "along_lines": 0, "alligator_share": 0.10},
+        {"density": 2.0, "width": 0.027, "darkness": 0.80, "along_lines": 1, "alligator_share": 0.15},
+        {"density": 2.8, "width": 0.031, "darkness": 0.88, "along_lines": 2, "alligator_share": 0.20},
+        {"density": 3.8, "width": 0.036, "darkness": 0.95, "along_lines": 4, "alligator_share": 0.25},
+    )
+
+    type: Literal["road_crack"] = "road_crack"
+    kind: Literal["mixed", "transverse", "longitudinal", "alligator"] = Field(
+        "mixed", description="crack pattern (mixed = mostly transverse, some longitudinal and alligator)")
+    density: float | None = Field(None, ge=0, le=20, description="cracks per 100 m^2; empty = from severity")
+    width: float | None = Field(None, ge=0.003, le=0.1, description="core width of a main crack (m)")
+    darkness: float | None = Field(None, ge=0, le=1, description="opacity of the crack core")
+    along_lines: int | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
+
+    def compile(self, ctx: CompileContext) -> None:
+        area = self._area(ctx)
+        if area is None:
+            return
+        rng = ctx.rng(self.seed)
+        crack_rng = np.random.default_rng(int(rng.integers(0, 2**63 - 1)))
+        gaps = rng.uniform(PAINT_CLEARANCE_M, 2.5 * PAINT_CLEARANCE_M, size=8)
+        along = [area.local_t(t) for t in _beside(_lines_near_ego(ctx), _setting(self, "along_lines"), gaps)]
+        density = _setting(self, "density")
+        shares = self._shares(self.level()["alligator_share"])
+        rgba, wet = tex.crack_mix(crack_rng, area.shape, area.texel,
+                                  {kind: density * share for kind, share in shares.items()},
+                                  _setting(self, "width"), _setting(self, "darkness"), along, ctx.env.wetness)
+        self._emit(ctx, area, rgba, wet, over_paint=False, name="cracks")
+
+    def _shares(self, alligator_share: float) -> dict[tex.CrackKind, float]:
+        """Share of the density that goes to each crack kind."""
+        if self.kind != "mixed":
+            return {kind: float(kind == self.kind) for kind in tex.CRACK_KINDS}
+        rest = 1.0 - alligator_share
+        return {"transverse": 0.65 * rest, "longitudinal": 0.35 * rest, "alligator": alligator_share}
+
+
+@register
+class RoadRepair(_SurfaceDamage):
+    """Repair patches of fresher, darker asphalt and strips of crack sealant, some running along the lane lines."""
+
+    # patches: rectangles and pothole fills; parallel: sealant strips beside lane lines; trenches: long narrow
+    # reinstatements along the lanes; size: patch size scale; contrast: fresh-asphalt darkness and opacity.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"patches": 2, "strips": 2, "parallel": 0, "trenches": 0, "size": 0.80, "contrast": 0.35,
+         "strip_width": 0.05, "bright_share": 0.00},
+        {"patches": 4, "strips": 3, "parallel": 0, "trenches": 0, "size": 0.90, "contrast": 0.50,
+         "strip_width": 0.06, "bright_share": 0.15},
+        {"patches": 6, "strips": 5, "parallel": 1, "trenches": 0, "size": 1.00, "contrast": 0.65,
+         "strip_width": 0.07, "bright_share": 0.30},
+        {"patches": 8, "strips": 7, "parallel": 2, "trenches": 1, "size": 1.10, "contrast": 0.80,
+         "strip_width": 0.09, "bright_share": 0.40},
+        {"patches": 11, "strips": 9, "parallel": 3, "trenches": 2, "size": 1.25, "contrast": 0.95,
+         "strip_width": 0.12, "bright_share": 0.50},
+    )
+
+    type: Literal["road_repair"] = "road_repair"
+    patches: int | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
+    strips: int | None = Field(None, ge=0, le=200, description="free-running sealant strips")
+    parallel: int | None = Field(None, ge=0, le=12, description="sealant strips right beside lane lines")
+    trenches: int | None = Field(None, ge=0, le=8, description="long narrow trench patches along the lanes")
+    size: float | None = Field(None, gt=0, le=4, description="patch size scale (1 = 0.8-4.4 m long)")
+    contrast: float | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
+    strip_width: float | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
+    bright_share: float | None = Field(None, ge=0, le=1, description="share of strips in bright weathered filler")
+
+    def compile(self, ctx: CompileContext) -> None:
+        area = self._area(ctx)
+        if area is None:
+            return
+        v = {key: _setting(self, key) for key in self.level()}
+        rng = ctx.rng(self.seed)
+        patch_rng, strip_rng = (np.random.default_rng(int(b)) for b in rng.integers(0, 2**63 - 1, size=2))
+        gaps = rng.uniform(1.5 * PAINT_CLEARANCE_M, 3.5 * PAINT_CLEARANCE_M, size=8)
+        swing = rng.uniform(-0.9, 0.9, size=8)
+        trench_t = [area.local_t(t + float(swing[k])) for k, t in enumerate(_lanes_near_ego(ctx)[:v["trenches"]])]
+        rectangles = (v["patches"] + 1) // 2 + v["patches"] // 4
+        rgba, _ = tex.patches(patch_rng, area.shape, area.texel, rectangles=rectangles,
+                              blobs=v["patches"] - rectangles, trench_t=trench_t, size_scale=v["size"],
+                              contrast=v["contrast"])
+        self._emit(ctx, area, rgba, None, over_paint=False, name="repair patches")
+        parallel_t = [area.local_t(t) for t in _beside(_lines_near_ego(ctx), v["parallel"], gaps)]
+        rgba, _ = tex.patches(strip_rng, area.shape, area.texel, rectangles=0, blobs=0, strips=v["strips"],
+                              parallel_t=parallel_t, contrast=v["contrast"], strip_width_m=v["strip_width"],
+                              bright_share=v["bright_share"])
+        self._emit(ctx, area, rgba, None, over_paint=True, name="sealant")
+
+@register
+class TireMarks(_SurfaceDamage):
+    """Dark rubber tyre tracks from emergency braking, swerves across lane lines and sideways yaw slides."""
+
+    TEXEL: ClassVar[float] = 0.04
+    # straddle: straight marks centred on a lane line (a track each side of it) instead of in a lane.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"straight": 1, "swerve": 0, "yaw": 0, "straddle": 0, "darkness": 0.40, "track_width": 0.18},
+        {"straight": 2, "swerve": 0, "yaw": 0, "straddle": 0, "darkness": 0.50, "track_width": 0.19},
+        {"straight": 2, "swerve": 1, "yaw": 0, "straddle": 1, "darkness": 0.62, "track_width": 0.20},
+        {"straight": 2, "swerve": 2, "yaw": 1, "straddle": 1, "darkness": 0.75, "track_width": 0.21},
+        {"straight": 3, "swerve": 3, "yaw": 1, "straddle": 2, "darkness": 0.88, "track_width": 0.22},
+    )
+
+    type: Literal["tire_marks"] = "tire_marks"
+    straight: int | None = Field(None, ge=0, le=40, description="straight braking marks")
+    swerve: int | None = Field(None, ge=0, le=40, description="swerving marks that cross a lane line")
+    yaw: int | None = Field(None, ge=0, le=40, description="curved sideways-sliding marks")
+    darkness: float | None = Field(None, ge=0, le=1, description="peak opacity of the rubber")
+    track_width: float | None = Field(None, ge=0.1, le=0.4, description="width of one tyre track (m)")
+    length_min: float = Field(15.0, gt=1, le=200, description="shortest mark (m)")
+    length_max: float = Field(35.0, gt=1, le=200, description="longest mark (m)")
+
+    def compile(self, ctx: CompileContext) -> None:
+        area = self._area(ctx)
+        if area is None:
+            return
+        straight, swerve, yaw = (_setting(self, key) for key in ("straight", "swerve", "yaw"))
+        straddle = min(self.level()["straddle"], straight)
+        lanes, lines = _lanes_near_ego(ctx), _lines_near_ego(ctx)
+        center_t = ([lanes[k % len(lanes)] for k in range(straight - straddle)]
+                    + [lines[k % len(lines)] for k in range(straddle)]
+                    + [lanes[k % len(lanes)] for k in range(swerve)]
+                    + [lanes[(k + 1) % len(lanes)] for k in range(yaw)])
+        rgba, _ = tex.skid_marks(
+            ctx.rng(self.seed), area.shape, area.texel, straight=straight, swerve=swerve, yaw=yaw,
+            center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
+            length_m=(min(self.length_min, self.length_max), max(self.length_min, self.length_max)),
+            darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"))
+        self._emit(ctx, area, rgba, None, over_paint=True, name="tyre marks")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+
+_Unit = Annotated[float, Field(ge=0, le=1)]
+RAIL_TOP_M = 0.75  # height of a W-beam's top edge above the ground
+MEDIAN_RAIL_T = 0.45  # a median rail stands just left of the centre line, clear of its paint
+SUN_SWING_RAD = np.radians(30.0)  # the shadow-casting sun stands this far behind the cross-road direction
+
+
+@register
+class GuardRail(Illusion):
+    """W-beam guard rails along the road edge whose bright top edge and shadow run parallel to the lane lines."""
+
+    CATEGORY: ClassVar[Category] = "road_damage"
+    # offset: gap between the carriageway edge and the rail (m); far_side: a second rail along the other edge;
+    # median: a rail just left of the centre line; shadow_m: how far across the road (from the rail nearest
+    # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept).
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"offset": 2.0, "far_side": False, "median": False, "albedo": 0.30, "shadow_m": 0.0},
+        {"offset": 1.5, "far_side": False, "median": False, "albedo": 0.38, "shadow_m": 0.0},
+        {"offset": 1.0, "far_side": False, "median": False, "albedo": 0.45, "shadow_m": 1.5},
+        {"offset": 0.6, "far_side": True, "median": False, "albedo": 0.52, "shadow_m": 2.4},
+        {"offset": 0.3, "far_side": True, "median": True, "albedo": 0.60, "shadow_m": 3.0},
+    )
+
+    type: Literal["guard_rail"] = "guard_rail"
+    side: Literal["right", "left"] = Field("right", description="road edge of the main rail")
+    offset: float | None = Field(None, ge=0, le=30, description="gap between the carriageway edge and the rail (m)")
+    extent: float = Field(130.0, gt=1, le=1000, description="length along the road (m)")
+    far_side: bool | None = Field(None, description="also a rail along the other edge")
+    median: bool | None = Field(None, description="also a rail just left of the centre line")
+    color: tuple[_Unit, _Unit, _Unit] | None = Field(None, description="linear albedo of the steel; empty = grey")
+    shadow_m: float | None = Field(None, ge=0, le=20, description="shadow reach across the road (m); 0 = keep sun")
+    post_spacing: float = Field(2.0, ge=0.5, le=10, description="distance between posts (m)")
+
+    def start_s(self, case: Case) -> float:
+        """Where along the road the rails start: by default beside the ego, so they line the whole view."""
+        return self.s if self.s is not None else case.ego.start_s
+
+    def compile(self, ctx: CompileContext) -> None:
+        # Imported here: structures -> road_layout -> case -> illusions would be circular at import time.
+        from ..structures import ground_height, guard_rail
+
+        main = ctx.network.main
+        s0 = self.start_s(ctx.case)
+        s1 = min(s0 + self.extent, main.line.length)
+        if s1 - s0 < 1.0:
+            return
+        color = self.color if self.color is not None else (self.level()["albedo"],) * 3
+        rails_t = self._rails_t(ctx)
+        for index, t_rail in enumerate(rails_t):
+            median = abs(t_rail) < main.half_width
+            for a, b in _open_spans(s0, s1, [(g0, g1) for g0, g1, side in main.gaps if median or side * t_rail > 0]):
+                ctx.add_mesh(guard_rail(main.line, a, b, t_rail, ground_height(main, t_rail), self.post_spacing,
+                                        tuple(float(c) for c in color), name=f"guard rail {index + 1}"))
+        shadow_m = _setting(self, "shadow_m")
+        if shadow_m > 0:
+            # The sun stands on the side of the rail nearest the ego and throws its shadow over the ego's lanes.
+            nearest = min(rails_t, key=lambda t: abs(t - _ego_center_t(ctx)))
+            ground = ground_height(main, nearest) if abs(nearest) > main.half_width else 0.0
+            ctx.env.sun_dir_world = _shadow_sun(float(main.line.heading_at(0.5 * (s0 + s1))),
+                                                1.0 if nearest >= 0 else -1.0, RAIL_TOP_M + ground, shadow_m)
+
+    def _rails_t(self, ctx: CompileContext) -> list[float]:
+        """Lateral positions of the rails: main side first, then the far side and the median if asked for."""
+        edge = ctx.network.main.half_width + _setting(self, "offset")
+        sign = -1.0 if self.side == "right" else 1.0
+        rails = [sign * edge]
+        if _setting(self, "far_side"):
+            rails.append(-sign * edge)
+        if _setting(self, "median"):
+            rails.append(MEDIAN_RAIL_T)
+        return rails
+
+
+def _open_spans(s0: float, s1: float, gaps: list[tuple[float, float]], shortest: float = 2.0
+                ) -> list[tuple[float, float]]:
+    """The parts of [s0, s1] outside every gap (junction mouths a rail must leave open), at least ``shortest`` m."""
+    spans, start = [], s0
+    for g0, g1 in sorted(gaps):
+        if g0 > start:
+            spans.append((start, min(g0, s1)))
+        start = max(start, g1)
+    spans.append((start, s1))
+    return [(a, b) for a, b in spans if b - a >= shortest]
+
+
+def _shadow_sun(heading: float, side: float, height: float, reach: float) -> np.ndarray:
+    """(3,) unit direction to a sun on the ``side`` (+1 left, -1 right) of a road heading ``heading`` (rad) that
+    throws the shadow of an edge ``height`` m up ``reach`` m across the road."""
+    azimuth = heading + side * (np.pi / 2 + SUN_SWING_RAD)
+    altitude = np.arctan2(height * np.cos(SUN_SWING_RAD), reach)
+    return np.array([np.cos(altitude) * np.cos(azimuth), np.cos(altitude) * np.sin(azimuth), np.sin(altitude)])

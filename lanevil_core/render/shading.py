@@ -128,9 +128,10 @@ def shade(
                 for c in range(3):
                     rgb[c] = material_albedo[material, c] * (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
                 if material == ASPHALT:
-                    wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, footprint, False, rgb, scratch)
+                    wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft, False, rgb,
+                                        scratch)
                     paint(stripes, stripe_range[piece, 0], stripe_range[piece, 1], s, t, fs, ft, rgb)
-                    wet = max(wet, sample_layers(layer_texels, layer_table, layer_first, piece, s, t, footprint,
+                    wet = max(wet, sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft,
                                                  True, rgb, scratch))
                     puddles = env_f[PUDDLES]
                     if puddles > 0.0:

@@ -10,6 +10,8 @@ import numpy as np
 
 from ._jit import kernel
 
+MAX_ANISO = 6
+
 
 @kernel(inline="always")
 def box_overlap(x: float, width: float, lo: float, hi: float) -> float:
@@ -83,10 +85,41 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
 
 
 @kernel(inline="always")
+def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: float, s0: float, t0: float,
+               weight: float, sample: np.ndarray) -> None:
+    """Add ``weight`` times the bilinear sample of one mip level at road point (s, t) to ``sample`` (5,)."""
+    texel = table[level, 3]
+    rows, cols, offset = int(table[level, 4]), int(table[level, 5]), int(table[level, 6])
+    y = (s - s0) / texel - 0.5
+    x = (t - t0) / texel - 0.5
+    y0 = min(max(int(np.floor(y)), 0), rows - 1)
+    x0 = min(max(int(np.floor(x)), 0), cols - 1)
+    y1 = min(y0 + 1, rows - 1)
+    x1 = min(x0 + 1, cols - 1)
+    fy = min(max(y - y0, 0.0), 1.0)
+    fx = min(max(x - x0, 0.0), 1.0)
+    a = offset + y0 * cols
+    b = offset + y1 * cols
+    for c in range(5):
+        top = texels[a + x0, c] * (1 - fx) + texels[a + x1, c] * fx
+        bottom = texels[b + x0, c] * (1 - fx) + texels[b + x1, c] * fx
+        sample[c] += weight * (top * (1 - fy) + bottom * fy)
+
+
+@kernel(inline="always")
 def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piece: int, s: float, t: float,
-                  footprint_m: float, over_paint: bool, rgb: np.ndarray, sample: np.ndarray) -> float:
-    """Blend every surface layer of ``piece`` (under or over paint) over ``rgb``; return the puddle wetness."""
+                  fs: float, ft: float, over_paint: bool, rgb: np.ndarray, sample: np.ndarray) -> float:
+    """Blend every surface layer of ``piece`` (under or over paint) over ``rgb``; return the puddle wetness.
+
+    Anisotropic filtering: the mip level follows the pixel's short footprint axis and up to MAX_ANISO samples
+    spread along the long one, so marks running along the road stay sharp far ahead.
+    """
     wet = 0.0
+    short = min(fs, ft)
+    long = max(fs, ft)
+    taps = min(int(np.ceil(long / max(short, 1e-6))), MAX_ANISO)
+    short = max(short, long / MAX_ANISO)
+    along_s = fs >= ft
     for layer in range(first.size - 1):
         row0 = first[layer]
         if int(table[row0, 0]) != piece or (table[row0, 7] > 0.5) != over_paint:
@@ -96,26 +129,18 @@ def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piec
         if s < s0 or t < t0 or s >= s0 + rows0 * texel0 or t >= t0 + cols0 * texel0:
             continue
         level = row0
-        ratio = footprint_m / texel0
+        ratio = short / texel0
         while ratio > 1.0 and level < first[layer + 1] - 1:
             ratio *= 0.5
             level += 1
-        texel = table[level, 3]
-        rows, cols, offset = int(table[level, 4]), int(table[level, 5]), int(table[level, 6])
-        y = (s - s0) / texel - 0.5
-        x = (t - t0) / texel - 0.5
-        y0 = min(max(int(np.floor(y)), 0), rows - 1)
-        x0 = min(max(int(np.floor(x)), 0), cols - 1)
-        y1 = min(y0 + 1, rows - 1)
-        x1 = min(x0 + 1, cols - 1)
-        fy = min(max(y - y0, 0.0), 1.0)
-        fx = min(max(x - x0, 0.0), 1.0)
-        a = offset + y0 * cols
-        b = offset + y1 * cols
         for c in range(5):
-            top = texels[a + x0, c] * (1 - fx) + texels[a + x1, c] * fx
-            bottom = texels[b + x0, c] * (1 - fx) + texels[b + x1, c] * fx
-            sample[c] = top * (1 - fy) + bottom * fy
+            sample[c] = 0.0
+        for k in range(taps):
+            offset = ((k + 0.5) / taps - 0.5) * long
+            if along_s:
+                _bilinear5(texels, table, level, s + offset, t, s0, t0, 1.0 / taps, sample)
+            else:
+                _bilinear5(texels, table, level, s, t + offset, s0, t0, 1.0 / taps, sample)
         alpha = sample[3]
         for c in range(3):
             rgb[c] = rgb[c] * (1.0 - alpha) + sample[c]  # premultiplied

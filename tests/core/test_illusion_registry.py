@@ -1,0 +1,106 @@
+"""Tests generated from the illusion registry: every type x severity level."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from lanevil_core.case import Case, case_json, parse_case
+from lanevil_core.compile import compile_scene
+from lanevil_core.illusions import CATEGORIES, REGISTRY
+from lanevil_core.labels import tusimple_record
+from lanevil_core.render import render_frame
+from lanevil_core.stock import original_case, perturbed_case
+
+TYPES = list(REGISTRY)
+LEVELS = [1, 2, 3, 4, 5]
+SIZE = (320, 180)
+BAND_PX = 6  # half width of the band around the labelled lanes where the effect is measured
+
+
+def test_registry_is_the_benchmark_taxonomy() -> None:
+    expected = {
+        "road_damage": {"road_crack", "road_repair", "tire_marks", "guard_rail"},
+        "traffic": {"pedestrian", "vehicle", "bicycle"},
+        "shadow": {"streetlight_shadow", "fence_shadow", "rail_shadow", "wire_shadow"},
+        "reflection": {"sunlight_reflection", "streetlight_reflection", "vehicle_reflection"},
+    }
+    assert len(REGISTRY) == 14
+    assert {c: {n for n, cls in REGISTRY.items() if cls.CATEGORY == c} for c in CATEGORIES} == expected
+
+
+@pytest.mark.parametrize("name", TYPES)
+def test_severity_table_has_five_rows_with_the_same_keys(name: str) -> None:
+    table = REGISTRY[name].SEVERITY
+    assert len(table) == 5
+    assert all(row.keys() == table[0].keys() for row in table)
+
+
+@pytest.mark.parametrize("name", TYPES)
+def test_minimal_spec_is_valid_in_any_case(name: str) -> None:
+    case = parse_case({"road": {"type": "bend"}, "illusions": [{"type": name, "severity": 3}]})
+    assert case.illusions[0].type == name
+
+
+@pytest.mark.parametrize("name", TYPES)
+def test_bad_severity_names_the_field(name: str) -> None:
+    with pytest.raises(ValueError, match=r"illusions\.0\..*severity"):
+        parse_case({"illusions": [{"type": name, "severity": 9}]})
+
+
+@pytest.mark.parametrize("level", LEVELS)
+@pytest.mark.parametrize("name", TYPES)
+def test_json_round_trip(name: str, level: int) -> None:
+    case = perturbed_case(name, level)
+    again = parse_case(json.loads(case_json(case)))
+    assert again == case
+    assert case_json(again) == case_json(case)
+
+
+@pytest.mark.parametrize("level", LEVELS)
+@pytest.mark.parametrize("name", TYPES)
+def test_compile_is_deterministic(name: str, level: int) -> None:
+    a, b = compile_scene(perturbed_case(name, level)), compile_scene(perturbed_case(name, level))
+    assert len(a.meshes) == len(b.meshes) and len(a.layers) == len(b.layers) and len(a.lights) == len(b.lights)
+    for m, n in zip(a.meshes, b.meshes):
+        assert np.array_equal(m.vertices, n.vertices) and np.array_equal(m.colors, n.colors)
+    for m, n in zip(a.layers, b.layers):
+        assert np.array_equal(m.rgba, n.rgba)
+    added = len(a.meshes) + len(a.layers) + len(a.lights) - len(compile_scene(original_case(name)).meshes)
+    assert added > 0, "an illusion must add something to the 3D world"
+
+
+def _render(case: Case) -> tuple[np.ndarray, dict]:
+    scene = compile_scene(case.model_copy(update={"camera": case.camera.model_copy(
+        update={"width": SIZE[0], "height": SIZE[1]})}))
+    frame = render_frame(scene, 0)
+    return frame.rgb, tusimple_record(scene, 0, frame, raw_file="000000.png")
+
+
+def _lane_band(record: dict, shape: tuple[int, int]) -> np.ndarray:
+    mask = np.zeros(shape, bool)
+    for lane in record["lanes"]:
+        for x, y in zip(lane, record["h_samples"]):
+            if x >= 0 and 0 <= y < shape[0]:
+                mask[y, max(x - BAND_PX, 0):x + BAND_PX + 1] = True
+    return mask
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", TYPES)
+def test_effect_is_deterministic_keeps_labels_and_grows_with_severity(name: str) -> None:
+    original, record0 = _render(original_case(name))
+    band = _lane_band(record0, original.shape[:2])
+    assert band.sum() > 500
+    effects = []
+    for level in LEVELS:
+        rgb, record = _render(perturbed_case(name, level))
+        again, _ = _render(perturbed_case(name, level))
+        assert np.array_equal(rgb, again), f"{name} level {level} is not deterministic"
+        assert record["lanes"] == record0["lanes"], f"{name} level {level} moved the lane labels"
+        diff = np.abs(rgb.astype(np.int16) - original.astype(np.int16)).mean(axis=-1)
+        effects.append(float(diff[band].mean()))
+    assert all(b > a for a, b in zip(effects, effects[1:])), f"{name}: effect {effects} does not grow strictly"
+    assert effects[-1] > 8.0, f"{name}: level 5 barely disturbs the lane region ({effects[-1]:.1f})"

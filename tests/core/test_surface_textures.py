@@ -1,0 +1,150 @@
+"""Road-surface texture generators: determinism, ranges, coverage against their parameters, thin antialiased lines."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lanevil_core import surface_textures as tex
+
+TEXEL = 0.03
+SHAPE = (500, 300)  # 15 m along s by 9 m across t
+
+
+def rng(seed: int = 7) -> np.random.Generator:
+    return np.random.default_rng(seed)
+
+
+def generate(name: str, seed: int = 7, **kw) -> tex.Texture:
+    if name in tex.CRACK_KINDS:
+        return tex.crack_network(rng(seed), SHAPE, TEXEL, name, **{"density": 2.0, **kw})
+    if name == "patches":
+        return tex.patches(rng(seed), SHAPE, TEXEL, **{"strips": 3, "parallel_t": (4.5,), **kw})
+    return tex.skid_marks(rng(seed), SHAPE, TEXEL, **{"straight": 1, "swerve": 1, "yaw": 1, **kw})
+
+
+GENERATORS = (*tex.CRACK_KINDS, "patches", "skid_marks")
+
+
+@pytest.mark.parametrize("name", GENERATORS)
+def test_deterministic_in_range_and_seed_dependent(name: str) -> None:
+    rgba, wet = generate(name)
+    again, wet_again = generate(name)
+    other, _ = generate(name, seed=8)
+    assert rgba.dtype == np.float32 and rgba.shape == (*SHAPE, 4)
+    assert np.array_equal(rgba, again)
+    assert (wet is None) == (wet_again is None)
+    assert np.isfinite(rgba).all() and rgba.min() >= 0.0 and rgba.max() <= 1.0
+    assert rgba[..., 3].max() > 0.3, "nothing visible was drawn"
+    assert not np.array_equal(rgba, other)
+
+
+@pytest.mark.parametrize("kind", tex.CRACK_KINDS)
+def test_crack_coverage_grows_with_density(kind: str) -> None:
+    coverage = [generate(kind, density=d)[0][..., 3].mean() for d in (1.0, 2.0, 4.0, 8.0)]
+    assert all(a < b for a, b in zip(coverage, coverage[1:])), coverage
+
+
+def test_cracks_are_dark_and_darkness_scales_opacity() -> None:
+    faint, _ = generate("transverse", darkness=0.3)
+    strong, _ = generate("transverse", darkness=0.9)
+    covered = strong[..., 3] > 0.5
+    assert strong[covered, :3].max() < 0.03  # darker than any asphalt (0.05-0.08)
+    assert (strong[..., 3] >= faint[..., 3]).all()
+    assert 2.5 < strong[..., 3].mean() / faint[..., 3].mean() <= 3.0  # opacity scales with darkness
+
+
+def test_crack_hugging_a_line_is_thin_and_antialiased() -> None:
+    texel, t_line = 0.01, 1.0
+    rgba, _ = tex.crack_network(rng(), (1500, 200), texel, "longitudinal", density=0.0, width_m=0.015,
+                                darkness=1.0, along_t=(t_line,))
+    alpha = rgba[..., 3]
+    cols = (np.arange(200) + 0.5) * texel
+    near = np.abs(cols - t_line) < 0.1
+    core_rows = (alpha[:, near] > 0.5).any(axis=1)
+    assert core_rows.mean() > 0.4, "the crack should follow the line over most of the texture"
+    widths = (alpha[core_rows][:, near] > 0.5).sum(axis=1)
+    assert np.median(widths) <= 3  # a 1-2 cm core at 1 cm texels
+    # Box-filtered edges: between the core and the bare asphalt there are partly covered texels.
+    soft = (alpha[:, near] > 0.05) & (alpha[:, near] < 0.5)
+    assert soft.sum() > core_rows.sum()
+    # Beyond the halo nothing but branches: far columns stay mostly bare.
+    assert alpha[:, ~near].mean() < 0.1 * alpha[:, near].mean()
+
+
+def test_wet_cracks_only_when_asked() -> None:
+    _, dry = generate("alligator")
+    rgba, wet = generate("alligator", wetness=0.8)
+    assert dry is None
+    assert wet is not None and wet.shape == SHAPE and 0.0 < wet.max() <= 0.8
+    assert (wet[rgba[..., 3] == 0] == 0).all()
+
+
+def test_unknown_crack_kind_is_rejected() -> None:
+    with pytest.raises(ValueError, match="kind"):
+        tex.crack_network(rng(), SHAPE, TEXEL, "diagonal")  # type: ignore[arg-type]
+
+
+def test_patch_and_strip_counts_raise_coverage_and_keep_earlier_items() -> None:
+    few, _ = tex.patches(rng(), SHAPE, TEXEL, rectangles=1, blobs=1, strips=1)
+    many, _ = tex.patches(rng(), SHAPE, TEXEL, rectangles=3, blobs=3, strips=4)
+    assert many[..., 3].mean() > few[..., 3].mean() + 0.01
+    assert (many[..., 3] >= few[..., 3] - 1e-6).all()  # adding items never removes the earlier ones
+
+
+def test_parallel_strip_runs_along_its_line() -> None:
+    t_line = 4.5
+    rgba, _ = tex.patches(rng(), SHAPE, TEXEL, rectangles=0, blobs=0, parallel_t=(t_line,), strip_width_m=0.1,
+                          contrast=1.0)
+    alpha = rgba[..., 3]
+    cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
+    band = np.abs(cols - t_line) < 0.15
+    assert (alpha[:, band].max(axis=1) > 0.5).mean() > 0.4
+    assert alpha[:, ~band].max() == 0.0
+
+
+def test_skid_marks_are_track_pairs_that_fade_at_their_ends() -> None:
+    rgba, _ = tex.skid_marks(rng(), SHAPE, TEXEL, straight=1, center_t=(4.5,), length_m=(12.0, 12.0),
+                             darkness=0.8, gauge_m=(1.6, 1.6))
+    alpha = rgba[..., 3]
+    cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
+    profile = alpha.max(axis=0)
+    # Two tracks about 1.6 m apart centred on t = 4.5 m, bare between them.
+    assert profile[np.abs(cols - 3.7) < 0.1].max() > 0.5 and profile[np.abs(cols - 5.3) < 0.1].max() > 0.5
+    assert profile[np.abs(cols - 4.5) < 0.4].max() == 0.0
+    along = alpha.max(axis=1)
+    marked = np.flatnonzero(along > 0)
+    first, last = marked[0], marked[-1]
+    assert np.isclose((last - first) * TEXEL, 12.0, atol=0.5)
+    assert along[first + 2] < 0.3 * along[(first + last) // 2]  # rubber builds up after the tyre locks
+    # Antialiased edges: partial coverage beside the full track.
+    edge = (alpha > 0.02) & (alpha < 0.6 * along.max())
+    assert edge.any()
+
+
+def test_skid_count_and_darkness_raise_coverage() -> None:
+    values = [tex.skid_marks(rng(), SHAPE, TEXEL, straight=n, swerve=n, darkness=d)[0][..., 3].mean()
+              for n, d in ((1, 0.4), (2, 0.6), (3, 0.8))]
+    assert values[0] < values[1] < values[2]
+
+
+def test_composite_is_porter_duff_over() -> None:
+    bottom = np.zeros((2, 2, 4), np.float32)
+    bottom[...] = (0.5, 0.5, 0.5, 1.0)
+    top = np.zeros((2, 2, 4), np.float32)
+    top[0, 0] = (0.0, 0.0, 0.0, 1.0)
+    top[0, 1] = (0.1, 0.1, 0.1, 0.5)
+    out = tex.composite(top, bottom)
+    assert np.allclose(out[0, 0], (0.0, 0.0, 0.0, 1.0))
+    assert np.allclose(out[0, 1], (0.3, 0.3, 0.3, 1.0))
+    assert np.allclose(out[1, 1], bottom[1, 1])
+
+
+def test_crack_mix_of_one_kind_is_that_crack_network() -> None:
+    single, _ = tex.crack_network(rng(), SHAPE, TEXEL, "longitudinal", density=2.0, along_t=(2.0,))
+    mixed, _ = tex.crack_mix(rng(), SHAPE, TEXEL, {"longitudinal": 2.0}, along_t=(2.0,))
+    assert np.array_equal(single, mixed)
+    both, _ = tex.crack_mix(rng(), SHAPE, TEXEL, {"longitudinal": 2.0, "alligator": 2.0}, along_t=(2.0,))
+    assert (both[..., 3] >= single[..., 3] - 1e-6).all()  # other kinds add cracks, never move these
+    with pytest.raises(ValueError, match="kinds"):
+        tex.crack_mix(rng(), SHAPE, TEXEL, {"potholes": 1.0})  # type: ignore[dict-item]
