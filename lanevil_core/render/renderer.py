@@ -136,11 +136,11 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
     else:
         refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
     lap("mirror")
-    st_buf = np.zeros((k.height, k.width, 2), np.float64)
+    st_buf = np.zeros((k.height, k.width, 2), np.float32)
     piece_buf = np.empty((k.height, k.width), np.int32)
     road_coordinates(frags.face, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
                      packed.face_material, st_buf, piece_buf)
-    hdr = np.empty((k.height, k.width, 3), np.float64)
+    hdr = np.empty((k.height, k.width, 3), np.float32)
     fine, coarse = noise_textures()
     shade(frags.face, frags.depth, st_buf, piece_buf, camera.R_world_camera, camera.p_world_camera,
           k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,

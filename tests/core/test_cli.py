@@ -1,0 +1,155 @@
+"""The ``lanevil`` command line: subcommands, one-line user errors with exit status 2, extension commands."""
+
+from __future__ import annotations
+
+import json
+import sys
+import types
+from functools import partial
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from lanevil_core import bench, cli
+from lanevil_core.case import save_case
+
+
+@pytest.fixture
+def case_file(tmp_path, make_case) -> Path:
+    path = tmp_path / "case.json"
+    save_case(make_case(), path)
+    return path
+
+
+def _error_line(capsys) -> str:
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+def test_render_writes_image_overlay_and_labels(case_file, tmp_path, capsys):
+    out, labels = tmp_path / "f.png", tmp_path / "f.json"
+    assert cli.main(["render", str(case_file), "--frame", "4", "--out", str(out), "--overlay",
+                     "--labels", str(labels)]) == 0
+    assert Image.open(out).size == (320, 180)
+    record = json.loads(labels.read_text())
+    assert record["raw_file"] == "f.png" and record["frame"] == 4
+    assert record["h_samples"] == sorted({round(y / 4) for y in range(160, 720, 10)})
+    assert capsys.readouterr().out.strip() == str(out)
+
+
+def test_render_size_flag(case_file, tmp_path):
+    out = tmp_path / "small.png"
+    assert cli.main(["render", str(case_file), "--out", str(out), "--size", "160x90"]) == 0
+    assert Image.open(out).size == (160, 90)
+
+
+def test_invalid_case_names_the_field(tmp_path, capsys):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps({"road": {"lane_width": 1.0}}))
+    assert cli.main(["render", str(path), "--out", str(tmp_path / "x.png")]) == 2
+    assert _error_line(capsys) == (
+        f"lanevil: error: {path}: road.lane_width: Input should be greater than or equal to 2.5")
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["render", "{case}", "--frame", "50", "--out", "{tmp}/x.png"], "--frame 50 is outside 0..49"),
+        (["render", "{case}", "--frame", "-1", "--out", "{tmp}/x.png"], "--frame -1"),
+        (["render", "{case}", "--size", "12x", "--out", "{tmp}/x.png"], "argument --size"),
+        (["render", "{case}", "--size", "10x10", "--out", "{tmp}/x.png"], "64..4096"),
+        (["render", "{case}"], "--out"),
+        (["render", "{tmp}/missing.json", "--out", "{tmp}/x.png"], "missing.json: cannot read"),
+        (["export", "{case}", "--out", "{tmp}/e", "--frames", "5:2"], "--frames '5:2'"),
+        (["export", "{case}", "--out", "{tmp}/e", "--frames", "x"], "START:STOP"),
+        (["export", "{case}", "--out", "{tmp}/e", "--format", "kitti"], "argument --format"),
+        (["bench", "--frames-per-case", "0"], "--frames-per-case"),
+        (["paint"], "invalid choice"),
+        ([], "required"),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(case_file, tmp_path, capsys, argv, needle):
+    argv = [arg.format(case=case_file, tmp=tmp_path) for arg in argv]
+    assert cli.main(argv) == 2
+    line = _error_line(capsys)
+    assert line.startswith("lanevil: error: ") and needle in line
+
+
+def test_not_json_is_a_user_error(tmp_path, capsys):
+    path = tmp_path / "broken.json"
+    path.write_text("{road: ")
+    assert cli.main(["export", str(path), "--out", str(tmp_path / "e")]) == 2
+    assert "not valid JSON" in _error_line(capsys)
+
+
+def test_export_frames_and_formats(case_file, tmp_path):
+    out = tmp_path / "e"
+    assert cli.main(["export", str(case_file), "--out", str(out), "--frames", "48:", "--format", "tusimple"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["000048.png", "000049.png", "case.json", "labels.json"]
+    assert [json.loads(line)["frame"] for line in (out / "labels.json").read_text().splitlines()] == [48, 49]
+
+
+def test_frame_range_parsing():
+    assert cli.frame_range(":", 50) == range(50)
+    assert cli.frame_range("10:", 50) == range(10, 50)
+    assert cli.frame_range(":3", 50) == range(3)
+    with pytest.raises(cli.UsageError):
+        cli.frame_range("0:51", 50)
+
+
+def test_preview_writes_image_and_overlay(case_file, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert cli.main(["preview", str(case_file), "--out", str(out), "--size", "160x90"]) == 0
+    plain, overlay = out / "case.png", out / "case.overlay.png"
+    assert Image.open(plain).size == Image.open(overlay).size == (160, 90)
+    assert plain.read_bytes() != overlay.read_bytes()
+    assert str(plain) in capsys.readouterr().out
+
+
+def test_preview_path_keeps_the_folder_below_scenes(tmp_path):
+    root = tmp_path / "scenes"
+    assert cli.preview_path(root / "01_shadow" / "a.json", Path("out"), root) == Path("out/01_shadow/a.png")
+    assert cli.preview_path(tmp_path / "b.json", Path("out"), root) == Path("out/b.png")
+
+
+def test_bench_json_is_one_object(monkeypatch, capsys, make_case):
+    monkeypatch.setattr(bench, "run_benchmark", partial(bench.run_benchmark, sizes=((160, 90), (96, 64))))
+    monkeypatch.setattr(bench, "bench_cases", lambda paths: [make_case()])
+    assert cli.main(["bench", "--json", "--frames-per-case", "2"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result) == ["160x90", "96x64"]
+    for row in result.values():
+        assert row["median_ms"] > 0 and {"raster", "shade"} <= set(row["stages"])
+    table = bench.format_table(result)
+    assert table.splitlines()[0].split()[:2] == ["size", "ms/frame"] and len(table.splitlines()) == 3
+
+
+def test_frames_to_time_spreads_over_the_drive(make_case):
+    case = make_case()
+    assert bench.frames_to_time(case, 3) == [0, 24, 49]
+    assert bench.frames_to_time(case, 1) == [0]
+
+
+def test_extension_modules_add_commands(monkeypatch):
+    module = types.ModuleType("lanevil_core.cli_fake")
+    module.COMMANDS = {"fake": cli.Command("a test command", lambda parser: parser.add_argument("--n", type=int),
+                                           lambda args: args.n)}
+    monkeypatch.setitem(sys.modules, "lanevil_core.cli_fake", module)
+    real = cli.pkgutil.iter_modules
+    fake = types.SimpleNamespace(name="cli_fake", ispkg=False)
+    monkeypatch.setattr(cli.pkgutil, "iter_modules", lambda path: [*real(path), fake])
+    assert {"render", "export", "preview", "bench", "fake"} <= set(cli.all_commands())
+    assert cli.main(["fake", "--n", "7"]) == 7
+
+
+@pytest.mark.slow
+def test_bench_on_the_stock_cases(capsys):
+    assert cli.main(["bench", "--json", "--frames-per-case", "1"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result) == ["1280x720", "640x360"]
+    assert result["1280x720"]["median_ms"] > result["640x360"]["median_ms"] > 0
