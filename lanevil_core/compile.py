@@ -9,22 +9,14 @@ from .environment import environment_for
 from .illusions import CompileContext
 from .road_layout import build_network
 from .scene import CompiledScene
-
-
-def _roadside(case: Case, ctx: CompileContext) -> None:
-    try:
-        from .scenery import roadside_meshes
-    except ImportError:  # scenery is optional while it is being written
-        return
-    rng = np.random.default_rng([case.seed, 0])
-    ctx.meshes.extend(roadside_meshes(case, ctx.network, rng))
+from .scenery import roadside_meshes
 
 
 def compile_scene(case: Case) -> CompiledScene:
     """Build the network, the roadside props and every illusion's scene elements."""
     network = build_network(case.road, case.scene.kind)
     ctx = CompileContext(case=case, network=network, env=environment_for(case))
-    _roadside(case, ctx)
+    ctx.meshes.extend(roadside_meshes(case, network, np.random.default_rng([case.seed, 0])))
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
         illusion.compile(ctx)

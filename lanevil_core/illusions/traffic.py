@@ -1,3 +1,472 @@
-"""traffic illusions."""
+"""Traffic obstruction: pedestrians, vehicles and bicycles standing on the road and hiding the lane lines.
+
+Participants are static meshes on the main road. The first stands ``distance`` m ahead of the ego's start, the
+rest follow in groups spread over the drive so later frames still see some. The ego's own path (its lane
+centre +- ``EGO_CLEAR_M`` from its start to past its last position) stays free, so nothing is driven through;
+participants crowd the lines beside it and the lanes next to it instead. Severity raises the number of
+participants, brings the first one closer and puts more of them on the lane lines.
+
+``load_obstacle`` reads a user's glTF/GLB/OBJ model; the ``vehicle`` type's ``mesh_file`` uses it in place of
+the procedural bodies.
+"""
 
 from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
+
+import numpy as np
+import trimesh
+from pydantic import Field
+
+from .. import props
+from ..primitives import pose_on_road, rotation_z, to_mesh, transformed
+from ..scene import Mesh
+from .base import Category, CompileContext, Illusion, register
+
+if TYPE_CHECKING:
+    from ..case import Case
+    from ..road_layout import RoadPiece
+    from ..typed import FloatArray
+
+EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
+EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position
+BEYOND_DRIVE_M = 30.0  # groups spread up to this far past the ego's last position
+ROAD_END_MARGIN_M = 10.0
+NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, tried against crowding
+GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
+GREY = (0.3, 0.3, 0.3)
+
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+RGB = tuple[Unit, Unit, Unit]
+# Footprint and height (length, width, height) of each procedural vehicle (m).
+VEHICLE_SIZE: dict[str, tuple[float, float, float]] = {"car": (4.5, 1.8, 1.45), "van": (5.2, 2.0, 2.3),
+                                                       "truck": (8.0, 2.5, 3.4)}
+VEHICLE_COLORS = ((0.45, 0.03, 0.03), (0.6, 0.6, 0.6), (0.03, 0.03, 0.035), (0.05, 0.12, 0.4),
+                  (0.3, 0.3, 0.32), (0.7, 0.55, 0.05), (0.02, 0.15, 0.06), (0.75, 0.75, 0.72))
+
+
+@dataclass(frozen=True)
+class Slot:
+    """Where one participant stands on the main road: road frame (s, t), yaw from the road heading (rad)."""
+
+    s: float
+    t: float
+    yaw: float
+
+
+class Footprints:
+    """The ego's free path and the ground participants took so far, in the main road's (s, t) frame."""
+
+    def __init__(self, case: Case, t_ego: float) -> None:
+        end_s = case.ego_s(case.ego.frames - 1)
+        self.path_s = (case.ego.start_s - 3.0, end_s + EGO_CLEAR_AHEAD_M)
+        self.t_ego = t_ego
+        self.taken: list[tuple[float, float, float, float]] = []  # s, t, half extents along s and t
+
+    @staticmethod
+    def extents(yaw: float, half_x: float, half_y: float) -> tuple[float, float]:
+        """Half extents along s and t of a footprint turned by ``yaw``."""
+        c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+        return c * half_x + s * half_y, s * half_x + c * half_y
+
+    def on_path(self, slot: Slot, ext_s: float, ext_t: float) -> bool:
+        s0, s1 = self.path_s
+        return slot.s + ext_s > s0 and slot.s - ext_s < s1 and abs(slot.t - self.t_ego) < EGO_CLEAR_M + ext_t
+
+    def off_path(self, slot: Slot, ext_t: float) -> Slot:
+        """The slot moved sideways, away from the ego's lane centre, just far enough to clear its path."""
+        side = 1.0 if slot.t >= self.t_ego else -1.0
+        return Slot(slot.s, self.t_ego + side * (EGO_CLEAR_M + ext_t + 0.05), slot.yaw)
+
+    def place(self, slot: Slot, half_x: float, half_y: float, reach: float) -> Slot | None:
+        """Claim ground for a footprint at ``slot`` (moved off the ego's path if needed, and along the road by
+        up to ``NUDGES`` when another participant stands there), or None if it would reach past
+        |t| = ``reach`` or finds no free ground."""
+        ext_s, ext_t = self.extents(slot.yaw, half_x, half_y)
+        if self.on_path(slot, ext_s, ext_t):
+            slot = self.off_path(slot, ext_t)
+        if abs(slot.t) + ext_t > reach:
+            return None
+        for nudge in NUDGES:
+            moved = Slot(slot.s + nudge * (ext_s + 0.3), slot.t, slot.yaw)
+            if self.on_path(moved, ext_s, ext_t):
+                continue
+            if all(abs(moved.s - s) >= ext_s + es + 0.1 or abs(moved.t - t) >= ext_t + et + 0.1
+                   for s, t, es, et in self.taken):
+                self.taken.append((moved.s, moved.t, ext_s, ext_t))
+                return moved
+        return None
+
+
+class TrafficIllusion(Illusion):
+    """Fields and placement shared by the traffic illusions (not registered itself)."""
+
+    CATEGORY: ClassVar[Category] = "traffic"
+
+    count: int | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
+    distance: float | None = Field(
+        None, ge=3, le=300, description="distance of the first one ahead of the ego start (m); empty = severity table"
+    )
+    spacing: float | None = Field(
+        None, gt=0, le=200,
+        description="distance between successive groups along the road (m); empty = spread over the drive",
+    )
+
+    def participants(self) -> int:
+        return int(self.level()["count"] if self.count is None else self.count)
+
+    def first_s(self, case: Case) -> float:
+        """Where the first group stands: ``s`` if given, else ``distance`` (or the table's) ahead of the start."""
+        if self.s is not None:
+            return self.s
+        return case.ego.start_s + float(self.level()["distance"] if self.distance is None else self.distance)
+
+    def group_stations(self, ctx: CompileContext, groups: int) -> list[float]:
+        """s of every group: from the first, ``spacing`` apart, or spread evenly up to ``BEYOND_DRIVE_M`` past
+        the ego's last position."""
+        case, length = ctx.case, ctx.network.main.line.length
+        first = self.first_s(case)
+        if self.spacing is not None:
+            step = self.spacing
+        else:
+            reach = case.ego_s(case.ego.frames - 1) + BEYOND_DRIVE_M
+            step = max((reach - first) / max(groups - 1, 1), 8.0)
+        stations = [first + k * step for k in range(groups)]
+        return [s for s in stations if s < length - ROAD_END_MARGIN_M]
+
+    def crowd_slots(self, ctx: CompileContext, rng: np.random.Generator, group: int, on_lines: float,
+                    yaw_of: Callable[[np.random.Generator, float], float]) -> list[Slot]:
+        """Slots for ``participants()`` people or bikes in groups of ``group`` across the road: a share
+        ``on_lines`` straddle lane lines (the ego lane's own first), the rest stand in the lanes beside it."""
+        total = self.participants()
+        stations = self.group_stations(ctx, math.ceil(total / group))
+        lines, centres = line_order(ctx), lane_centres(ctx)
+        slots = []
+        for g, station in enumerate(stations):
+            members = range(g * group, min((g + 1) * group, total))
+            lined = [i for i in members if on_line(i, on_lines)]
+            for k, index in enumerate(members):
+                s = station + (rng.uniform(0.0, GROUP_DEPTH_M) if k else 0.0)
+                if index in lined:
+                    t = lines[(lined.index(index) + g) % len(lines)]
+                else:
+                    t = centres[(k - len(lined) + g) % len(centres)] + rng.uniform(-0.5, 0.5)
+                slots.append(Slot(s, t, yaw_of(rng, t)))
+        return slots
+
+    def add(self, ctx: CompileContext, mesh: Mesh, slot: Slot, index: int, follow_grade: bool = True) -> None:
+        """Put a local-frame participant at ``slot``, pitched with the road's grade (wheels on the slope)
+        unless it stands upright (people)."""
+        line = ctx.network.main.line
+        T_world_local = pose_on_road(line, slot.s, slot.t, slot.yaw)
+        if follow_grade:
+            pitch = math.atan(float(line.grade_at(slot.s)) * math.cos(slot.yaw))
+            c, s = math.cos(pitch), math.sin(pitch)
+            T_world_local = T_world_local @ np.array([[c, 0, -s, 0], [0, 1, 0, 0], [s, 0, c, 0], [0, 0, 0, 1.0]])
+        placed = transformed(mesh, T_world_local)
+        placed.name = f"{self.type} {index + 1}"
+        ctx.add_mesh(placed)
+
+
+def half_extents(mesh: Mesh) -> tuple[float, float]:
+    """Half extents (m) along local X and Y of a local-frame mesh's footprint about its origin."""
+    reach = np.abs(mesh.vertices[:, :2]).max(0)
+    return float(reach[0]), float(reach[1])
+
+
+def paved_reach(piece: RoadPiece) -> float:
+    """|t| up to which the road is flat asphalt: the carriageway plus any level asphalt strip at its edge."""
+    reach = piece.half_width
+    for strip in piece.strips:
+        if strip.material != "asphalt" or strip.height != 0.0:
+            break
+        reach += strip.width
+    return reach
+
+
+def line_order(ctx: CompileContext) -> list[float]:
+    """t of the main road's lane lines nearest the ego's lane centre first (the ego lane's own lines lead)."""
+    t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+    boundaries = [float(t) for t in ctx.network.main.boundaries_t]
+    return sorted(boundaries, key=lambda t: (abs(t - t_ego), t))
+
+
+def lane_centres(ctx: CompileContext) -> list[float]:
+    """t of every lane centre of both directions, nearest the ego's lane first (the ego lane itself last)."""
+    t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+    b = ctx.network.main.boundaries_t
+    centres = [float(t) for t in 0.5 * (b[:-1] + b[1:]) if abs(t - t_ego) > 1e-6]
+    return sorted(centres, key=lambda t: (abs(t - t_ego), t)) + [t_ego]
+
+
+def on_line(index: int, share: float) -> bool:
+    """Whether participant ``index`` stands on a line when ``share`` of them do (the first one does first)."""
+    return math.ceil((index + 1) * share - 1e-9) > math.ceil(index * share - 1e-9)
+
+
+@register
+class Pedestrian(TrafficIllusion):
+    """People crossing or standing on the road, on the lane lines and in the lanes beside the ego's."""
+
+    # count: people; group: people per crossing group; distance: first group ahead of the ego start (m);
+    # on_lines: share of the people standing on a lane line. On the default road the first frame loses about
+    # 0, 0.5, 0.7, 3 and 6 % of its lane-line rows behind them.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
+        {"count": 3, "group": 1, "distance": 35.0, "on_lines": 0.34},
+        {"count": 6, "group": 3, "distance": 24.0, "on_lines": 0.5},
+        {"count": 12, "group": 5, "distance": 16.0, "on_lines": 0.6},
+        {"count": 20, "group": 8, "distance": 10.0, "on_lines": 0.75},
+    )
+    type: Literal["pedestrian"] = "pedestrian"
+    motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
+    group: int | None = Field(None, ge=1, le=12, description="people per group; empty = severity table")
+    on_lines: float | None = Field(
+        None, ge=0, le=1, description="share of people standing on a lane line; empty = severity table"
+    )
+    shirt_colors: list[RGB] | None = Field(None, description="shirt colours (linear RGB), cycled; empty = random")
+    height: float = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        rng = ctx.rng(self.seed)
+        group = self.group or int(level["group"])
+        share = float(level["on_lines"] if self.on_lines is None else self.on_lines)
+        crossing = self.motion == "crossing"
+
+        def yaw_of(r: np.random.Generator, t: float) -> float:
+            if crossing:
+                return float(np.pi / 2 if r.random() < 0.5 else -np.pi / 2)
+            return float(np.pi + r.uniform(-0.6, 0.6))
+
+        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        for index, slot in enumerate(self.crowd_slots(ctx, rng, group, share, yaw_of)):
+            shirt = None if not self.shirt_colors else self.shirt_colors[index % len(self.shirt_colors)]
+            height = self.height * float(rng.uniform(0.94, 1.06))
+            mesh = props.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
+            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
+            if placed is not None:
+                self.add(ctx, mesh, placed, index, follow_grade=False)
+
+
+@register
+class Bicycle(TrafficIllusion):
+    """Cyclists riding along the lane lines (or crossing the road) beside the ego's path."""
+
+    # count: cyclists; group: cyclists side by side; distance: first group ahead of the ego start (m);
+    # on_lines: share of cyclists riding on a lane line. The first frame loses about 0.3, 0.5, 1, 1 and 5 % of
+    # its lane-line rows behind them.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
+        {"count": 3, "group": 1, "distance": 35.0, "on_lines": 0.34},
+        {"count": 5, "group": 2, "distance": 24.0, "on_lines": 0.5},
+        {"count": 9, "group": 3, "distance": 16.0, "on_lines": 0.67},
+        {"count": 14, "group": 5, "distance": 10.0, "on_lines": 0.8},
+    )
+    type: Literal["bicycle"] = "bicycle"
+    motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
+    group: int | None = Field(None, ge=1, le=8, description="cyclists per group; empty = severity table")
+    on_lines: float | None = Field(
+        None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
+    )
+    frame_colors: list[RGB] | None = Field(None, description="bicycle frame colours (linear RGB), cycled")
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        rng = ctx.rng(self.seed)
+        group = self.group or int(level["group"])
+        share = float(level["on_lines"] if self.on_lines is None else self.on_lines)
+        riding = self.motion == "riding"
+
+        def yaw_of(r: np.random.Generator, t: float) -> float:
+            if riding:  # keep to the road's right: those left of the centre line ride towards the ego
+                return float(r.uniform(-0.05, 0.05) + (np.pi if t > 0 else 0.0))
+            return float(np.pi / 2 if r.random() < 0.5 else -np.pi / 2)
+
+        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        for index, slot in enumerate(self.crowd_slots(ctx, rng, group, share, yaw_of)):
+            color = None if not self.frame_colors else self.frame_colors[index % len(self.frame_colors)]
+            mesh = props.bicycle_with_rider(rng, frame_color=color)
+            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
+            if placed is not None:
+                self.add(ctx, mesh, placed, index)
+
+
+@register
+class Vehicle(TrafficIllusion):
+    """Cars, vans and trucks standing in the lanes beside the ego's, some changing lanes across a line, and in
+    the ego's lane beyond the end of its drive."""
+
+    # count: vehicles; per_row: vehicles side by side in different lanes; distance: first row ahead of the ego
+    # start (m); large: share of vans and trucks (mixed kind); lane_change: share straddling a lane line.
+    # The first frame loses about 1, 1.5, 8, 15 and 30 % of its lane-line rows behind them.
+    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
+        {"count": 1, "per_row": 1, "distance": 45.0, "large": 0.0, "lane_change": 0.0},
+        {"count": 2, "per_row": 1, "distance": 35.0, "large": 0.2, "lane_change": 0.0},
+        {"count": 4, "per_row": 2, "distance": 25.0, "large": 0.3, "lane_change": 0.15},
+        {"count": 6, "per_row": 2, "distance": 18.0, "large": 0.4, "lane_change": 0.25},
+        {"count": 9, "per_row": 3, "distance": 12.0, "large": 0.5, "lane_change": 0.35},
+    )
+    # Lanes relative to the ego's (+1 = next lane to its right, -1 = to its left), tried in this order.
+    LANE_ORDER: ClassVar[tuple[int, ...]] = (1, -1, -2, 2, -3, 3, 0, -4, 4, -5, 5, -6, 6, -7, 7)
+
+    type: Literal["vehicle"] = "vehicle"
+    kind: Literal["mixed", "car", "van", "truck"] = Field("mixed", description="vehicle type; mixed = by severity")
+    per_row: int | None = Field(None, ge=1, le=8, description="vehicles side by side; empty = severity table")
+    lane_change: float | None = Field(
+        None, ge=0, le=1, description="share of vehicles straddling a lane line; empty = severity table"
+    )
+    colors: list[RGB] | None = Field(None, description="body colours (linear RGB), cycled; empty = random")
+    lights_on: bool = Field(False, description="headlights and tail lights glow")
+    mesh_file: str | None = Field(
+        None, description="glTF/GLB/OBJ model used instead of the procedural bodies, scaled to the vehicle size"
+    )
+
+    def compile(self, ctx: CompileContext) -> None:
+        level = self.level()
+        rng = ctx.rng(self.seed)
+        per_row = self.per_row or int(level["per_row"])
+        lane_change = float(level["lane_change"] if self.lane_change is None else self.lane_change)
+        total = self.participants()
+        stations = self.group_stations(ctx, math.ceil(total / per_row))
+        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        loaded = load_obstacle(self.mesh_file) if self.mesh_file else None
+        index = 0
+        for row, s in enumerate(stations):
+            for lane_t in self._row_lanes(ctx, s, per_row, row):
+                if index >= total:
+                    return
+                kind = self._kind(rng, float(level["large"]))
+                length, width, height = VEHICLE_SIZE[kind]
+                s_vehicle, reach = s + rng.uniform(-2.0, 2.0), paved_reach(ctx.network.main)
+                changing = on_line(index, lane_change)
+                placed = free.place(self._slot(ctx, rng, s_vehicle, lane_t, changing), length / 2, width / 2, reach)
+                if placed is None and changing:  # no room to change lanes: keep to the lane
+                    placed = free.place(self._slot(ctx, rng, s_vehicle, lane_t, False), length / 2, width / 2, reach)
+                if placed is not None:
+                    self.add(ctx, self._body(rng, kind, index, loaded), placed, index)
+                index += 1
+
+    def _row_lanes(self, ctx: CompileContext, s: float, per_row: int, row: int) -> list[float]:
+        """Lane centres (t) of one row: lanes beside the ego's, the ego's own only past its free path."""
+        network, case = ctx.network, ctx.case
+        n = network.lanes_per_direction
+        ego_index = n + case.ego.lane  # lanes numbered left to right over both directions
+        free_beyond = case.ego_s(case.ego.frames - 1) + EGO_CLEAR_AHEAD_M + VEHICLE_SIZE["truck"][0]
+        lanes = []
+        for offset in self.LANE_ORDER:
+            j = ego_index + offset
+            if 0 <= j < 2 * n and (offset != 0 or s > free_beyond):
+                lanes.append(float((n - j - 0.5) * network.lane_width))
+        shift = row % max(len(lanes), 1)
+        return (lanes[shift:] + lanes[:shift])[:per_row]
+
+    def _slot(self, ctx: CompileContext, rng: np.random.Generator, s: float, lane_t: float, changing: bool) -> Slot:
+        """A vehicle in the lane at ``lane_t``, facing its direction of travel, or straddling the line it is
+        changing over (never one of the ego lane's lines or a road edge)."""
+        yaw = 0.0 if lane_t < 0 else np.pi
+        t = lane_t + rng.uniform(-0.25, 0.25)
+        if changing:
+            t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+            inner = [float(b) for b in ctx.network.main.boundaries_t[1:-1]
+                     if abs(abs(b - lane_t) - ctx.network.lane_width / 2) < 1e-6
+                     and abs(abs(b - t_ego) - ctx.network.lane_width / 2) > 1e-6]
+            if inner:
+                line = inner[int(rng.integers(len(inner)))]
+                t = line + 0.15 * (lane_t - line)
+                steer = 0.12 if (line > lane_t) == (yaw == 0.0) else -0.12
+                yaw += steer
+        return Slot(s, t, float(yaw))
+
+    def _kind(self, rng: np.random.Generator, large: float) -> str:
+        if self.kind != "mixed":
+            return self.kind
+        u = rng.random()
+        return "truck" if u < large / 2 else "van" if u < large else "car"
+
+    def _body(self, rng: np.random.Generator, kind: str, index: int, loaded: Mesh | None) -> Mesh:
+        length, width, height = VEHICLE_SIZE[kind]
+        if loaded is not None:
+            return scaled_to(loaded, (length, width, height))
+        palette = self.colors or VEHICLE_COLORS
+        color = palette[index % len(palette)] if self.colors else palette[int(rng.integers(len(palette)))]
+        if kind == "truck":
+            return props.truck(color, lights_on=self.lights_on)
+        if kind == "van":
+            return props.van(color, lights_on=self.lights_on)
+        return props.car(color, lights_on=self.lights_on)
+
+
+def srgb_to_linear(rgb8: FloatArray) -> FloatArray:
+    """(..., 3) sRGB 0-255 -> linear [0, 1]."""
+    c = np.asarray(rgb8, np.float64) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _face_colors(geometry: trimesh.Trimesh) -> FloatArray:
+    """(m, 3) linear albedo per face from a loaded mesh's visual: face or vertex colours, the texture
+    sampled at the vertices, the material's base colour, else grey."""
+    visual = geometry.visual
+    faces = geometry.faces
+    try:
+        if visual.kind == "face":
+            return srgb_to_linear(visual.face_colors[:, :3])
+        if visual.kind == "vertex":
+            return srgb_to_linear(visual.vertex_colors[faces][:, :, :3].mean(1))
+        if visual.kind == "texture":
+            material = getattr(visual, "material", None)
+            if getattr(visual, "uv", None) is not None and getattr(material, "image", None) is not None:
+                colors = visual.to_color().vertex_colors
+                return srgb_to_linear(colors[faces][:, :, :3].mean(1))
+            if material is not None:
+                return np.broadcast_to(srgb_to_linear(np.asarray(material.main_color)[:3]), (len(faces), 3))
+    except (AttributeError, ValueError, IndexError, ImportError):
+        pass
+    return np.broadcast_to(np.asarray(GREY, np.float64), (len(faces), 3))
+
+
+def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: int = 60_000,
+                  name: str | None = None) -> Mesh:
+    """A user's glTF/GLB/OBJ model as a local-frame ``Mesh``: footprint centred on the origin, resting on z = 0,
+    +X forward.
+
+    ``up="y"`` converts glTF's convention (+Y up, +Z forward) to this frame; ``up="z"`` keeps the axes. Colours
+    come per face from the file (sRGB converted to linear), grey where it has none.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"obstacle model not found: {path}")
+    scene = trimesh.load(str(path), force="scene")
+    parts = [g for g in scene.dump(concatenate=False) if isinstance(g, trimesh.Trimesh) and len(g.faces)]
+    if not parts:
+        raise ValueError(f"{path}: no triangles in the model")
+    faces = sum(len(g.faces) for g in parts)
+    if faces > max_faces:
+        raise ValueError(f"{path}: {faces} triangles, more than the {max_faces} the renderer takes per obstacle")
+    vertices, tris, colors, offset = [], [], [], 0
+    for g in parts:
+        vertices.append(np.asarray(g.vertices, np.float64))
+        tris.append(np.asarray(g.faces, np.int64) + offset)
+        colors.append(_face_colors(g))
+        offset += len(g.vertices)
+    p = np.concatenate(vertices)
+    if up == "y":  # (x, y, z) glTF -> +X forward (glTF +Z), +Y left (glTF +X), +Z up (glTF +Y)
+        p = np.stack([p[:, 2], p[:, 0], p[:, 1]], axis=1)
+    lo, hi = p.min(0), p.max(0)
+    p = p - [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]]
+    mesh = to_mesh(trimesh.Trimesh(p, np.concatenate(tris), process=False), np.concatenate(colors),
+                   name=name or path.stem, kind="obstacle", gloss=0.3)
+    return mesh
+
+
+def scaled_to(mesh: Mesh, size: tuple[float, float, float]) -> Mesh:
+    """A copy of a local-frame mesh scaled uniformly to fit inside ``size`` (length, width, height) (m)."""
+    extent = np.maximum(mesh.vertices.max(0) - mesh.vertices.min(0), 1e-9)
+    k = float(np.min(np.asarray(size) / extent))
+    T = rotation_z(0.0)
+    T[:3, :3] *= k
+    return transformed(mesh, T)

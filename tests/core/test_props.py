@@ -1,0 +1,190 @@
+"""Props: real dimensions, resting on the ground, faces wound outwards, deterministic, renderable arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lanevil_core import props
+from lanevil_core.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
+from lanevil_core.road_layout import build_network
+from lanevil_core.case import Road
+from lanevil_core.scene import Mesh
+
+
+def extents(mesh: Mesh) -> np.ndarray:
+    return mesh.vertices.max(0) - mesh.vertices.min(0)
+
+
+def signed_volume(mesh: Mesh) -> float:
+    """Enclosed volume (m3) for closed meshes; measured about the vertex mean so one-sided panels (windows)
+    add little and rigid motions change nothing."""
+    p = mesh.vertices - mesh.vertices.mean(0)
+    a, b, c = (p[mesh.faces[:, i]] for i in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def outward_share(mesh: Mesh) -> float:
+    """Share of the face area whose normal points away from the bounding-box centre."""
+    tri = mesh.vertices[mesh.faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    centre = 0.5 * (mesh.vertices.min(0) + mesh.vertices.max(0))
+    away = np.einsum("ij,ij->i", normal, tri.mean(1) - centre) > 0
+    area = np.linalg.norm(normal, axis=1)
+    return float(area[away].sum() / area.sum())
+
+
+def assert_renderable(mesh: Mesh) -> None:
+    assert mesh.vertices.dtype == np.float64 and mesh.vertices.shape[1] == 3
+    assert mesh.faces.dtype == np.int32 and mesh.faces.max() < len(mesh.vertices)
+    assert mesh.colors.shape == (len(mesh.faces), 3) and mesh.colors.dtype == np.float32
+    assert np.all(mesh.colors >= 0) and np.all(mesh.colors <= 1)
+    assert np.isfinite(mesh.vertices).all()
+
+
+RNG = np.random.default_rng
+
+
+# (builder, expected length x width x height in m, tolerance)
+SIZED = {
+    "car": (lambda: props.car(), (4.5, 1.8, 1.45), 0.12),
+    "van": (lambda: props.van(), (5.2, 2.0, 2.3), 0.12),
+    "truck": (lambda: props.truck(), (8.0, 2.5, 3.4), 0.15),
+    "bicycle": (lambda: props.bicycle_with_rider(RNG(0)), (1.8, 0.55, 1.75), 0.12),
+}
+
+
+@pytest.mark.parametrize("name", SIZED)
+def test_vehicle_sized_props_have_real_dimensions(name: str) -> None:
+    build, size, tol = SIZED[name]
+    mesh = build()
+    assert_renderable(mesh)
+    np.testing.assert_allclose(extents(mesh), size, atol=tol)
+    assert abs(mesh.vertices[:, 2].min()) < 0.01  # wheels touch the ground
+    centre = 0.5 * (mesh.vertices.min(0) + mesh.vertices.max(0))
+    assert abs(centre[0]) < 0.15 and abs(centre[1]) < 0.05  # origin at the footprint centre
+
+
+@pytest.mark.parametrize("name", ["car", "van", "truck"])
+def test_vehicles_wind_faces_outwards(name: str) -> None:
+    mesh = SIZED[name][0]()
+    length, width, height = SIZED[name][1]
+    assert signed_volume(mesh) > 0.4 * length * width * height
+    assert outward_share(mesh) > 0.75  # wheels' inner caps rightly face the body
+
+
+def test_vehicle_lights_glow_only_when_on() -> None:
+    dark, lit = props.car(), props.car(lights_on=True)
+    assert dark.emission is None
+    assert lit.emission is not None and lit.emission.shape == (len(lit.faces), 3)
+    glowing = lit.emission.max(1) > 0
+    front = lit.vertices[lit.faces[glowing]].mean(1)[:, 0]
+    assert (front > 1.8).any() and (front < -1.8).any()  # headlights at the front, tail lights at the back
+    red = lit.emission[glowing & (lit.vertices[lit.faces].mean(1)[:, 0] < 0)]
+    assert np.all(red[:, 0] > 5 * red[:, 2])
+
+
+def test_vehicle_body_colour_and_dark_glass() -> None:
+    car = props.car((0.5, 0.0, 0.0))
+    share_body = np.mean(np.all(np.isclose(car.colors, (0.5, 0.0, 0.0)), axis=1))
+    assert share_body > 0.05
+    tri = car.vertices[car.faces]
+    high = tri.mean(1)[:, 2] > 1.0  # glasshouse
+    assert np.any(car.colors[high].max(1) < 0.05)
+
+
+def test_pedestrian_is_a_person_sized_standing_figure() -> None:
+    for walking in (False, True):
+        person = props.pedestrian(RNG(3), walking=walking)
+        assert_renderable(person)
+        size = extents(person)
+        assert abs(size[2] - 1.75) < 0.03
+        assert 0.4 < size[1] < 0.8 and size[0] < (1.0 if walking else 0.45)
+        assert abs(person.vertices[:, 2].min()) < 0.01
+    tall = props.pedestrian(RNG(3), height=1.9)
+    assert abs(extents(tall)[2] - 1.9) < 0.03
+
+
+def test_pedestrian_colours_come_from_rng_or_arguments() -> None:
+    a, b = props.pedestrian(RNG(1)), props.pedestrian(RNG(1))
+    np.testing.assert_array_equal(a.colors, b.colors)
+    shirts = {tuple(props.pedestrian(RNG(seed)).colors.max(0).round(3)) for seed in range(8)}
+    assert len(shirts) > 2
+    red = props.pedestrian(RNG(1), shirt=(0.9, 0.0, 0.0))
+    assert np.any(np.all(np.isclose(red.colors, (0.9, 0.0, 0.0)), axis=1))
+
+
+def test_trees_and_bushes_stand_on_the_ground() -> None:
+    for seed in range(6):
+        for conifer in (True, False):
+            tree = props.tree(RNG(seed), conifer=conifer)
+            assert_renderable(tree)
+            assert 4.0 < extents(tree)[2] < 12.5
+            assert -0.4 < tree.vertices[:, 2].min() <= 0.0
+        shrub = props.bush(RNG(seed))
+        assert extents(shrub)[2] < 2.0 and shrub.vertices[:, 2].min() < 0.05
+    tree = props.tree(RNG(0), height=8.0, conifer=False)
+    assert abs(tree.vertices[:, 2].max() - 8.0) < 1.5
+
+
+def test_building_and_house_fill_their_footprint() -> None:
+    block = props.building(RNG(0), 20.0, 12.0, 16.0, shopfront=True)
+    assert_renderable(block)
+    np.testing.assert_allclose(extents(block), (20.2, 12.2, 16.9), atol=0.1)  # parapet, footing
+    assert outward_share(block) > 0.85  # all but the parapet's underside
+    windows = block.colors.max(1) < 0.06
+    assert windows.sum() >= 2 * 4 * 5  # a grid of dark windows on the facades
+    home = props.house(RNG(1), 10.0, 8.0, storeys=2)
+    size = extents(home)
+    assert 10.0 <= size[0] < 11.0 and 8.0 <= size[1] < 9.0 and 7.0 < size[2] < 10.0
+
+
+def test_jersey_barrier_profile() -> None:
+    barrier = props.jersey_barrier(4.0)
+    np.testing.assert_allclose(extents(barrier), (4.0, 0.61, 0.81), atol=1e-6)
+    assert signed_volume(barrier) == pytest.approx(4.0 * 0.3, rel=0.15)  # ~0.3 m2 cross-section
+
+
+def test_tunnel_portal_keeps_its_opening_clear() -> None:
+    width, height = 16.0, 6.0
+    portal = props.tunnel_portal(width, height, lining=8.0)
+    assert_renderable(portal)
+    tri = portal.vertices[portal.faces]
+    probes = np.concatenate([tri.mean(1), portal.vertices[portal.faces].reshape(-1, 3)])
+    inside = ((np.abs(probes[:, 1]) < width / 2 - 0.01) & (probes[:, 2] > 0.01) & (probes[:, 2] < height - 0.01)
+              & (probes[:, 0] > -30.0) & (probes[:, 0] < 8.0))
+    assert not inside.any()
+    assert portal.vertices[:, 2].max() > height + 5.0  # a hill rises over it
+    assert portal.vertices[:, 0].min() < -5.0  # and its foot reaches out in front
+
+
+def test_props_are_deterministic() -> None:
+    for build in (props.tree, props.bush, props.pedestrian, props.bicycle_with_rider, props.house):
+        a, b = build(RNG(7)), build(RNG(7))
+        np.testing.assert_array_equal(a.vertices, b.vertices)
+        np.testing.assert_array_equal(a.colors, b.colors)
+
+
+def test_primitives_are_closed_and_outward() -> None:
+    solids = [box((2.0, 1.0, 0.5), (1.0, 2.0, 3.0)), cylinder(0.3, 1.0, sections=8),
+              cylinder(0.2, segment=[(0, 0, 0), (1, 1, 1)]), prism([(0, 0), (2, 0), (1, 1)], -1, 1),
+              prism([(0, 1), (1, 0), (0, 0)], 0, 2, axis="x"),
+              loft([[(0, 0, 0), (1, 0, 0), (1, 1, 0)], [(0, 0, 2), (1, 0, 2), (1, 1, 2)]])]
+    for solid in solids:
+        assert signed_volume(solid) > 0
+    np.testing.assert_allclose(signed_volume(solids[0]), 1.0)
+    merged = merge(solids[:2], name="both", kind="test")
+    assert len(merged.faces) == len(solids[0].faces) + len(solids[1].faces)
+    assert merged.name == "both" and signed_volume(merged) > 1.0
+
+
+def test_pose_on_road_stands_upright_along_the_heading() -> None:
+    line = build_network(Road(type="bend", radius=80.0), "suburban").main.line
+    for s in (10.0, 90.0, 150.0):
+        T = pose_on_road(line, s, -3.0, yaw=0.3, h=0.1)
+        np.testing.assert_allclose(T[:3, 2], (0.0, 0.0, 1.0))  # +Z straight up
+        heading = float(line.heading_at(s)) + 0.3
+        np.testing.assert_allclose(T[:3, 0], (np.cos(heading), np.sin(heading), 0.0), atol=1e-12)
+        np.testing.assert_allclose(T[:3, 3], line.to_world(s, -3.0, 0.1))
+    car = transformed(props.car(), pose_on_road(line, 100.0, -1.75))
+    assert signed_volume(car) == pytest.approx(signed_volume(props.car()))

@@ -1,0 +1,131 @@
+"""Roadside scenery: nothing on any carriageway, shoulder or sidewalk, modest triangle counts, deterministic."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from lanevil_core.case import Case
+from lanevil_core.road_layout import RoadNetwork, RoadPiece, build_network
+from lanevil_core.scene import Mesh
+from lanevil_core.scenery import corridor_half_width, roadside_meshes
+from lanevil_core.typed import SCENE_KINDS
+
+OVERHEAD_CLEARANCE_M = 4.5  # what is this high above the road (a lamp arm, a tunnel lintel) may span it
+# Structures allowed inside the roadside strips (but never on the carriageway).
+ON_VERGE = {"barrier", "pole"}
+
+
+def road_frame(piece: RoadPiece, p_world: np.ndarray) -> tuple[np.ndarray, ...]:
+    """s, t and height above the road surface of world points (n, 3) in ``piece``'s road frame (nearest
+    sample every 4 m, then two projections on the local tangent)."""
+    line = piece.line
+    coarse = slice(None, None, 40)
+    near = np.argmin(((p_world[:, None, :2] - line.xy[coarse][None]) ** 2).sum(-1), axis=1)
+    s = line.s[coarse][near]
+    for _ in range(2):
+        origin, tangent, _ = line.frame(s)
+        flat = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
+        s = s + ((p_world[:, :2] - origin[:, :2]) * flat).sum(1)
+    origin, _, left = line.frame(np.clip(s, 0.0, line.length))
+    return s, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
+
+
+def intrusions(network: RoadNetwork, meshes: list[Mesh], reach: Callable[[RoadPiece], float]) -> set[str]:
+    """Names of meshes with a vertex (or face centre) within ``reach(piece)`` of some piece's centre line,
+    inside its length, lower than the overhead clearance."""
+    if not meshes:
+        return set()
+    probes = [np.concatenate([m.vertices, m.vertices[m.faces].mean(1)]) for m in meshes]
+    owner = np.concatenate([np.full(len(p), i) for i, p in enumerate(probes)])
+    probes = np.concatenate(probes)
+    bad: set[str] = set()
+    for piece in network.pieces:
+        s, t, h = road_frame(piece, probes)
+        inside = (s > 0.5) & (s < piece.line.length - 0.5) & (np.abs(t) < reach(piece)) & (h < OVERHEAD_CLEARANCE_M)
+        bad |= {meshes[i].name for i in np.unique(owner[inside])}
+    return bad
+
+
+def scenery(kind: str, road: str = "straight", density: float = 1.0, seed: int = 0) -> tuple[RoadNetwork, list[Mesh]]:
+    case = Case.model_validate({"scene": {"kind": kind, "density": density}, "road": {"type": road}})
+    network = build_network(case.road, kind)
+    return network, roadside_meshes(case, network, np.random.default_rng(seed))
+
+
+@pytest.mark.parametrize("road", ["straight", "bend", "crossroad"])
+@pytest.mark.parametrize("kind", SCENE_KINDS)
+def test_nothing_stands_on_the_road(kind: str, road: str) -> None:
+    network, meshes = scenery(kind, road)
+    assert meshes
+    # Every prop clears the carriageway of every piece (main road and junction arms) ...
+    assert intrusions(network, meshes, lambda piece: piece.half_width) == set()
+    # ... and, but for barriers and lamp posts, the shoulders, kerbs and sidewalks too.
+    props = [mesh for mesh in meshes if mesh.kind not in ON_VERGE]
+    assert intrusions(network, props, lambda piece: corridor_half_width(piece) - 0.05) == set()
+
+
+@pytest.mark.parametrize("kind", SCENE_KINDS)
+def test_triangle_budget(kind: str) -> None:
+    for density in (1.0, 3.0):
+        _, meshes = scenery(kind, "crossroad", density)
+        faces = sum(len(mesh.faces) for mesh in meshes)
+        assert faces < (30_000 if density == 1.0 else 60_000), (kind, density, faces)
+
+
+def test_scenery_is_deterministic_and_seeded() -> None:
+    _, a = scenery("suburban", "bend", seed=4)
+    _, b = scenery("suburban", "bend", seed=4)
+    _, c = scenery("suburban", "bend", seed=5)
+    assert [m.name for m in a] == [m.name for m in b]
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x.vertices, y.vertices)
+        np.testing.assert_array_equal(x.colors, y.colors)
+    assert sum(len(m.faces) for m in a) != sum(len(m.faces) for m in c) or not np.array_equal(
+        a[0].vertices, c[0].vertices)
+
+
+@pytest.mark.parametrize("kind", ["urban", "suburban", "rural"])
+def test_density_scales_the_props(kind: str) -> None:
+    faces = [sum(len(m.faces) for m in scenery(kind, density=d)[1]) for d in (0.0, 1.0, 3.0)]
+    assert faces[0] < faces[1] < faces[2] and faces[0] < faces[2] / 2
+
+
+def test_scenes_differ_by_kind() -> None:
+    kinds = {kind: {m.kind for m in scenery(kind)[1]} for kind in SCENE_KINDS}
+    assert "building" in kinds["urban"] and "pole" in kinds["urban"]
+    assert {"building", "tree"} <= kinds["suburban"]
+    assert "barrier" in kinds["highway"] and "building" not in kinds["highway"]
+    assert "tree" in kinds["rural"]
+    assert "tunnel" in kinds["tunnel_approach"]
+
+
+def test_props_cover_the_whole_road() -> None:
+    network, meshes = scenery("rural", "bend")
+    s, _, _ = road_frame(network.main, np.concatenate([m.vertices for m in meshes if m.kind == "tree"]))
+    inside = s[(s > 0) & (s < network.main.line.length)]
+    assert inside.min() < 40.0 and inside.max() > network.main.line.length - 40.0
+
+
+def test_highway_barriers_line_both_edges_beyond_the_shoulder() -> None:
+    network, meshes = scenery("highway", "bend")
+    barriers = np.concatenate([m.vertices for m in meshes if m.kind == "barrier"])
+    s, t, h = road_frame(network.main, barriers)
+    shoulder = network.main.half_width + network.main.strips[0].width
+    assert np.all(np.abs(t) > shoulder) and np.all(np.abs(t) < corridor_half_width(network.main) + 0.5)
+    assert (t > 0).any() and (t < 0).any()
+    assert np.all(np.abs(h) < 0.9)  # standing on the verge, not floating
+
+
+def test_tunnel_portal_spans_the_road_ahead_of_the_ego() -> None:
+    case = Case.model_validate({"scene": {"kind": "tunnel_approach"}})
+    network = build_network(case.road, "tunnel_approach")
+    meshes = roadside_meshes(case, network, np.random.default_rng(0))
+    portal = next(m for m in meshes if m.name == "tunnel portal")
+    s, t, h = road_frame(network.main, portal.vertices[portal.faces].mean(1))
+    lintel = (np.abs(t) < network.main.half_width) & (h > 5.0)
+    assert lintel.any()
+    s_face = s[lintel].min()
+    assert case.ego.start_s + 145.0 < s_face < case.ego.start_s + 255.0
