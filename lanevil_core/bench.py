@@ -77,3 +77,38 @@ def format_table(result: dict[str, dict[str, Any]]) -> str:
             for size, row in result.items()]
     widths = [max(len(line[i]) for line in [header, *rows]) for i in range(len(header))]
     return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths)) for line in [header, *rows])
+
+
+def illusion_benchmark(size: tuple[int, int] = (1280, 720), frames: int = 3, level: int = 5) -> list[dict[str, Any]]:
+    """Per illusion type: median ms/frame of its stock original and of its ``level`` case, and their ratio."""
+    from .compile import compile_scene
+    from .illusions import REGISTRY
+    from .render import render_frame
+    from .render.packed import pack_scene
+    from .stock import original_case, perturbed_case
+
+    def median_ms(case: Case) -> float:
+        scene = compile_scene(case)
+        pack_scene(scene)
+        times = []
+        for frame_index in frames_to_time(case, frames):
+            start = time.perf_counter()
+            render_frame(scene, frame_index, size)
+            times.append((time.perf_counter() - start) * 1000.0)
+        return _median(times)
+
+    render_frame(compile_scene(Case()), 0, size)  # warm-up: numba compilation
+    rows = []
+    for name in REGISTRY:
+        base, perturbed = median_ms(original_case(name)), median_ms(perturbed_case(name, level))
+        rows.append({"type": name, "original_ms": base, f"level{level}_ms": perturbed,
+                     "ratio": round(perturbed / base, 2) if base else 0.0})
+    return rows
+
+
+def format_rows(rows: list[dict[str, Any]]) -> str:
+    """A plain-text table of a list of flat dicts (same keys)."""
+    header = list(rows[0])
+    cells = [[str(row[key]) for key in header] for row in rows]
+    widths = [max(len(line[i]) for line in [header, *cells]) for i in range(len(header))]
+    return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths)) for line in [header, *cells])

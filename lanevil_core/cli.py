@@ -26,6 +26,7 @@ from .case import Case, CaseError, load_case, write_atomic
 PROG = "lanevil"
 EXTENSION_PREFIX = "cli_"
 SCENES_DIR = Path("scenes")
+CLEAN_DIR = SCENES_DIR / "00_clean"
 
 
 class UsageError(Exception):
@@ -206,11 +207,16 @@ def _bench_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_bench(args: argparse.Namespace) -> int:
-    from .bench import bench_cases, format_table, run_benchmark
+    from .bench import bench_cases, format_rows, format_table, illusion_benchmark, run_benchmark
 
     if args.frames_per_case < 1:
         raise UsageError("--frames-per-case must be at least 1")
-    result = run_benchmark(bench_cases(stock_scenes()), frames_per_case=args.frames_per_case)
+    if args.illusions:
+        rows = illusion_benchmark(frames=args.frames_per_case)
+        print(json.dumps(rows) if args.json else format_rows(rows))
+        return 0
+    result = run_benchmark(bench_cases(stock_scenes() if args.all else stock_scenes(CLEAN_DIR)),
+                           frames_per_case=args.frames_per_case)
     print(json.dumps(result) if args.json else format_table(result))
     return 0
 

@@ -59,9 +59,13 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
 
 
 @kernel(inline="always")
-def sun_visibility(p: np.ndarray, normal: np.ndarray, maps: np.ndarray, coarse: np.ndarray, params: np.ndarray,
-                   R_light: np.ndarray, penumbra: float) -> float:
-    """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges."""
+def sun_visibility(p: np.ndarray, normal: np.ndarray, n_dot_l: float, maps: np.ndarray, coarse: np.ndarray,
+                   params: np.ndarray, R_light: np.ndarray, penumbra: float) -> float:
+    """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges.
+
+    The depth bias grows with the slope of the surface to the light, so grazing-lit faces do not self-shadow.
+    """
+    slope = min(np.sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 0.05), 8.0)
     q0 = p[0] + normal[0] * 0.02
     q1 = p[1] + normal[1] * 0.02
     q2 = p[2] + normal[2] * 0.02
@@ -75,7 +79,7 @@ def sun_visibility(p: np.ndarray, normal: np.ndarray, maps: np.ndarray, coarse: 
         y = (v - params[c, 1]) * scale
         if x < 2 or y < 2 or x > size - 2 or y > size - 2:
             continue
-        bias = 1.5 / scale
+        bias = (1.5 + 1.5 * slope) / scale
         # Nearest caster within a coarse cell and its neighbours: no caster above the point -> fully lit.
         cx = int(x) >> COARSE_SHIFT
         cy = int(y) >> COARSE_SHIFT

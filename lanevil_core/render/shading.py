@@ -161,7 +161,7 @@ def shade(
             light[:] = 0.0
             spec[:] = 0.0
             if sun_i > 0.0 and n_dot_l > 0.0:
-                vis = sun_visibility(p, n, shadow_depth, shadow_coarse, shadow_params, R_light, env_f[PENUMBRA])
+                vis = sun_visibility(p, n, n_dot_l, shadow_depth, shadow_coarse, shadow_params, R_light, env_f[PENUMBRA])
                 for c in range(3):
                     light[c] += SUN_SCALE * sun_i * sun_color[c] * n_dot_l * vis
                 if vis > 0.0 and shiny > 0.0:
