@@ -104,7 +104,7 @@ def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, lengt
     cabin = prism([(rear_b, zb), (front_b, zb), (front_t, zt), (rear_t, zt)], -cabin_hy, cabin_hy, color)
     parts = [body, cabin,
              _slanted_panel((front_b, zb), (front_t, zt), cabin_hy - 0.06, 0.05, (zt - zb, front_b - front_t), GLASS),
-             _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (rear_t - rear_b, zt - zb), GLASS)]
+             _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (zb - zt, rear_t - rear_b), GLASS)]
     parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, True),
                           cabin_hy, GLASS)
     parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, False),

@@ -8,6 +8,7 @@ from ._jit import kernel
 
 SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
 SKY_SCALE = 1.6
+NORMAL_OFFSET_M = 0.03
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 
@@ -66,9 +67,11 @@ def sun_visibility(p: np.ndarray, normal: np.ndarray, n_dot_l: float, maps: np.n
     The depth bias grows with the slope of the surface to the light, so grazing-lit faces do not self-shadow.
     """
     slope = min(np.sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 0.05), 8.0)
-    q0 = p[0] + normal[0] * 0.02
-    q1 = p[1] + normal[1] * 0.02
-    q2 = p[2] + normal[2] * 0.02
+    # Normal offset: move the lookup off the surface, more so where the light grazes it.
+    offset = NORMAL_OFFSET_M * (1.0 + min(slope, 4.0))
+    q0 = p[0] + normal[0] * offset
+    q1 = p[1] + normal[1] * offset
+    q2 = p[2] + normal[2] * offset
     u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
