@@ -1,17 +1,41 @@
 """lanevil_core: editable 3D lane-detection robustness cases, a CPU renderer and exact lane ground truth."""
 
 from .camera import Intrinsics, PinholeCamera, ego_camera
-from .case import Camera, Case, CaseError, Ego, Marking, Road, Scene, Sun, Weather, load_case, parse_case, save_case
-from .illusions import ILLUSION_TYPES, REGISTRY, Illusion
+from .case import (
+    Camera,
+    Case,
+    CaseError,
+    Ego,
+    Marking,
+    Road,
+    Scene,
+    Sun,
+    Weather,
+    case_json,
+    case_schema,
+    load_case,
+    parse_case,
+    save_case,
+)
+from .compile import compile_scene
+from .export import export_case
+from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
+from .labels import culane_lines, tusimple_record
+from .overlay import draw_lanes
+from .render import Frame, render_frame
 from .road_layout import RoadNetwork, build_network
+from .scene import CompiledScene
 
 __all__ = [
+    "CATEGORIES",
     "ILLUSION_TYPES",
     "REGISTRY",
     "Camera",
     "Case",
     "CaseError",
+    "CompiledScene",
     "Ego",
+    "Frame",
     "Illusion",
     "Intrinsics",
     "Marking",
@@ -22,8 +46,16 @@ __all__ = [
     "Sun",
     "Weather",
     "build_network",
+    "case_json",
+    "case_schema",
+    "compile_scene",
+    "culane_lines",
+    "draw_lanes",
     "ego_camera",
+    "export_case",
     "load_case",
     "parse_case",
+    "render_frame",
     "save_case",
+    "tusimple_record",
 ]

@@ -204,6 +204,10 @@ def _run_preview(args: argparse.Namespace) -> int:
 def _bench_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--frames-per-case", type=int, default=2, help="frames timed per stock case (default 2)")
+    parser.add_argument("--all", action="store_true",
+                        help=f"time every stock case (default: the clean cases in {CLEAN_DIR})")
+    parser.add_argument("--illusions", action="store_true",
+                        help="instead: per illusion type, its original and level-5 case at 1280x720")
 
 
 def _run_bench(args: argparse.Namespace) -> int:
