@@ -155,6 +155,26 @@ class Case(_Model):
     illusions: list[IllusionSpec] = Field(default_factory=list)
     seed: int = Field(0, ge=0, le=2**32 - 1)
 
+    @model_validator(mode="before")
+    @classmethod
+    def _apply_preset(cls, data: Any) -> Any:
+        """A ``"preset": "ClearNoon"`` key fills the weather and sun numbers it names (fields given explicitly
+        win); the case then stores only the numbers."""
+        if not isinstance(data, dict) or "preset" not in data:
+            return data
+        data = dict(data)
+        name = data.pop("preset")
+        try:
+            values = preset_values(str(name))
+        except KeyError as error:
+            raise ValueError(f"preset: {error.args[0]}") from None
+        for section in ("weather", "sun"):
+            given = data.get(section) or {}
+            if not isinstance(given, dict):
+                continue
+            data[section] = {**values[section], **given}
+        return data
+
     @model_validator(mode="after")
     def _check_drive(self) -> Case:
         if self.ego.lane >= self.road.lanes_per_direction:
@@ -191,10 +211,11 @@ class CaseError(ValueError):
 
 def _describe(error: ValidationError) -> str:
     first = error.errors()[0]
-    where = ".".join(str(part) for part in first["loc"]) or "case"
+    where = ".".join(str(part) for part in first["loc"])
+    message = first["msg"].removeprefix("Value error, ")
     more = len(error.errors()) - 1
     suffix = f" (and {more} more error{'s' if more > 1 else ''})" if more else ""
-    return f"{where}: {first['msg']}{suffix}"
+    return f"{where}: {message}{suffix}" if where else f"{message}{suffix}"
 
 
 def parse_case(data: dict[str, Any] | str, source: str = "case") -> Case:

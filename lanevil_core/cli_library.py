@@ -96,7 +96,25 @@ def _run_library(args: argparse.Namespace) -> int:
     return 0
 
 
+def _schema_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, default=None, help="write to this file (default: print)")
+
+
+def _run_schema(args: argparse.Namespace) -> int:
+    from .case import case_schema
+
+    text = json.dumps(case_schema(), indent=2, sort_keys=True) + "\n"
+    if args.out is None:
+        print(text, end="")
+    else:
+        write_atomic(args.out, text.encode("utf-8"))
+        print(args.out)
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
+    "schema": Command("print the JSON schema of case files (illusions: a discriminated union on type)",
+                      _schema_arguments, _run_schema),
     "illusions": Command("list the illusion registry with parameters and severity tables", _illusions_arguments,
                          _run_illusions),
     "sheet": Command("render a contact sheet: one row per illusion, original and levels 1-5", _sheet_arguments,
