@@ -8,9 +8,10 @@ import numpy as np
 
 from ..case import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, DOUBLE_LINE_SPACING_M, Marking
 from ..road_layout import RoadNetwork
-from ..road_mesh import road_surface
+from ..road_mesh import RoadSurface, road_surface
 from ..scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from .raster import depth_orthographic
 
 # Linear albedo of the cross-section materials (index = typed.MATERIALS).
 MATERIAL_ALBEDO = np.array([
@@ -65,6 +66,8 @@ class PackedScene:
     stripes: FloatArray  # (k, STRIPE_COLUMNS)
     layers: LayerAtlas
     lights: FloatArray  # (l, 7): x, y, z, r, g, b, intensity
+    overhead: Float32Array  # (H, W) height of the highest caster above each ground cell (-inf: open sky)
+    overhead_params: FloatArray  # (3,) x0, y0, cells per metre
 
 
 def _color(marking: Marking) -> tuple[float, float, float]:
@@ -149,6 +152,26 @@ def _face_normals(vertices: FloatArray, faces: IntArray) -> Float32Array:
     return (normal / np.where(length > 0, length, 1.0)).astype(np.float32)
 
 
+OVERHEAD_CELL_M = 0.25
+OVERHEAD_MAX_CELLS = 2048
+OVERHEAD_MARGIN_M = 25.0
+
+
+def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
+    """Top-down map of the highest shadow caster over the ground near the carriageways.
+
+    Ground under a bridge deck, a tunnel roof or a tree crown sees less of the sky; the renderer dims its
+    ambient light accordingly.
+    """
+    near_road = road.vertices[np.abs(road.st[:, 1]) < np.abs(road.st[:, 1]).min() + OVERHEAD_MARGIN_M + 20.0]
+    lo, hi = near_road[:, :2].min(axis=0) - OVERHEAD_MARGIN_M, near_road[:, :2].max(axis=0) + OVERHEAD_MARGIN_M
+    cell = max(OVERHEAD_CELL_M, float(max(hi - lo)) / OVERHEAD_MAX_CELLS)
+    size = (int(np.ceil((hi[0] - lo[0]) / cell)) + 1, int(np.ceil((hi[1] - lo[1]) / cell)) + 1)
+    v_down = np.stack([packed.vertices[:, 0], packed.vertices[:, 1], -packed.vertices[:, 2]], axis=-1)
+    depth = depth_orthographic(v_down, packed.faces, packed.shadow_faces, size, 1.0 / cell, lo[0], lo[1])
+    return np.ascontiguousarray(-depth), np.array([lo[0], lo[1], 1.0 / cell])
+
+
 def pack_scene(scene: CompiledScene) -> PackedScene:
     """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
     cached = scene.cache.get("packed")
@@ -193,7 +216,9 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
         mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),
         stripes=paint_stripes(scene.network, scene.case.road.markings), layers=layer_atlas(scene), lights=lights,
+        overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )
+    packed.overhead, packed.overhead_params = overhead_map(packed, road)
     scene.cache["packed"] = packed
     return packed
 

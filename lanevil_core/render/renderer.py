@@ -149,7 +149,8 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
           fine, coarse,
           _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
           env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
-          shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world, refl_rgb, refl_depth, hdr)
+          shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world,
+          packed.overhead, packed.overhead_params, refl_rgb, refl_depth, hdr)
     lap("shade")
     object_id = np.where(frags.face >= 0, packed.face_object[np.maximum(frags.face, 0)], ID_SKY).astype(np.int32)
     rgb = np.empty((k.height, k.width, 3), np.uint8)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ._jit import kernel
 
-from .lighting import SUN_SCALE, fresnel_schlick, glossy_lobe, sky_radiance, sun_visibility
+from .lighting import SUN_SCALE, fresnel_schlick, glossy_lobe, sky_openness, sky_radiance, sun_visibility
 from .surface import paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
@@ -63,7 +63,7 @@ def shade(
     face_material, face_color, face_emission, face_gloss, face_normal, material_albedo,
     stripes, stripe_range, layer_texels, layer_table, layer_first, lights,
     noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
-    shadow_depth, shadow_coarse, shadow_params, R_light, refl_rgb, refl_depth, out,
+    shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, out,
 ):
     height, width = face_buf.shape
     rgb = np.empty(3)
@@ -194,6 +194,8 @@ def shade(
                     light[c] += power * lights[k, 3 + c] * ndl
                     spec[c] += power * lights[k, 3 + c] * lobe * (0.1 + shiny)
             up = 0.6 + 0.4 * n[2]
+            if material >= 0:  # ground under a roof, deck or crown sees less sky
+                up *= sky_openness(overhead, overhead_params, p)
             for c in range(3):
                 rgb[c] = rgb[c] * (light[c] + ambient_rgb[c] * up) + spec[c] + face_emission[f, c]
             # Mirror reflection of sky and objects on wet surfaces and glossy paint.
