@@ -77,9 +77,11 @@ def _mean_abs(a: np.ndarray, b: np.ndarray) -> float:
 def test_golden_images(relative: str, tmp_path: Path) -> None:
     rgb = render_frame(compile_scene(_small(load_case(ROOT / "scenes" / relative))), 0).rgb
     golden = GOLDEN / (relative.replace("/", "__").removesuffix(".json") + ".png")
-    if UPDATE or not golden.exists():
+    if UPDATE:
+        golden.parent.mkdir(exist_ok=True)
         Image.fromarray(rgb).save(golden)
         pytest.skip(f"wrote {golden.name}")
+    assert golden.exists(), f"missing {golden}; LANEVIL_UPDATE_GOLDEN=1 writes it"
     expected = np.asarray(Image.open(golden).convert("RGB"))
     difference = _mean_abs(rgb, expected)
     if difference > GOLDEN_TOLERANCE:
