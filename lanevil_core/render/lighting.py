@@ -15,17 +15,15 @@ COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 
 
 @kernel(inline="always")
-def sky_radiance(d: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
-                 zenith: np.ndarray, horizon: np.ndarray, cloudiness: float, out: np.ndarray) -> None:
-    """Radiance of the sky seen along unit world direction ``d`` (gradient, sun disk and glow)."""
-    e = max(d[2], 0.0)
-    k = np.sqrt(e)
-    for c in range(3):
-        out[c] = SKY_SCALE * (horizon[c] * (1.0 - k) + zenith[c] * k)
-    if d[2] < 0.0:  # below the horizon (seen past the terrain's edge): darker haze
-        for c in range(3):
-            out[c] *= 0.85
-    cos_sun = d[0] * sun_dir[0] + d[1] * sun_dir[1] + d[2] * sun_dir[2]
+def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
+                 zenith: np.ndarray, horizon: np.ndarray, cloudiness: float) -> tuple[float, float, float]:
+    """Radiance (r, g, b) of the sky seen along unit world direction (dx, dy, dz): gradient, sun disk, glow."""
+    k = np.sqrt(max(dz, 0.0))
+    below = 0.85 if dz < 0.0 else 1.0  # below the horizon (seen past the terrain's edge): darker haze
+    r = SKY_SCALE * below * (horizon[0] * (1.0 - k) + zenith[0] * k)
+    g = SKY_SCALE * below * (horizon[1] * (1.0 - k) + zenith[1] * k)
+    b = SKY_SCALE * below * (horizon[2] * (1.0 - k) + zenith[2] * k)
+    cos_sun = dx * sun_dir[0] + dy * sun_dir[1] + dz * sun_dir[2]
     if cos_sun > 0.0 and sun_intensity > 0.0:
         clear = 1.0 - cloudiness
         disk = 60.0 * clear if cos_sun > 0.99996 else 0.0
@@ -34,9 +32,11 @@ def sky_radiance(d: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, sun_
         c8 = c4 * c4
         c16 = c8 * c8
         halo = np.exp(400.0 * np.log(cos_sun)) if cos_sun > 0.97 else 0.0
-        glow = halo * 3.0 * clear + c16 * 0.35 * (0.3 + 0.7 * clear)
-        for c in range(3):
-            out[c] += sun_color[c] * sun_intensity * (disk + glow)
+        glow = sun_intensity * (disk + halo * 3.0 * clear + c16 * 0.35 * (0.3 + 0.7 * clear))
+        r += sun_color[0] * glow
+        g += sun_color[1] * glow
+        b += sun_color[2] * glow
+    return r, g, b
 
 
 @kernel(inline="always")
@@ -61,8 +61,9 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
 
 
 @kernel(inline="always")
-def sun_visibility(p: np.ndarray, normal: np.ndarray, n_dot_l: float, maps: np.ndarray, coarse: np.ndarray,
-                   params: np.ndarray, R_light: np.ndarray, penumbra: float) -> float:
+def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, n_dot_l: float,
+                   maps: np.ndarray, coarse: np.ndarray, params: np.ndarray, R_light: np.ndarray,
+                   penumbra: float) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges.
 
     The depth bias grows with the slope of the surface to the light, so grazing-lit faces do not self-shadow.
@@ -70,9 +71,9 @@ def sun_visibility(p: np.ndarray, normal: np.ndarray, n_dot_l: float, maps: np.n
     slope = min(np.sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 0.05), 8.0)
     # Normal offset: move the lookup off the surface, more so where the light grazes it.
     offset = NORMAL_OFFSET_M * (1.0 + min(slope, 4.0))
-    q0 = p[0] + normal[0] * offset
-    q1 = p[1] + normal[1] * offset
-    q2 = p[2] + normal[2] * offset
+    q0 = px + nx * offset
+    q1 = py + ny * offset
+    q2 = pz + nz * offset
     u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
@@ -107,12 +108,12 @@ def sun_visibility(p: np.ndarray, normal: np.ndarray, n_dot_l: float, maps: np.n
 
 
 @kernel(inline="always")
-def sky_openness(overhead: np.ndarray, params: np.ndarray, p: np.ndarray) -> float:
+def sky_openness(overhead: np.ndarray, params: np.ndarray, px: float, py: float, pz: float) -> float:
     """1 under open sky, down to COVERED_AMBIENT where a caster stands well above ground point ``p``
     (bilinear over the top-down map, so the edge of a roof's shade is soft)."""
     height, width = overhead.shape
-    x = (p[0] - params[0]) * params[2] - 0.5
-    y = (p[1] - params[1]) * params[2] - 0.5
+    x = (px - params[0]) * params[2] - 0.5
+    y = (py - params[1]) * params[2] - 0.5
     if x < 0.0 or y < 0.0 or x >= width - 1 or y >= height - 1:
         return 1.0
     x0 = int(x)
@@ -123,7 +124,7 @@ def sky_openness(overhead: np.ndarray, params: np.ndarray, p: np.ndarray) -> flo
     for dy in range(2):
         for dx in range(2):
             w = (fx if dx else 1.0 - fx) * (fy if dy else 1.0 - fy)
-            if overhead[y0 + dy, x0 + dx] > p[2] + 1.5:
+            if overhead[y0 + dy, x0 + dx] > pz + 1.5:
                 covered += w
     return 1.0 - (1.0 - COVERED_AMBIENT) * covered
 

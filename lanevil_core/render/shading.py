@@ -65,54 +65,51 @@ def shade(
     noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
     shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, out,
 ):
+    """Linear radiance of every pixel into ``out`` (H, W, 3). Per-pixel state lives in scalars (registers)."""
     height, width = face_buf.shape
-    rgb = np.empty(3)
-    sky = np.empty(3)
-    d_world = np.empty(3)
-    p = np.empty(3)
-    n = np.empty(3)
-    refl = np.empty(3)
-    ambient_rgb = np.empty(3)
-    light = np.empty(3)
-    spec = np.empty(3)
-    r = np.empty(3)
-    scratch = np.empty(5)
-    for c in range(3):
-        ambient_rgb[c] = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * 2.2
-    fog_rgb = np.empty(3)
-    for c in range(3):
-        fog_rgb[c] = horizon[c] * 1.6 * (0.25 + 0.75 * min(env_f[AMBIENT] * 3.0, 1.0))
+    amb_r = env_f[AMBIENT] * (0.5 * horizon[0] + 0.5 * zenith[0]) * 2.2
+    amb_g = env_f[AMBIENT] * (0.5 * horizon[1] + 0.5 * zenith[1]) * 2.2
+    amb_b = env_f[AMBIENT] * (0.5 * horizon[2] + 0.5 * zenith[2]) * 2.2
+    fog_level = 1.6 * (0.25 + 0.75 * min(env_f[AMBIENT] * 3.0, 1.0))
+    fog_r, fog_g, fog_b = horizon[0] * fog_level, horizon[1] * fog_level, horizon[2] * fog_level
     sun_i = env_f[SUN_I]
+    lx_sun, ly_sun, lz_sun = sun_dir[0], sun_dir[1], sun_dir[2]
+    sun_r, sun_g, sun_b = (SUN_SCALE * sun_i * sun_color[0], SUN_SCALE * sun_i * sun_color[1],
+                           SUN_SCALE * sun_i * sun_color[2])
+    wetness, puddles, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[CLOUD], env_f[PENUMBRA]
     fog_lut = np.empty(FOG_LUT_SIZE)
     for i in range(FOG_LUT_SIZE):
         fog_lut[i] = 1.0 - np.exp(-env_f[FOG_DENSITY] * max((i + 0.5) / FOG_LUT_PER_M - env_f[FOG_DISTANCE], 0.0))
+    last_fog = FOG_LUT_SIZE - 1
     for row in range(height):
         y_cam = (row + 0.5 - cy) / fy
         for col in range(width):
             x_cam = (col + 0.5 - cx) / fx
             norm = np.sqrt(x_cam * x_cam + y_cam * y_cam + 1.0)
-            for i in range(3):
-                d_world[i] = (R_wc[i, 0] * x_cam + R_wc[i, 1] * y_cam + R_wc[i, 2]) / norm
+            inv_norm = 1.0 / norm
+            dx = (R_wc[0, 0] * x_cam + R_wc[0, 1] * y_cam + R_wc[0, 2]) * inv_norm
+            dy = (R_wc[1, 0] * x_cam + R_wc[1, 1] * y_cam + R_wc[1, 2]) * inv_norm
+            dz = (R_wc[2, 0] * x_cam + R_wc[2, 1] * y_cam + R_wc[2, 2]) * inv_norm
             f = face_buf[row, col]
             if f < 0:
-                sky_radiance(d_world, sun_dir, sun_color, sun_i, zenith, horizon, env_f[CLOUD], sky)
-                for c in range(3):
-                    out[row, col, c] = sky[c]
+                r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                out[row, col, 0] = r
+                out[row, col, 1] = g
+                out[row, col, 2] = b
                 continue
             depth = depth_buf[row, col]
             dist = depth * norm
-            for i in range(3):
-                p[i] = c_world[i] + d_world[i] * dist
-                n[i] = face_normal[f, i]
-            n_dot_v = -(n[0] * d_world[0] + n[1] * d_world[1] + n[2] * d_world[2])
+            px = c_world[0] + dx * dist
+            py = c_world[1] + dy * dist
+            pz = c_world[2] + dz * dist
+            nx, ny, nz = face_normal[f, 0], face_normal[f, 1], face_normal[f, 2]
+            n_dot_v = -(nx * dx + ny * dy + nz * dz)
             if n_dot_v < 0.0:  # back side of a two-sided face
-                for i in range(3):
-                    n[i] = -n[i]
-                n_dot_v = -n_dot_v
+                nx, ny, nz, n_dot_v = -nx, -ny, -nz, -n_dot_v
             material = face_material[f]
             wet = 0.0
             gloss = face_gloss[f]
-            roughness = 0.35
+            roughness = 0.25
             f0 = 0.04
             if material >= 0:
                 piece = piece_buf[row, col]
@@ -125,98 +122,104 @@ def shade(
                 footprint = max(fs, ft)
                 grain = sample_noise(noise_fine, FINE_TEXEL_M, s, t, footprint)
                 blotch = sample_noise(noise_coarse, COARSE_TEXEL_M, s * 0.5, t, footprint)
-                for c in range(3):
-                    rgb[c] = material_albedo[material, c] * (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
+                tone = (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
+                r = material_albedo[material, 0] * tone
+                g = material_albedo[material, 1] * tone
+                b = material_albedo[material, 2] * tone
                 if material == ASPHALT:
-                    wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft, False, rgb,
-                                        scratch)
-                    paint(stripes, stripe_range[piece, 0], stripe_range[piece, 1], s, t, fs, ft, rgb)
-                    wet = max(wet, sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft,
-                                                 True, rgb, scratch))
-                    puddles = env_f[PUDDLES]
+                    r, g, b, wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft, False,
+                                                 r, g, b)
+                    r, g, b = paint(stripes, stripe_range[piece, 0], stripe_range[piece, 1], s, t, fs, ft, r, g, b)
+                    r, g, b, wet_over = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft,
+                                                      True, r, g, b)
+                    wet = max(wet, wet_over)
                     if puddles > 0.0:
                         shape = sample_noise(noise_coarse, COARSE_TEXEL_M, s * 0.7 + 37.0, t * 0.7, footprint)
-                        level = 0.55 - 1.2 * puddles
-                        wet = max(wet, min(max((shape - level) * 6.0, 0.0), 1.0))
+                        wet = max(wet, min(max((shape - (0.55 - 1.2 * puddles)) * 6.0, 0.0), 1.0))
                     roughness = 0.55
                     f0 = 0.02
+                else:
+                    roughness = 0.35
                 gloss = 0.0
             else:
-                for c in range(3):
-                    rgb[c] = face_color[f, c]
-                roughness = 0.25
+                r, g, b = face_color[f, 0], face_color[f, 1], face_color[f, 2]
             # Paved surfaces hold a water film; grass, gravel and dirt soak it up.
             paved = material == ASPHALT or material == CONCRETE or material == KERB
-            surface_wet = max(env_f[WETNESS] if paved else 0.0, wet)
+            surface_wet = max(wetness if paved else 0.0, wet)
             if surface_wet > 0.0:
                 darken = 1.0 - 0.5 * surface_wet
-                for c in range(3):
-                    rgb[c] *= darken
+                r *= darken
+                g *= darken
+                b *= darken
                 roughness = roughness * (1.0 - surface_wet) + 0.09 * surface_wet
                 if wet > 0.5:
                     roughness = 0.03
             shiny = surface_wet + gloss
+            spec_f0 = max(f0, gloss * 0.08)
+            light_r = light_g = light_b = 0.0
+            spec_r = spec_g = spec_b = 0.0
             # Direct sun.
-            n_dot_l = n[0] * sun_dir[0] + n[1] * sun_dir[1] + n[2] * sun_dir[2]
-            light[:] = 0.0
-            spec[:] = 0.0
+            n_dot_l = nx * lx_sun + ny * ly_sun + nz * lz_sun
             if sun_i > 0.0 and n_dot_l > 0.0:
-                vis = sun_visibility(p, n, n_dot_l, shadow_depth, shadow_coarse, shadow_params, R_light, env_f[PENUMBRA])
-                for c in range(3):
-                    light[c] += SUN_SCALE * sun_i * sun_color[c] * n_dot_l * vis
+                vis = sun_visibility(px, py, pz, nx, ny, nz, n_dot_l, shadow_depth, shadow_coarse, shadow_params,
+                                     R_light, penumbra)
+                k = n_dot_l * vis
+                light_r += sun_r * k
+                light_g += sun_g * k
+                light_b += sun_b * k
                 if vis > 0.0 and shiny > 0.0:
-                    hx = sun_dir[0] - d_world[0]
-                    hy = sun_dir[1] - d_world[1]
-                    hz = sun_dir[2] - d_world[2]
-                    hn = np.sqrt(hx * hx + hy * hy + hz * hz)
-                    n_dot_h = (n[0] * hx + n[1] * hy + n[2] * hz) / hn
-                    lobe = glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, max(f0, gloss * 0.08))
-                    for c in range(3):
-                        spec[c] += SUN_SCALE * sun_i * sun_color[c] * vis * lobe * 0.25 * shiny
+                    hx, hy, hz = lx_sun - dx, ly_sun - dy, lz_sun - dz
+                    n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
+                    k = vis * glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, spec_f0) * 0.25 * shiny
+                    spec_r += sun_r * k
+                    spec_g += sun_g * k
+                    spec_b += sun_b * k
             # Lamps.
-            for k in range(lights.shape[0]):
-                lx = lights[k, 0] - p[0]
-                ly = lights[k, 1] - p[1]
-                lz = lights[k, 2] - p[2]
+            for i in range(lights.shape[0]):
+                lx = lights[i, 0] - px
+                ly = lights[i, 1] - py
+                lz = lights[i, 2] - pz
                 d2 = lx * lx + ly * ly + lz * lz
-                dl = np.sqrt(d2)
-                ndl = (n[0] * lx + n[1] * ly + n[2] * lz) / dl
+                inv_dl = 1.0 / np.sqrt(d2)
+                ndl = (nx * lx + ny * ly + nz * lz) * inv_dl
                 if ndl <= 0.0:
                     continue
-                power = lights[k, 6] / (d2 + 1.0)
-                hx = lx / dl - d_world[0]
-                hy = ly / dl - d_world[1]
-                hz = lz / dl - d_world[2]
-                hn = np.sqrt(hx * hx + hy * hy + hz * hz)
-                n_dot_h = (n[0] * hx + n[1] * hy + n[2] * hz) / hn
-                lobe = glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, max(f0, gloss * 0.08))
-                for c in range(3):
-                    light[c] += power * lights[k, 3 + c] * ndl
-                    spec[c] += power * lights[k, 3 + c] * lobe * (0.1 + shiny)
-            up = 0.6 + 0.4 * n[2]
+                power = lights[i, 6] / (d2 + 1.0)
+                hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
+                n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
+                k_spec = power * glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, spec_f0) * (0.1 + shiny)
+                k_diff = power * ndl
+                light_r += lights[i, 3] * k_diff
+                light_g += lights[i, 4] * k_diff
+                light_b += lights[i, 5] * k_diff
+                spec_r += lights[i, 3] * k_spec
+                spec_g += lights[i, 4] * k_spec
+                spec_b += lights[i, 5] * k_spec
+            up = 0.6 + 0.4 * nz
             if material >= 0:  # ground under a roof, deck or crown sees less sky
-                up *= sky_openness(overhead, overhead_params, p)
-            for c in range(3):
-                rgb[c] = rgb[c] * (light[c] + ambient_rgb[c] * up) + spec[c] + face_emission[f, c]
+                up *= sky_openness(overhead, overhead_params, px, py, pz)
+            r = r * (light_r + amb_r * up) + spec_r + face_emission[f, 0]
+            g = g * (light_g + amb_g * up) + spec_g + face_emission[f, 1]
+            b = b * (light_b + amb_b * up) + spec_b + face_emission[f, 2]
             # Mirror reflection of sky and objects on wet surfaces and glossy paint.
             mirror = surface_wet if material >= 0 else gloss
             if mirror > 0.0:
                 fres = fresnel_schlick(n_dot_v, 0.02 if material >= 0 else 0.05)
                 strength = fres * (wet + (surface_wet - wet) * WET_FILM_MIRROR if material >= 0 else gloss)
-                dot = d_world[0] * n[0] + d_world[1] * n[1] + d_world[2] * n[2]
-                for i in range(3):
-                    r[i] = d_world[i] - 2.0 * dot * n[i]
-                sky_radiance(r, sun_dir, sun_color, sun_i * (1.0 - roughness), zenith, horizon, env_f[CLOUD],
-                             refl)
+                dot = dx * nx + dy * ny + dz * nz
+                ref_r, ref_g, ref_b = sky_radiance(dx - 2.0 * dot * nx, dy - 2.0 * dot * ny, dz - 2.0 * dot * nz,
+                                                   sun_dir, sun_color, sun_i * (1.0 - roughness), zenith, horizon,
+                                                   cloud)
                 if material >= 0 and refl_depth[row, col] < np.inf and refl_depth[row, col] > depth:
-                    for c in range(3):
-                        refl[c] = refl_rgb[row, col, c]
-                for c in range(3):
-                    rgb[c] = rgb[c] * (1.0 - strength) + refl[c] * strength
+                    ref_r, ref_g, ref_b = refl_rgb[row, col, 0], refl_rgb[row, col, 1], refl_rgb[row, col, 2]
+                r = r * (1.0 - strength) + ref_r * strength
+                g = g * (1.0 - strength) + ref_g * strength
+                b = b * (1.0 - strength) + ref_b * strength
             # Distance fog.
-            fog = fog_lut[min(int(dist * FOG_LUT_PER_M), fog_lut.size - 1)]
-            for c in range(3):
-                out[row, col, c] = rgb[c] * (1.0 - fog) + fog_rgb[c] * fog
+            fog = fog_lut[min(int(dist * FOG_LUT_PER_M), last_fog)]
+            out[row, col, 0] = r * (1.0 - fog) + fog_r * fog
+            out[row, col, 1] = g * (1.0 - fog) + fog_g * fog
+            out[row, col, 2] = b * (1.0 - fog) + fog_b * fog
 
 
 @kernel

@@ -63,9 +63,8 @@ def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprin
 
 @kernel(inline="always")
 def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
-          rgb: np.ndarray) -> float:
-    """Blend the paint of stripes[lo:hi] over ``rgb`` in place; return the total paint coverage."""
-    total = 0.0
+          r: float, g: float, b: float) -> tuple[float, float, float]:
+    """(r, g, b) with the paint of stripes[lo:hi] blended over it."""
     for k in range(lo, hi):
         t_c, half = stripes[k, 1], stripes[k, 2]
         if abs(t - t_c) > half + ft:
@@ -75,19 +74,18 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
         cov *= box_overlap(s, fs, s0, s1)
         if cov <= 0.0:
             continue
-        pattern = stripes[k, 5]
-        if pattern > 0.5:
+        if stripes[k, 5] > 0.5:
             cov *= dash_coverage(s - s0, fs, stripes[k, 6], stripes[k, 7])
-        for c in range(3):
-            rgb[c] = rgb[c] * (1.0 - cov) + stripes[k, 8 + c] * cov
-        total += cov
-    return min(total, 1.0)
+        r = r * (1.0 - cov) + stripes[k, 8] * cov
+        g = g * (1.0 - cov) + stripes[k, 9] * cov
+        b = b * (1.0 - cov) + stripes[k, 10] * cov
+    return r, g, b
 
 
 @kernel(inline="always")
-def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: float, s0: float, t0: float,
-               weight: float, sample: np.ndarray) -> None:
-    """Add ``weight`` times the bilinear sample of one mip level at road point (s, t) to ``sample`` (5,)."""
+def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: float, s0: float,
+               t0: float) -> tuple[float, float, float, float, float]:
+    """Bilinear sample (premultiplied r, g, b, alpha, wet) of one mip level at road point (s, t)."""
     texel = table[level, 3]
     rows, cols, offset = int(table[level, 4]), int(table[level, 5]), int(table[level, 6])
     y = (s - s0) / texel - 0.5
@@ -98,18 +96,26 @@ def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: f
     x1 = min(x0 + 1, cols - 1)
     fy = min(max(y - y0, 0.0), 1.0)
     fx = min(max(x - x0, 0.0), 1.0)
+    w00 = (1 - fx) * (1 - fy)
+    w01 = fx * (1 - fy)
+    w10 = (1 - fx) * fy
+    w11 = fx * fy
     a = offset + y0 * cols
     b = offset + y1 * cols
-    for c in range(5):
-        top = texels[a + x0, c] * (1 - fx) + texels[a + x1, c] * fx
-        bottom = texels[b + x0, c] * (1 - fx) + texels[b + x1, c] * fx
-        sample[c] += weight * (top * (1 - fy) + bottom * fy)
+    out0 = w00 * texels[a + x0, 0] + w01 * texels[a + x1, 0] + w10 * texels[b + x0, 0] + w11 * texels[b + x1, 0]
+    out1 = w00 * texels[a + x0, 1] + w01 * texels[a + x1, 1] + w10 * texels[b + x0, 1] + w11 * texels[b + x1, 1]
+    out2 = w00 * texels[a + x0, 2] + w01 * texels[a + x1, 2] + w10 * texels[b + x0, 2] + w11 * texels[b + x1, 2]
+    out3 = w00 * texels[a + x0, 3] + w01 * texels[a + x1, 3] + w10 * texels[b + x0, 3] + w11 * texels[b + x1, 3]
+    out4 = w00 * texels[a + x0, 4] + w01 * texels[a + x1, 4] + w10 * texels[b + x0, 4] + w11 * texels[b + x1, 4]
+    return out0, out1, out2, out3, out4
 
 
 @kernel(inline="always")
 def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piece: int, s: float, t: float,
-                  fs: float, ft: float, over_paint: bool, rgb: np.ndarray, sample: np.ndarray) -> float:
-    """Blend every surface layer of ``piece`` (under or over paint) over ``rgb``; return the puddle wetness.
+                  fs: float, ft: float, over_paint: bool, r: float, g: float,
+                  b: float) -> tuple[float, float, float, float]:
+    """(r, g, b, wet): every surface layer of ``piece`` (under or over paint) blended over (r, g, b), and the
+    puddle wetness there.
 
     Anisotropic filtering: the mip level follows the pixel's short footprint axis and up to MAX_ANISO samples
     spread along the long one, so marks running along the road stay sharp far ahead.
@@ -133,16 +139,22 @@ def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piec
         while ratio > 1.0 and level < first[layer + 1] - 1:
             ratio *= 0.5
             level += 1
-        for c in range(5):
-            sample[c] = 0.0
+        pr = pg = pb = alpha = w = 0.0
         for k in range(taps):
             offset = ((k + 0.5) / taps - 0.5) * long
             if along_s:
-                _bilinear5(texels, table, level, s + offset, t, s0, t0, 1.0 / taps, sample)
+                q0, q1, q2, q3, q4 = _bilinear5(texels, table, level, s + offset, t, s0, t0)
             else:
-                _bilinear5(texels, table, level, s, t + offset, s0, t0, 1.0 / taps, sample)
-        alpha = sample[3]
-        for c in range(3):
-            rgb[c] = rgb[c] * (1.0 - alpha) + sample[c]  # premultiplied
-        wet = max(wet, sample[4])
-    return wet
+                q0, q1, q2, q3, q4 = _bilinear5(texels, table, level, s, t + offset, s0, t0)
+            pr += q0
+            pg += q1
+            pb += q2
+            alpha += q3
+            w += q4
+        inv = 1.0 / taps
+        alpha *= inv
+        r = r * (1.0 - alpha) + pr * inv  # premultiplied
+        g = g * (1.0 - alpha) + pg * inv
+        b = b * (1.0 - alpha) + pb * inv
+        wet = max(wet, w * inv)
+    return r, g, b, wet
