@@ -5,10 +5,11 @@ texel (i, j) has its centre at ``s_local = (i + 0.5) * texel``, ``t_local = (j +
 corner. Shapes are drawn from distance fields with box-filtered edges, so a crack thinner than a texel comes out
 as partial coverage rather than as aliased stair steps.
 
-Every generator returns ``(rgba, wet)``: ``rgba`` (h, w, 4) float32 linear albedo plus straight (not
-premultiplied) coverage alpha, ``wet`` (h, w) float32 puddle coverage or None. All randomness comes from the
-Generator passed in; each drawn item (a crack, a patch, a mark) takes its own child generator, so raising a count
-adds items without changing the ones already there.
+Every generator returns ``(rgba, wet)`` (``crack_layers`` the same split into a stain and a crack layer):
+``rgba`` (h, w, 4) float32 linear albedo plus straight (not premultiplied) coverage alpha, ``wet`` (h, w)
+float32 puddle coverage or None. All randomness comes from the Generator passed in; each drawn item (a crack, a
+patch, a mark) takes its own child generator, so raising a count adds items without changing the ones already
+there.
 """
 
 from __future__ import annotations
@@ -27,16 +28,19 @@ CRACK_KINDS: tuple[CrackKind, ...] = ("transverse", "longitudinal", "alligator")
 
 Texture = tuple[Float32Array, Float32Array | None]
 
-# Linear albedos (fresh asphalt ~0.035, worn asphalt 0.05-0.08).
+# Linear albedos (fresh asphalt 0.02-0.03, worn asphalt 0.05-0.08, tyre rubber 0.012-0.02).
 CRACK_RGB = (0.010, 0.010, 0.011)
-CRACK_HALO_RGB = (0.030, 0.030, 0.031)
-FRESH_ASPHALT_RGB = (0.030, 0.030, 0.032)
+CRACK_HALO_RGB = (0.024, 0.024, 0.025)
+FRESH_ASPHALT_RGB = (0.025, 0.025, 0.027)
 SEALANT_DARK_RGB = (0.012, 0.012, 0.013)
 SEALANT_BRIGHT_RGB = (0.30, 0.30, 0.29)  # weathered or sun-glossy crack filler, reads like faded paint
-RUBBER_RGB = (0.010, 0.010, 0.011)
+RUBBER_RGB = (0.015, 0.015, 0.016)  # tyre rubber laid on the asphalt
 
 HALO_OPACITY = 0.4  # the crushed, stained rim either side of a crack, relative to its core
 HALO_SCALE = 5.0  # halo radius in crack half widths
+ALLIGATOR_WIDTH = 0.6  # an alligator crack's core width relative to a main crack's
+ALLIGATOR_HALO = 3.0  # an alligator crack's halo radius in its half widths (before spalling)
+JOINT_SEED_OFFSET = 1_000_000  # joint bands take child seeds of the along-line family from here on
 GOLDEN_FRACTION = 0.6180339887498949
 _SEEDS_PER_CALL = 8  # every generator draws exactly this many values from the caller's Generator
 
@@ -394,6 +398,36 @@ def crack_mix(rng: np.random.Generator, shape: tuple[int, int], texel: float,
     ``crack_mix(rng, ..., {kind: d})`` draws exactly what ``crack_network(rng, ..., kind, d)`` draws; each kind
     has its own child seeds, so changing one kind's density leaves the others' cracks where they were.
     """
+    layers = crack_layers(rng, shape, texel, densities, width_m, darkness, along_t, wetness)
+    return composite(layers.cracks, layers.stains), layers.wet
+
+
+@dataclass(frozen=True)
+class CrackLayers:
+    """A crack texture split by depth, each (h, w, 4) float32 straight-alpha rgba (``wet`` (h, w) or None).
+
+    ``stains`` are the crushed, darkened and spalled rims beside the cracks, which lie under the paint;
+    ``cracks`` are the open cracks themselves, which split a lane line's paint as they split the asphalt.
+    """
+
+    stains: Float32Array
+    cracks: Float32Array
+    wet: Float32Array | None
+
+
+def crack_layers(rng: np.random.Generator, shape: tuple[int, int], texel: float,
+                 densities: Mapping[CrackKind, float], width_m: float = 0.015, darkness: float = 0.8,
+                 along_t: Sequence[float] = (), wetness: float = 0.0, *, joint_t: Sequence[float] = (),
+                 spall: float = 0.0) -> CrackLayers:
+    """``crack_mix``'s cracks as separate stain and crack layers, plus deteriorated joints and spalled edges.
+
+    Args:
+        rng, shape, texel, densities, width_m, darkness, along_t, wetness: as for ``crack_mix``.
+        joint_t: t_local (m) of paving joints under lane lines that have failed into a band of fatigue
+            (alligator) cracking strung along the line, one band each.
+        spall: how far the crack edges have broken down, in [0, 1]: widens the stained rim (by up to 2x) and
+            darkens it (by up to 2x); 0 = the plain rim of ``HALO_SCALE`` half widths at ``HALO_OPACITY``.
+    """
     unknown = set(densities) - set(CRACK_KINDS)
     if unknown:
         raise ValueError(f"crack kinds must be among {CRACK_KINDS}, got {sorted(unknown)}")
@@ -401,32 +435,53 @@ def crack_mix(rng: np.random.Generator, shape: tuple[int, int], texel: float,
     size_m = (shape[0] * texel, shape[1] * texel)
     core, halo = np.zeros(shape, np.float32), np.zeros(shape, np.float32)
     filter_width = 1.25 * texel
+    halo_scale = HALO_SCALE * (1.0 + spall)
     for index, kind in enumerate(CRACK_KINDS):
         for k in range(_count(densities.get(kind, 0.0), size_m[0] * size_m[1])):
             child, spot = _child(bases[index], k), _spot(bases[4 + index], k)
             if kind == "alligator":
-                _alligator_patch(child, core, halo, size_m, width_m, texel, filter_width, spot)
+                _alligator_patch(child, core, halo, size_m, width_m, texel, filter_width, spot, halo_scale)
                 continue
             for stroke in _crack_strokes(child, kind, size_m, width_m, spot):
                 _stamp_polyline(core, halo, stroke.pts, stroke.half_width, stroke.value, texel, filter_width,
-                                HALO_SCALE)
+                                halo_scale)
     for k, t_line in enumerate(along_t):
         for stroke in _along_strokes(_child(bases[3], k), float(t_line), size_m[0], width_m, _spot(bases[7], k)):
-            _stamp_polyline(core, halo, stroke.pts, stroke.half_width, stroke.value, texel, filter_width, HALO_SCALE)
-    canvas = _Canvas.empty(shape)
-    canvas.paint(CRACK_HALO_RGB, halo * (HALO_OPACITY * darkness))
-    canvas.paint(CRACK_RGB, core * darkness)
+            _stamp_polyline(core, halo, stroke.pts, stroke.half_width, stroke.value, texel, filter_width, halo_scale)
+    for k, t_line in enumerate(joint_t):
+        _joint_band(_child(bases[3], JOINT_SEED_OFFSET + k), core, halo, size_m, float(t_line), width_m, texel,
+                    filter_width, halo_scale)
+    stains, cracks = _Canvas.empty(shape), _Canvas.empty(shape)
+    stains.paint(CRACK_HALO_RGB, halo * min(HALO_OPACITY * (1.0 + spall) * darkness, 1.0))
+    cracks.paint(CRACK_RGB, core * darkness)
     wet = (core * wetness).astype(np.float32) if wetness > 0.0 else None
-    return canvas.rgba(), wet
+    return CrackLayers(stains.rgba(), cracks.rgba(), wet)
 
 
 def _alligator_patch(rng: np.random.Generator, core: np.ndarray, halo: np.ndarray, size_m: tuple[float, float],
-                     width_m: float, texel: float, filter_width: float, spot: float) -> None:
-    """One patch of fatigue (alligator) cracking: an ellipse of polygonal cells 0.15-0.35 m across."""
+                     width_m: float, texel: float, filter_width: float, spot: float,
+                     halo_scale: float = HALO_SCALE) -> None:
+    """One patch of fatigue (alligator) cracking: an ellipse of polygonal cells 0.2-0.5 m across."""
     radii = np.array([rng.uniform(0.8, 3.0), rng.uniform(0.6, 1.6)])
     center = np.array([spot * size_m[0], rng.uniform(0.0, size_m[1])])
-    _stamp_alligator(core, halo, center, radii, rng.uniform(0.15, 0.35), 0.4 * width_m, rng.uniform(0.75, 0.95),
-                     texel, filter_width, 3.0, int(rng.integers(1, 2**31 - 1)))
+    _stamp_alligator(core, halo, center, radii, rng.uniform(0.2, 0.5), ALLIGATOR_WIDTH * width_m,
+                     rng.uniform(0.75, 0.95), texel, filter_width, ALLIGATOR_HALO * halo_scale / HALO_SCALE,
+                     int(rng.integers(1, 2**31 - 1)))
+
+
+def _joint_band(rng: np.random.Generator, core: np.ndarray, halo: np.ndarray, size_m: tuple[float, float],
+                t_line: float, width_m: float, texel: float, filter_width: float, halo_scale: float) -> None:
+    """Fatigue cracking along a failed paving joint at ``t_line``: overlapping alligator patches 2-7 m long and
+    1.1-1.8 m wide strung along the line with short sound stretches between them, from the texture's start."""
+    s = rng.uniform(-1.5, 0.5)
+    while s < size_m[0]:
+        half_s = rng.uniform(1.0, 3.5)
+        center = np.array([s + half_s, t_line + rng.normal(0.0, 0.08)])
+        radii = np.array([half_s, rng.uniform(0.55, 0.9)])
+        _stamp_alligator(core, halo, center, radii, rng.uniform(0.2, 0.3), ALLIGATOR_WIDTH * width_m,
+                         rng.uniform(0.9, 0.99), texel, filter_width, ALLIGATOR_HALO * halo_scale / HALO_SCALE,
+                         int(rng.integers(1, 2**31 - 1)))
+        s += 2.0 * half_s * rng.uniform(0.75, 0.95) + rng.uniform(0.0, 0.8)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -451,27 +506,35 @@ def _blob_distance(rng: np.random.Generator, ds: FloatArray, dt: FloatArray, rad
     return (rho - wobble) * min(radii)
 
 
+PatchKind = Literal["rectangle", "blob", "trench", "across"]
+
+
 def _patch_coverage(rng: np.random.Generator, shape: tuple[int, int], texel: float, size_scale: float,
-                    irregular: bool, spot: float, trench_t: float | None = None
+                    kind: PatchKind, spot: float, t_local: float | None = None
                     ) -> tuple[np.ndarray, np.ndarray, tuple[slice, slice]]:
     """Fill and seal-rim coverage of one patch, over the sub-window (slices) of the texture it touches.
 
-    A patch is a saw-cut rectangle, an irregular blob, or (``trench_t`` given) a long narrow trench
-    reinstatement centred on that t_local, its edges parallel to the lanes.
+    A patch is a saw-cut ``rectangle`` or an irregular ``blob`` anywhere across the texture, a long narrow
+    ``trench`` reinstatement centred on ``t_local`` with its edges parallel to the lanes, starting in the
+    texture's first tenth, or a saw-cut patch laid ``across`` a lane line at ``t_local`` (within 0.3 m of its
+    centre, so it covers the line) in the texture's first half.
     """
     length_s, width_t = shape[0] * texel, shape[1] * texel
-    if trench_t is None:
+    if kind == "trench":
+        half = (0.5 * length_s * rng.uniform(0.35, 0.7), rng.uniform(0.3, 0.5) * size_scale)
+        center = (half[0] + 0.1 * spot * (length_s - 2 * half[0]), float(t_local))
+    elif kind == "across":
+        half = (rng.uniform(0.6, 2.0) * size_scale, rng.uniform(0.5, 1.2) * size_scale)
+        center = (0.5 * spot * length_s, float(t_local) + rng.uniform(-0.3, 0.3))
+    else:
         half = (rng.uniform(0.5, 2.2) * size_scale, rng.uniform(0.4, 1.6) * size_scale)
         center = (spot * length_s, rng.uniform(0.0, width_t))
-    else:
-        half = (0.5 * length_s * rng.uniform(0.35, 0.7), rng.uniform(0.3, 0.5) * size_scale)
-        center = (half[0] + spot * (length_s - 2 * half[0]), trench_t)
     reach = max(half) * 1.4 + 0.1
     rows = slice(max(int((center[0] - reach) / texel), 0), min(int((center[0] + reach) / texel) + 1, shape[0]))
     cols = slice(max(int((center[1] - reach) / texel), 0), min(int((center[1] + reach) / texel) + 1, shape[1]))
     ds = ((np.arange(rows.start, rows.stop) + 0.5) * texel - center[0])[:, None]
     dt = ((np.arange(cols.start, cols.stop) + 0.5) * texel - center[1])[None, :]
-    if irregular:
+    if kind == "blob":
         sd = _blob_distance(rng, ds, dt, half)
     else:
         angle = rng.normal(0.0, 0.02)
@@ -508,8 +571,8 @@ def _strip_stroke(rng: np.random.Generator, size_m: tuple[float, float], width_m
 
 def patches(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, rectangles: int = 3,
             blobs: int = 2, strips: int = 0, parallel_t: Sequence[float] = (), trench_t: Sequence[float] = (),
-            size_scale: float = 1.0, contrast: float = 0.7, strip_width_m: float = 0.08,
-            bright_share: float = 0.3) -> Texture:
+            across_t: Sequence[float] = (), size_scale: float = 1.0, contrast: float = 0.7,
+            strip_width_m: float = 0.08, bright_share: float = 0.3) -> Texture:
     """Repair patches of fresher asphalt and strips of crack sealant.
 
     Args:
@@ -518,7 +581,10 @@ def patches(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, r
         blobs: irregular pothole fills.
         strips: free-running sealant strips (2-10 m, following cracks across or along the road).
         parallel_t: t_local (m) of long straight strips running parallel to the lanes, one each.
-        trench_t: t_local (m) of long narrow trench patches (0.6-1 m wide at ``size_scale`` 1) along the lanes.
+        trench_t: t_local (m) of long narrow trench patches (0.6-1 m wide at ``size_scale`` 1) along the lanes,
+            starting in the texture's first tenth.
+        across_t: t_local (m) of lane lines, one saw-cut patch (1.2-4 m by 1-2.4 m at ``size_scale`` 1) laid
+            across each, in the texture's first half.
         size_scale: multiplies patch sizes.
         contrast: how much darker and more opaque the fresh asphalt is, in [0, 1].
         strip_width_m: sealant strip width (m).
@@ -531,12 +597,14 @@ def patches(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, r
     size_m = (shape[0] * texel, shape[1] * texel)
     canvas = _Canvas.empty(shape)
     fill_alpha = 0.35 + 0.6 * contrast
-    shapes = ([(bases[0], k, False, None) for k in range(rectangles)]
-              + [(bases[1], k, True, None) for k in range(blobs)]
-              + [(bases[4], k, False, float(t)) for k, t in enumerate(trench_t)])
-    for base, k, irregular, t_trench in shapes:
+    shapes: list[tuple[int, int, PatchKind, float | None]] = (
+        [(bases[0], k, "rectangle", None) for k in range(rectangles)]
+        + [(bases[1], k, "blob", None) for k in range(blobs)]
+        + [(bases[4], k, "trench", float(t)) for k, t in enumerate(trench_t)]
+        + [(bases[5], k, "across", float(t)) for k, t in enumerate(across_t)])
+    for base, k, kind, t_local in shapes:
         child = _child(base, k)
-        fill, rim, window = _patch_coverage(child, shape, texel, size_scale, irregular, _spot(base, k), t_trench)
+        fill, rim, window = _patch_coverage(child, shape, texel, size_scale, kind, _spot(base, k), t_local)
         tone = np.asarray(FRESH_ASPHALT_RGB) * child.uniform(0.85, 1.25)
         _paint_window(canvas, window, tone, fill * fill_alpha)
         _paint_window(canvas, window, SEALANT_DARK_RGB, rim * (0.3 + 0.5 * contrast))
@@ -567,8 +635,11 @@ SkidKind = Literal["straight", "swerve", "yaw"]
 
 
 def _skid_centerline(rng: np.random.Generator, kind: SkidKind, size_m: tuple[float, float], center_t: float,
-                     swerve_m: float, length_m: tuple[float, float], spot: float) -> tuple[FloatArray, FloatArray]:
-    """(n, 2) (s, t) centre path of a vehicle's skid and (n,) its heading, sampled every 0.1 m."""
+                     swerve_m: float, length_m: tuple[float, float], spot: float,
+                     start_m: tuple[float, float] | None = None) -> tuple[FloatArray, FloatArray]:
+    """(n, 2) (s, t) centre path of a vehicle's skid and (n,) its heading, sampled every 0.1 m. The path starts
+    ``spot`` (a fraction) of the way through ``start_m`` (s range, m) or, when None, the room left along the
+    texture; a start never leaves the mark running past the texture's end."""
     length = min(rng.uniform(*length_m), 0.95 * size_m[0])
     step = 0.1
     n = max(int(length / step), 3)
@@ -582,14 +653,16 @@ def _skid_centerline(rng: np.random.Generator, kind: SkidKind, size_m: tuple[flo
     else:
         curvature = rng.choice([-1.0, 1.0]) / rng.uniform(25.0, 60.0)
         theta = rng.normal(0.0, 0.05) + curvature * u
-    start = np.array([spot * (size_m[0] - length), center_t])
+    lo, hi = (0.0, size_m[0]) if start_m is None else start_m
+    hi = max(min(hi, size_m[0] - length), lo)
+    start = np.array([lo + spot * (hi - lo), center_t])
     return _walk(start, theta, step), theta
 
 
 def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, straight: int = 1,
                swerve: int = 0, yaw: int = 0, center_t: Sequence[float] = (), swerve_m: float = 3.5,
                length_m: tuple[float, float] = (15.0, 35.0), darkness: float = 0.7, track_width_m: float = 0.2,
-               gauge_m: tuple[float, float] = (1.5, 1.8)) -> Texture:
+               gauge_m: tuple[float, float] = (1.5, 1.8), start_m: tuple[float, float] | None = None) -> Texture:
     """Pairs of dark rubber tyre tracks along smooth curves, fading in and out at their ends.
 
     Args:
@@ -605,6 +678,9 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
         darkness: peak opacity of the rubber in [0, 1].
         track_width_m: width of one tyre track (m).
         gauge_m: range of track spacing, centre to centre (m).
+        start_m: (lo, hi) s (m from the texture's start) over which the marks' starts spread, so the marks of
+            one incident bunch together; lo < 0 lets a mark begin before the texture (only the rest is drawn).
+            None = spread over the whole texture.
 
     Returns:
         rgba (h, w, 4) float32, wet None.
@@ -622,7 +698,7 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
         sweep = swerve_m if k % 2 == 0 else -swerve_m
         if not 0.5 <= t_c + sweep <= size_m[1] - 0.5:
             sweep = -sweep
-        path, theta = _skid_centerline(child, kind, size_m, t_c, sweep, length_m, _spot(base, k))
+        path, theta = _skid_centerline(child, kind, size_m, t_c, sweep, length_m, _spot(base, k), start_m)
         _stamp_tracks(child, cover, path, theta, kind, texel, darkness, track_width_m, gauge_m)
     canvas = _Canvas.empty(shape)
     canvas.paint(RUBBER_RGB, cover)

@@ -1,8 +1,8 @@
 """Road damage: cracks, repairs and sealant, tyre marks on the main road's surface, and guard rails beside it.
 
-Surface damage becomes ``SurfaceLayer`` textures on road piece 0 (cracks lie under the paint, sealant and rubber
-over it); guard rails are W-beam meshes swept along the road, whose bright top edge and shadow run parallel to the
-lane lines.
+Surface damage becomes ``SurfaceLayer`` textures on road piece 0: crack stains and repainted repairs lie under the
+paint; open cracks, patches laid after the paint, sealant and rubber over it. Guard rails are W-beam meshes swept
+along the road, whose bright top edge and shadow run parallel to the lane lines.
 """
 
 from __future__ import annotations
@@ -114,16 +114,25 @@ def _beside(lines_t: list[float], count: int, gaps: np.ndarray) -> list[float]:
 
 @register
 class RoadCrack(_SurfaceDamage):
-    """Thin dark branching cracks in the asphalt, under the paint: transverse, longitudinal and alligator."""
+    """Dark branching cracks in the asphalt: transverse, longitudinal and alligator, and at the higher levels
+    failed paving joints under the lane lines. The stained, spalled rims lie under the paint; the open cracks
+    split the paint of the lines they cross."""
 
     TEXEL: ClassVar[float] = 0.02
-    # density: cracks per 100 m^2; along_lines: long cracks right beside the lane lines nearest the ego.
+    # density: cracks per 100 m^2; width: core width of a main crack (1-3 cm); along_lines: long cracks right
+    # beside the lane lines nearest the ego; joints: those lines whose paving joint has failed into a band of
+    # alligator cracking along the line; spall: broken-down crack edges (wider, darker stained rims).
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"density": 0.8, "width": 0.020, "darkness": 0.65, "along_lines": 0, "alligator_share": 0.00},
-        {"density": 1.3, "width": 0.024, "darkness": 0.72, "along_lines": 0, "alligator_share": 0.10},
-        {"density": 2.0, "width": 0.027, "darkness": 0.80, "along_lines": 1, "alligator_share": 0.15},
-        {"density": 2.8, "width": 0.031, "darkness": 0.88, "along_lines": 2, "alligator_share": 0.20},
-        {"density": 3.8, "width": 0.036, "darkness": 0.95, "along_lines": 4, "alligator_share": 0.25},
+        {"density": 0.8, "width": 0.010, "darkness": 0.60, "along_lines": 0, "alligator_share": 0.00,
+         "joints": 0, "spall": 0.0},
+        {"density": 1.5, "width": 0.014, "darkness": 0.70, "along_lines": 0, "alligator_share": 0.10,
+         "joints": 0, "spall": 0.1},
+        {"density": 2.5, "width": 0.018, "darkness": 0.80, "along_lines": 1, "alligator_share": 0.15,
+         "joints": 1, "spall": 0.25},
+        {"density": 4.0, "width": 0.024, "darkness": 0.90, "along_lines": 2, "alligator_share": 0.20,
+         "joints": 2, "spall": 0.5},
+        {"density": 8.0, "width": 0.030, "darkness": 1.00, "along_lines": 6, "alligator_share": 0.25,
+         "joints": 5, "spall": 1.0},
     )
 
     type: Literal["road_crack"] = "road_crack"
@@ -133,6 +142,7 @@ class RoadCrack(_SurfaceDamage):
     width: float | None = Field(None, ge=0.003, le=0.1, description="core width of a main crack (m)")
     darkness: float | None = Field(None, ge=0, le=1, description="opacity of the crack core")
     along_lines: int | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
+    joints: int | None = Field(None, ge=0, le=12, description="lane lines with failed joints cracked along them")
 
     def compile(self, ctx: CompileContext) -> None:
         area = self._area(ctx)
@@ -141,13 +151,17 @@ class RoadCrack(_SurfaceDamage):
         rng = ctx.rng(self.seed)
         crack_rng = np.random.default_rng(int(rng.integers(0, 2**63 - 1)))
         gaps = rng.uniform(PAINT_CLEARANCE_M, 2.5 * PAINT_CLEARANCE_M, size=8)
-        along = [area.local_t(t) for t in _beside(_lines_near_ego(ctx), _setting(self, "along_lines"), gaps)]
+        lines = _lines_near_ego(ctx)
+        along = [area.local_t(t) for t in _beside(lines, _setting(self, "along_lines"), gaps)]
+        joints = [area.local_t(t) for t in lines[:_setting(self, "joints")]]
         density = _setting(self, "density")
         shares = self._shares(self.level()["alligator_share"])
-        rgba, wet = tex.crack_mix(crack_rng, area.shape, area.texel,
+        layers = tex.crack_layers(crack_rng, area.shape, area.texel,
                                   {kind: density * share for kind, share in shares.items()},
-                                  _setting(self, "width"), _setting(self, "darkness"), along, ctx.env.wetness)
-        self._emit(ctx, area, rgba, wet, over_paint=False, name="cracks")
+                                  _setting(self, "width"), _setting(self, "darkness"), along, ctx.env.wetness,
+                                  joint_t=joints, spall=self.level()["spall"])
+        self._emit(ctx, area, layers.stains, None, over_paint=False, name="crack stains")
+        self._emit(ctx, area, layers.cracks, layers.wet, over_paint=True, name="cracks")
 
     def _shares(self, alligator_share: float) -> dict[tex.CrackKind, float]:
         """Share of the density that goes to each crack kind."""
@@ -159,20 +173,24 @@ class RoadCrack(_SurfaceDamage):
 
 @register
 class RoadRepair(_SurfaceDamage):
-    """Repair patches of fresher, darker asphalt and strips of crack sealant, some running along the lane lines."""
+    """Repair patches of fresher, darker asphalt, trench reinstatements along the lane lines, strips of crack
+    sealant, some running along the lines, and at the higher levels fresh patches across the lines whose paint
+    has not been restored yet."""
 
     # patches: rectangles and pothole fills; parallel: sealant strips beside lane lines; trenches: long narrow
-    # reinstatements along the lanes; size: patch size scale; contrast: fresh-asphalt darkness and opacity.
+    # reinstatements (joint inlays) along the lane lines nearest the ego, repainted: the line runs over them;
+    # unpainted: patches laid across those lines after the paint, so the line breaks off there; size: patch
+    # size scale; contrast: fresh-asphalt darkness and opacity.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"patches": 2, "strips": 2, "parallel": 0, "trenches": 0, "size": 0.80, "contrast": 0.35,
+        {"patches": 2, "strips": 2, "parallel": 0, "trenches": 0, "unpainted": 0, "size": 0.80, "contrast": 0.35,
          "strip_width": 0.05, "bright_share": 0.00},
-        {"patches": 4, "strips": 3, "parallel": 0, "trenches": 0, "size": 0.90, "contrast": 0.50,
+        {"patches": 4, "strips": 3, "parallel": 0, "trenches": 0, "unpainted": 0, "size": 0.90, "contrast": 0.50,
          "strip_width": 0.06, "bright_share": 0.15},
-        {"patches": 6, "strips": 5, "parallel": 1, "trenches": 0, "size": 1.00, "contrast": 0.65,
+        {"patches": 6, "strips": 5, "parallel": 1, "trenches": 1, "unpainted": 1, "size": 1.00, "contrast": 0.65,
          "strip_width": 0.07, "bright_share": 0.30},
-        {"patches": 8, "strips": 7, "parallel": 2, "trenches": 1, "size": 1.10, "contrast": 0.80,
+        {"patches": 8, "strips": 7, "parallel": 2, "trenches": 2, "unpainted": 3, "size": 1.10, "contrast": 0.80,
          "strip_width": 0.09, "bright_share": 0.40},
-        {"patches": 11, "strips": 9, "parallel": 3, "trenches": 2, "size": 1.25, "contrast": 0.95,
+        {"patches": 11, "strips": 9, "parallel": 4, "trenches": 5, "unpainted": 6, "size": 1.30, "contrast": 1.00,
          "strip_width": 0.12, "bright_share": 0.50},
     )
 
@@ -180,7 +198,8 @@ class RoadRepair(_SurfaceDamage):
     patches: int | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
     strips: int | None = Field(None, ge=0, le=200, description="free-running sealant strips")
     parallel: int | None = Field(None, ge=0, le=12, description="sealant strips right beside lane lines")
-    trenches: int | None = Field(None, ge=0, le=8, description="long narrow trench patches along the lanes")
+    trenches: int | None = Field(None, ge=0, le=8, description="long narrow trench patches along lane lines")
+    unpainted: int | None = Field(None, ge=0, le=12, description="patches across lane lines, paint not restored")
     size: float | None = Field(None, gt=0, le=4, description="patch size scale (1 = 0.8-4.4 m long)")
     contrast: float | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
     strip_width: float | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
@@ -192,34 +211,50 @@ class RoadRepair(_SurfaceDamage):
             return
         v = {key: _setting(self, key) for key in self.level()}
         rng = ctx.rng(self.seed)
-        patch_rng, strip_rng = (np.random.default_rng(int(b)) for b in rng.integers(0, 2**63 - 1, size=2))
+        patch_rng, strip_rng, unpainted_rng = (np.random.default_rng(int(b))
+                                               for b in rng.integers(0, 2**63 - 1, size=3))
         gaps = rng.uniform(1.5 * PAINT_CLEARANCE_M, 3.5 * PAINT_CLEARANCE_M, size=8)
-        swing = rng.uniform(-0.9, 0.9, size=8)
-        trench_t = [area.local_t(t + float(swing[k])) for k, t in enumerate(_lanes_near_ego(ctx)[:v["trenches"]])]
+        swing = rng.uniform(-0.15, 0.15, size=8)  # a trench follows its line within a few centimetres
+        lines = _lines_near_ego(ctx)
+        trench_t = [area.local_t(lines[k % len(lines)] + float(swing[k % 8])) for k in range(v["trenches"])]
         rectangles = (v["patches"] + 1) // 2 + v["patches"] // 4
         rgba, _ = tex.patches(patch_rng, area.shape, area.texel, rectangles=rectangles,
                               blobs=v["patches"] - rectangles, trench_t=trench_t, size_scale=v["size"],
                               contrast=v["contrast"])
         self._emit(ctx, area, rgba, None, over_paint=False, name="repair patches")
-        parallel_t = [area.local_t(t) for t in _beside(_lines_near_ego(ctx), v["parallel"], gaps)]
+        across_t = [area.local_t(lines[k % len(lines)]) for k in range(v["unpainted"])]
+        rgba, _ = tex.patches(unpainted_rng, area.shape, area.texel, rectangles=0, blobs=0, across_t=across_t,
+                              size_scale=v["size"], contrast=v["contrast"])
+        self._emit(ctx, area, rgba, None, over_paint=True, name="unpainted patches")
+        parallel_t = [area.local_t(t) for t in _beside(lines, v["parallel"], gaps)]
         rgba, _ = tex.patches(strip_rng, area.shape, area.texel, rectangles=0, blobs=0, strips=v["strips"],
                               parallel_t=parallel_t, contrast=v["contrast"], strip_width_m=v["strip_width"],
                               bright_share=v["bright_share"])
         self._emit(ctx, area, rgba, None, over_paint=True, name="sealant")
+
 
 @register
 class TireMarks(_SurfaceDamage):
     """Dark rubber tyre tracks from emergency braking, swerves across lane lines and sideways yaw slides."""
 
     TEXEL: ClassVar[float] = 0.04
-    # straddle: straight marks centred on a lane line (a track each side of it) instead of in a lane.
+    # on_line: straight marks of a vehicle braking astride a lane line, one track running along the paint;
+    # cluster: how tightly the marks of the incident bunch at the start of the marked stretch (0 = spread
+    # over it; 0.9 = all start within its first tenth, most of them already under way where it begins, so the
+    # rubber is at its darkest in the camera's first view).
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"straight": 1, "swerve": 0, "yaw": 0, "straddle": 0, "darkness": 0.40, "track_width": 0.18},
-        {"straight": 2, "swerve": 0, "yaw": 0, "straddle": 0, "darkness": 0.50, "track_width": 0.19},
-        {"straight": 2, "swerve": 1, "yaw": 0, "straddle": 1, "darkness": 0.62, "track_width": 0.20},
-        {"straight": 2, "swerve": 2, "yaw": 1, "straddle": 1, "darkness": 0.75, "track_width": 0.21},
-        {"straight": 3, "swerve": 3, "yaw": 1, "straddle": 2, "darkness": 0.88, "track_width": 0.22},
+        {"straight": 1, "swerve": 0, "yaw": 0, "on_line": 0, "darkness": 0.45, "track_width": 0.18,
+         "cluster": 0.0},
+        {"straight": 2, "swerve": 0, "yaw": 0, "on_line": 0, "darkness": 0.55, "track_width": 0.19,
+         "cluster": 0.3},
+        {"straight": 2, "swerve": 1, "yaw": 0, "on_line": 1, "darkness": 0.68, "track_width": 0.20,
+         "cluster": 0.55},
+        {"straight": 4, "swerve": 2, "yaw": 1, "on_line": 2, "darkness": 0.82, "track_width": 0.21,
+         "cluster": 0.75},
+        {"straight": 6, "swerve": 4, "yaw": 2, "on_line": 4, "darkness": 0.95, "track_width": 0.22,
+         "cluster": 0.9},
     )
+    HALF_GAUGE_M: ClassVar[float] = 0.82  # a car's track centre to its wheel tracks
 
     type: Literal["tire_marks"] = "tire_marks"
     straight: int | None = Field(None, ge=0, le=40, description="straight braking marks")
@@ -227,26 +262,33 @@ class TireMarks(_SurfaceDamage):
     yaw: int | None = Field(None, ge=0, le=40, description="curved sideways-sliding marks")
     darkness: float | None = Field(None, ge=0, le=1, description="peak opacity of the rubber")
     track_width: float | None = Field(None, ge=0.1, le=0.4, description="width of one tyre track (m)")
-    length_min: float = Field(15.0, gt=1, le=200, description="shortest mark (m)")
-    length_max: float = Field(35.0, gt=1, le=200, description="longest mark (m)")
+    length_min: float = Field(20.0, gt=1, le=200, description="shortest mark (m)")
+    length_max: float = Field(45.0, gt=1, le=200, description="longest mark (m)")
 
     def compile(self, ctx: CompileContext) -> None:
         area = self._area(ctx)
         if area is None:
             return
         straight, swerve, yaw = (_setting(self, key) for key in ("straight", "swerve", "yaw"))
-        straddle = min(self.level()["straddle"], straight)
+        on_line = min(self.level()["on_line"], straight)
         lanes, lines = _lanes_near_ego(ctx), _lines_near_ego(ctx)
-        center_t = ([lanes[k % len(lanes)] for k in range(straight - straddle)]
-                    + [lines[k % len(lines)] for k in range(straddle)]
+        astride = [lines[k % len(lines)] + (1.0 if k % 2 else -1.0) * self.HALF_GAUGE_M for k in range(on_line)]
+        center_t = ([lanes[k % len(lanes)] for k in range(straight - on_line)] + astride
                     + [lanes[k % len(lanes)] for k in range(swerve)]
                     + [lanes[(k + 1) % len(lanes)] for k in range(yaw)])
         rgba, _ = tex.skid_marks(
             ctx.rng(self.seed), area.shape, area.texel, straight=straight, swerve=swerve, yaw=yaw,
             center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
             length_m=(min(self.length_min, self.length_max), max(self.length_min, self.length_max)),
-            darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"))
+            darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"),
+            start_m=self._starts(area, self.level()["cluster"]))
         self._emit(ctx, area, rgba, None, over_paint=True, name="tyre marks")
+
+    def _starts(self, area: _Area, cluster: float) -> tuple[float, float]:
+        """s range (m from the texture's start) of the marks' starts: the whole stretch at ``cluster`` 0,
+        shrinking and reaching back up to half the shortest mark before the stretch as ``cluster`` grows."""
+        lead = 0.5 * cluster * min(self.length_min, self.length_max)
+        return -lead, -lead + (1.0 - cluster) * area.shape[0] * area.texel
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -168,18 +168,19 @@ class StreetlightShadow(SunShadowIllusion):
 class FenceShadow(SunShadowIllusion):
     """A slatted fence beside the road whose low-sun shadow lays stripes across the lanes."""
 
-    # Lower sun from further ahead (longer stripes nearer the lane direction), taller and denser slats.
+    # A gently lowering sun from a fixed bearing and a taller fence with denser slats: the striped shadow reaches
+    # further across the lanes with every level while the rest of the scene's light changes little.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 32.0, "sun_ahead": 20.0, "sun_intensity": 0.8, "penumbra": 0.020, "height": 1.6,
+        {"sun_altitude": 30.0, "sun_ahead": 32.0, "sun_intensity": 0.9, "penumbra": 0.020, "height": 1.6,
          "slat_width": 0.10, "slat_gap": 0.40},
-        {"sun_altitude": 26.0, "sun_ahead": 28.0, "sun_intensity": 0.95, "penumbra": 0.015, "height": 2.0,
-         "slat_width": 0.12, "slat_gap": 0.32},
-        {"sun_altitude": 21.0, "sun_ahead": 36.0, "sun_intensity": 1.1, "penumbra": 0.011, "height": 2.4,
-         "slat_width": 0.13, "slat_gap": 0.26},
-        {"sun_altitude": 17.0, "sun_ahead": 44.0, "sun_intensity": 1.3, "penumbra": 0.008, "height": 2.8,
-         "slat_width": 0.14, "slat_gap": 0.21},
-        {"sun_altitude": 14.0, "sun_ahead": 50.0, "sun_intensity": 1.5, "penumbra": 0.005, "height": 3.2,
-         "slat_width": 0.15, "slat_gap": 0.18},
+        {"sun_altitude": 26.0, "sun_ahead": 32.0, "sun_intensity": 0.95, "penumbra": 0.015, "height": 2.0,
+         "slat_width": 0.11, "slat_gap": 0.33},
+        {"sun_altitude": 22.0, "sun_ahead": 32.0, "sun_intensity": 1.0, "penumbra": 0.011, "height": 2.4,
+         "slat_width": 0.12, "slat_gap": 0.27},
+        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 2.8,
+         "slat_width": 0.13, "slat_gap": 0.22},
+        {"sun_altitude": 18.0, "sun_ahead": 32.0, "sun_intensity": 1.1, "penumbra": 0.005, "height": 3.2,
+         "slat_width": 0.15, "slat_gap": 0.15},
     )
 
     type: Literal["fence_shadow"] = "fence_shadow"

@@ -83,14 +83,18 @@ class Footprints:
         return Slot(slot.s, self.t_ego + side * (EGO_CLEAR_M + ext_t + 0.05), slot.yaw)
 
     def place(self, slot: Slot, half_x: float, half_y: float, reach: float) -> Slot | None:
-        """Claim ground for a footprint at ``slot`` (moved off the ego's path if needed, and along the road by
-        up to ``NUDGES`` when another participant stands there), or None if it would reach past
-        |t| = ``reach`` or finds no free ground."""
+        """Claim ground for a footprint at ``slot`` (moved off the ego's path if needed, inwards when it sticks
+        out past the paved edge |t| = ``reach``, and along the road by up to ``NUDGES`` when another participant
+        stands there), or None if its centre lies off the paved road or it finds no free ground."""
         ext_s, ext_t = self.extents(slot.yaw, half_x, half_y)
         if self.on_path(slot, ext_s, ext_t):
             slot = self.off_path(slot, ext_t)
-        if abs(slot.t) + ext_t > reach:
+        if abs(slot.t) > reach or ext_t > reach:
             return None
+        if abs(slot.t) + ext_t > reach:  # e.g. someone on the edge line beside a kerb: just inside the edge
+            slot = Slot(slot.s, math.copysign(reach - ext_t, slot.t), slot.yaw)
+            if self.on_path(slot, ext_s, ext_t):
+                return None
         for nudge in NUDGES:
             moved = Slot(slot.s + nudge * (ext_s + 0.3), slot.t, slot.yaw)
             if self.on_path(moved, ext_s, ext_t):
@@ -213,14 +217,14 @@ class Pedestrian(TrafficIllusion):
     """People crossing or standing on the road, on the lane lines and in the lanes beside the ego's."""
 
     # count: people; group: people per crossing group; distance: first group ahead of the ego start (m);
-    # on_lines: share of the people standing on a lane line. On the default road the first frame loses about
-    # 0, 0.5, 0.7, 3 and 6 % of its lane-line rows behind them.
+    # on_lines: share of the people standing on a lane line. Level 5 is a crowd crossing right in front of the
+    # ego, on both of its lane lines and the lines beyond.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
         {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
-        {"count": 3, "group": 1, "distance": 35.0, "on_lines": 0.34},
-        {"count": 6, "group": 3, "distance": 24.0, "on_lines": 0.5},
-        {"count": 12, "group": 5, "distance": 16.0, "on_lines": 0.6},
-        {"count": 20, "group": 8, "distance": 10.0, "on_lines": 0.75},
+        {"count": 3, "group": 1, "distance": 30.0, "on_lines": 0.34},
+        {"count": 6, "group": 3, "distance": 18.0, "on_lines": 0.5},
+        {"count": 12, "group": 6, "distance": 9.0, "on_lines": 0.67},
+        {"count": 20, "group": 10, "distance": 5.0, "on_lines": 0.8},
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
@@ -258,18 +262,18 @@ class Bicycle(TrafficIllusion):
     """Cyclists riding along the lane lines (or crossing the road) beside the ego's path."""
 
     # count: cyclists; group: cyclists side by side; distance: first group ahead of the ego start (m);
-    # on_lines: share of cyclists riding on a lane line. The first frame loses about 0.3, 0.5, 1, 1 and 5 % of
-    # its lane-line rows behind them.
+    # on_lines: share of cyclists riding on a lane line. Level 5 is a club ride spread over the whole road just
+    # ahead of the ego, most of it riding on the lane lines.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
         {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
-        {"count": 3, "group": 1, "distance": 35.0, "on_lines": 0.34},
-        {"count": 5, "group": 2, "distance": 24.0, "on_lines": 0.5},
-        {"count": 9, "group": 3, "distance": 16.0, "on_lines": 0.67},
-        {"count": 14, "group": 5, "distance": 10.0, "on_lines": 0.8},
+        {"count": 3, "group": 1, "distance": 30.0, "on_lines": 0.34},
+        {"count": 5, "group": 2, "distance": 18.0, "on_lines": 0.5},
+        {"count": 10, "group": 5, "distance": 9.0, "on_lines": 0.67},
+        {"count": 20, "group": 10, "distance": 6.0, "on_lines": 0.8},
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
-    group: int | None = Field(None, ge=1, le=8, description="cyclists per group; empty = severity table")
+    group: int | None = Field(None, ge=1, le=12, description="cyclists per group; empty = severity table")
     on_lines: float | None = Field(
         None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
     )

@@ -119,7 +119,8 @@ def test_layers_cover_the_carriageway_in_view_from_the_first_frame(name: str) ->
 
 
 def test_long_damage_is_split_into_layers_under_the_texel_budget() -> None:
-    scene = compiled({"type": "tire_marks", "extent": 300.0, "margin": 2.0, "straight": 6},
+    # Level 1 spreads its marks over the whole stretch (higher levels bunch them at its start).
+    scene = compiled({"type": "tire_marks", "severity": 1, "extent": 300.0, "margin": 2.0, "straight": 6},
                      road={"lanes_per_direction": 4, "length": 800.0})
     assert len(scene.layers) >= 2
     assert all(layer.rgba.shape[0] * layer.rgba.shape[1] <= MAX_LAYER_TEXELS for layer in scene.layers)
@@ -127,10 +128,13 @@ def test_long_damage_is_split_into_layers_under_the_texel_budget() -> None:
     assert all(b[0] >= a[1] - 1e-6 for a, b in zip(ends, ends[1:]))  # consecutive, never overlapping
 
 
-def test_cracks_lie_under_the_paint_and_sealant_and_rubber_over_it() -> None:
-    assert {layer.over_paint for layer in compiled({"type": "road_crack"}).layers} == {False}
-    repair = compiled({"type": "road_repair"}).layers
-    assert {layer.name.split()[0]: layer.over_paint for layer in repair} == {"repair": False, "sealant": True}
+def test_crack_stains_lie_under_the_paint_and_cracks_sealant_and_rubber_over_it() -> None:
+    cracks = compiled({"type": "road_crack"}).layers
+    assert {layer.name.rsplit(" ", 1)[0]: layer.over_paint for layer in cracks} == {"crack stains": False,
+                                                                                    "cracks": True}
+    repair = compiled({"type": "road_repair", "severity": 4}).layers
+    assert {layer.name.rsplit(" ", 1)[0]: layer.over_paint for layer in repair} == {
+        "repair patches": False, "unpainted patches": True, "sealant": True}
     assert {layer.over_paint for layer in compiled({"type": "tire_marks"}).layers} == {True}
 
 
@@ -192,3 +196,39 @@ def test_guard_rail_leaves_junction_mouths_open() -> None:
     right = y < -main.half_width
     assert right.any() and not ((x[right] > gap[0] + 0.5) & (x[right] < gap[1] - 0.5)).any()
     assert (x[right] > gap[1]).any() and (x[right] < gap[0]).any()  # the rail goes on beyond the mouth
+
+
+def _over_paint_on_ego_lines(scene: CompiledScene, s_max: float | None = None) -> float:
+    """Coverage-weighted area (m^2) of over-paint layers on the paint of the ego lane's two lines (t = 0 and
+    t = -lane_width on the default road), up to ``s_max`` along the road if given."""
+    area = 0.0
+    for layer in (layer for layer in scene.layers if layer.over_paint):
+        t_road = layer.t0 + (np.arange(layer.rgba.shape[1]) + 0.5) * layer.texel
+        s_road = layer.s0 + (np.arange(layer.rgba.shape[0]) + 0.5) * layer.texel
+        on_line = (np.abs(t_road) < 0.08) | (np.abs(t_road + scene.network.lane_width) < 0.08)
+        rows = s_road < (np.inf if s_max is None else s_max)
+        area += float(layer.rgba[rows][:, on_line, 3].sum(dtype=np.float64)) * layer.texel**2
+    return area
+
+
+@pytest.mark.parametrize("name", SURFACE_TYPES)
+def test_level_five_breaks_the_paint_of_the_ego_lane_lines(name: str) -> None:
+    weak, strong = (_over_paint_on_ego_lines(compiled({"type": name, "severity": level})) for level in (1, 5))
+    assert strong > 0.5  # m^2 of cracks, unpainted patches or rubber over the lines' paint
+    assert strong > 5.0 * weak
+
+
+def test_tire_marks_bunch_in_the_first_view_at_level_five() -> None:
+    # The default ego starts at s = 10 m and first sees the road about 6 m ahead.
+    near = [_over_paint_on_ego_lines(compiled({"type": "tire_marks", "severity": level}), s_max=26.0)
+            for level in (1, 5)]
+    assert near[0] == 0.0 and near[1] > 0.3
+
+
+def test_cracked_joints_and_inlays_follow_the_lines_nearest_the_ego() -> None:
+    cracks = compiled({"type": "road_crack", "severity": 1, "joints": 2, "density": 0.0})
+    repair = compiled({"type": "road_repair", "severity": 1, "trenches": 2, "patches": 0, "strips": 0})
+    for scene in (cracks, repair):
+        on_lines = lane_alpha(scene, -0.3, 0.3) + lane_alpha(scene, -3.8, -3.2)
+        elsewhere = lane_alpha(scene, 1.2, 3.5) + lane_alpha(scene, -2.6, -1.0)
+        assert on_lines > 10.0 * max(elsewhere, 1e-3), (on_lines, elsewhere)

@@ -200,3 +200,14 @@ def test_posts_keep_clear_of_the_lamps_already_there(name: str) -> None:
     assert len(lamp_feet) and len(my_feet)
     gap = np.sqrt(((lamp_feet[:, None] - my_feet[None]) ** 2).sum(-1)).min()
     assert gap > 0.5
+
+
+def test_fence_sun_keeps_its_bearing_while_the_fence_grows() -> None:
+    scenes = [compiled({"type": "fence_shadow", "severity": level}) for level in LEVELS]
+    azimuth = [np.degrees(np.arctan2(s.env.sun_dir_world[1], s.env.sun_dir_world[0])) for s in scenes]
+    assert np.ptp(azimuth) < 1.0  # the rest of the scene's shadows only lengthen from level to level
+    height = [own_vertices(s)[:, 2].max() for s in scenes]
+    assert all(a < b for a, b in zip(height, height[1:]))
+    slats = [REGISTRY["fence_shadow"].SEVERITY[k]["slat_width"] / REGISTRY["fence_shadow"].SEVERITY[k]["slat_gap"]
+             for k in range(5)]
+    assert all(a < b for a, b in zip(slats, slats[1:]))  # denser slats: darker stripes

@@ -148,3 +148,55 @@ def test_crack_mix_of_one_kind_is_that_crack_network() -> None:
     assert (both[..., 3] >= single[..., 3] - 1e-6).all()  # other kinds add cracks, never move these
     with pytest.raises(ValueError, match="kinds"):
         tex.crack_mix(rng(), SHAPE, TEXEL, {"potholes": 1.0})  # type: ignore[dict-item]
+
+
+def test_crack_layers_put_stains_under_and_open_cracks_over_the_paint() -> None:
+    layers = tex.crack_layers(rng(), SHAPE, TEXEL, {"transverse": 2.0}, width_m=0.03, darkness=1.0)
+    mixed, _ = tex.crack_mix(rng(), SHAPE, TEXEL, {"transverse": 2.0}, width_m=0.03, darkness=1.0)
+    np.testing.assert_allclose(tex.composite(layers.cracks, layers.stains), mixed, atol=1e-5)
+    crack, stain = layers.cracks[..., 3] > 0.5, layers.stains[..., 3] > 0.05
+    assert crack.any() and layers.cracks[crack, :3].max() < 0.012  # the open crack is near black
+    assert (stain & ~crack).sum() > 2 * crack.sum()  # the stained rim reaches beyond the crack
+    assert layers.stains[stain, :3].max() < 0.03  # and is darker than any asphalt
+
+
+def test_spalling_widens_and_darkens_the_stains_only() -> None:
+    plain = tex.crack_layers(rng(), SHAPE, TEXEL, {"longitudinal": 2.0}, width_m=0.03, spall=0.0)
+    spalled = tex.crack_layers(rng(), SHAPE, TEXEL, {"longitudinal": 2.0}, width_m=0.03, spall=1.0)
+    assert np.array_equal(plain.cracks, spalled.cracks)
+    assert (spalled.stains[..., 3] > 0.02).sum() > 1.5 * (plain.stains[..., 3] > 0.02).sum()
+    assert spalled.stains[..., 3].max() > 1.5 * plain.stains[..., 3].max()
+
+
+def test_failed_joint_is_a_band_of_alligator_cracking_along_its_line() -> None:
+    t_line = 4.5
+    layers = tex.crack_layers(rng(), SHAPE, TEXEL, {}, width_m=0.03, darkness=1.0, joint_t=(t_line,))
+    alpha = layers.cracks[..., 3]
+    cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
+    band = np.abs(cols - t_line) < 1.3  # half widths of 0.55-0.9 m, a wavy rim, a few cm off the line
+    assert alpha[:, ~band].max() == 0.0  # nothing but the band
+    cracked_rows = (alpha[:, np.abs(cols - t_line) < 0.3] > 0.5).any(axis=1)
+    assert cracked_rows.mean() > 0.6, "the band runs along most of the line"
+    assert cracked_rows[: int(2.0 / TEXEL)].any(), "from the texture's start"
+    assert 0.05 < alpha[:, band].mean() < 0.4  # a network of cells, not a solid strip
+
+
+def test_skid_marks_start_where_asked_even_before_the_texture() -> None:
+    alpha = tex.skid_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
+                           length_m=(8.0, 10.0), darkness=0.9, start_m=(-4.0, -2.0))[0][..., 3]
+    along = alpha.max(axis=1)
+    assert along[: int(1.0 / TEXEL)].max() > 0.5  # already dark where the texture begins
+    assert along[int(8.5 / TEXEL):].max() == 0.0  # and over before 8 m past its start
+    spread = tex.skid_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
+                            length_m=(8.0, 10.0), darkness=0.9)[0][..., 3]
+    assert spread.max(axis=1)[int(8.5 / TEXEL):].max() > 0.5  # without a range they spread over the texture
+
+
+def test_patch_across_a_line_covers_it_in_the_first_half() -> None:
+    t_line = 4.5
+    rgba, _ = tex.patches(rng(), SHAPE, TEXEL, rectangles=0, blobs=0, across_t=(t_line, t_line), contrast=1.0)
+    alpha = rgba[..., 3]
+    col = int(t_line / TEXEL)
+    covered = np.flatnonzero(alpha[:, col] > 0.9)
+    assert covered.size * TEXEL > 1.0  # at least a metre of the line lies under fresh asphalt
+    assert covered.max() * TEXEL < 0.5 * SHAPE[0] * TEXEL + 2.5  # laid in the first half (plus its half length)

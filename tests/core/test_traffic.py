@@ -15,7 +15,7 @@ from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, parse_case
 from lanevil_core.environment import environment_for
 from lanevil_core.illusions import REGISTRY, CompileContext
-from lanevil_core.illusions.traffic import EGO_CLEAR_M, load_obstacle, srgb_to_linear
+from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
 from lanevil_core.road_layout import build_network
 from lanevil_core.scene import Mesh
 
@@ -233,3 +233,25 @@ def test_vehicle_mesh_file_replaces_the_bodies(tmp_path: Path) -> None:
         assert len(mesh.faces) == 12 + 32  # the loaded model, not the procedural van
         size = np.sort(mesh.vertices.max(0) - mesh.vertices.min(0))
         assert size.max() <= 5.2 + 1e-6 and size.max() > 2.5
+
+
+def test_someone_on_an_edge_line_stands_just_inside_the_paved_edge() -> None:
+    case = Case()
+    free = Footprints(case, t_ego=-1.75)
+    placed = free.place(Slot(40.0, -7.0, 0.0), 0.3, 0.4, reach=7.2)
+    assert placed is not None and placed.t == pytest.approx(-6.8)  # squeezed in, still on the edge line
+    assert free.place(Slot(60.0, -7.5, 0.0), 0.3, 0.4, reach=7.2) is None  # standing off the road: dropped
+
+
+@pytest.mark.parametrize("name", ["pedestrian", "bicycle"])
+def test_level_five_crowds_the_ego_lines_in_the_first_frame(name: str) -> None:
+    case, ctx = compiled({"type": name, "severity": 5})
+    t_ego = ctx.network.lane_center_t(case.ego.lane)
+    ego_lines = (t_ego - ctx.network.lane_width / 2, t_ego + ctx.network.lane_width / 2)
+    s, t = road_st(ctx, np.array([m.vertices.mean(0) for m in ctx.meshes]))
+    near = s < case.ego.start_s + 15.0
+    on_ego_lines = near & np.any([np.abs(t - line) < 0.3 for line in ego_lines], axis=0)
+    assert near.sum() >= 6 and on_ego_lines.sum() >= 2
+    _, weaker = compiled({"type": name, "severity": 4})
+    s4, _ = road_st(weaker, np.array([m.vertices.mean(0) for m in weaker.meshes]))
+    assert s.min() < s4.min()  # the crowd comes closer with severity
