@@ -30,35 +30,53 @@ def _encode(x: float, inv_w2: float, lut: np.ndarray) -> np.uint8:
 
 
 @kernel
-def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
-    """Tone-map to sRGB bytes; pixels on an object-id boundary are first blended with their 4-neighbourhood
-    (a cheap silhouette antialias: the procedural road is already filtered, object edges are not)."""
+def _encode_all(hdr: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+    inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
+    flat_in = hdr.reshape(-1)
+    flat_out = out.reshape(-1)
+    for i in range(flat_in.size):
+        flat_out[i] = _encode(flat_in[i] * exposure, inv_w2, lut)
+
+
+@kernel
+def _smooth_edges(hdr: np.ndarray, edges: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
     height, width, _ = hdr.shape
     inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
-    for row in range(height):
-        for col in range(width):
-            i = ids[row, col]
-            edge = ((col + 1 < width and ids[row, col + 1] != i) or (row + 1 < height and ids[row + 1, col] != i)
-                    or (col > 0 and ids[row, col - 1] != i) or (row > 0 and ids[row - 1, col] != i))
-            for c in range(3):
-                x = hdr[row, col, c]
-                if edge:
-                    acc = 0.0
-                    cnt = 0.0
-                    if col + 1 < width:
-                        acc += min(hdr[row, col + 1, c], CLAMP)
-                        cnt += 1.0
-                    if col > 0:
-                        acc += min(hdr[row, col - 1, c], CLAMP)
-                        cnt += 1.0
-                    if row + 1 < height:
-                        acc += min(hdr[row + 1, col, c], CLAMP)
-                        cnt += 1.0
-                    if row > 0:
-                        acc += min(hdr[row - 1, col, c], CLAMP)
-                        cnt += 1.0
-                    x = 0.5 * min(x, CLAMP) + 0.5 * acc / cnt
-                out[row, col, c] = _encode(x * exposure, inv_w2, lut)
+    for k in range(edges.size):
+        row = edges[k] // width
+        col = edges[k] % width
+        for c in range(3):
+            acc = 0.0
+            cnt = 0.0
+            if col + 1 < width:
+                acc += min(hdr[row, col + 1, c], CLAMP)
+                cnt += 1.0
+            if col > 0:
+                acc += min(hdr[row, col - 1, c], CLAMP)
+                cnt += 1.0
+            if row + 1 < height:
+                acc += min(hdr[row + 1, col, c], CLAMP)
+                cnt += 1.0
+            if row > 0:
+                acc += min(hdr[row - 1, col, c], CLAMP)
+                cnt += 1.0
+            x = 0.5 * min(hdr[row, col, c], CLAMP) + 0.5 * acc / cnt
+            out[row, col, c] = _encode(x * exposure, inv_w2, lut)
+
+
+def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+    """Tone-map (H, W, 3) linear radiance to sRGB bytes in ``out``; pixels on an object-id boundary are first
+    blended with their 4-neighbourhood (a cheap silhouette antialias: the procedural road is already filtered,
+    object edges are not)."""
+    _encode_all(np.ascontiguousarray(hdr), exposure, lut, out)
+    edge = np.zeros(ids.shape, bool)
+    across = ids[:, 1:] != ids[:, :-1]
+    down = ids[1:, :] != ids[:-1, :]
+    edge[:, 1:] |= across
+    edge[:, :-1] |= across
+    edge[1:, :] |= down
+    edge[:-1, :] |= down
+    _smooth_edges(hdr, np.flatnonzero(edge), exposure, lut, out)
 
 
 @kernel

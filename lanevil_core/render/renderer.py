@@ -18,6 +18,8 @@ from .shadow_map import ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
 MIRROR_BLUR_PX_AT_1280 = 10
+LAMP_RANGE_M = 110.0
+LAMP_BEHIND_M = 12.0
 
 
 @dataclass(frozen=True)
@@ -94,14 +96,24 @@ def _ground_heights(packed: PackedScene) -> np.ndarray:
 
 
 def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment) -> np.ndarray:
-    """The scene's lamps plus, when on, the ego's headlights (they move with the camera)."""
+    """The lamps near enough to matter this frame plus, when on, the ego's headlights (they move with it).
+
+    Lamps farther than LAMP_RANGE_M light the road below them to a few per cent of a near one and sit deep in
+    the fog; leaving them out keeps the per-pixel light loop short.
+    """
+    lamps_world = packed.lights
+    if len(lamps_world):
+        offset = lamps_world[:, :3] - camera.p_world_camera
+        ahead = offset @ camera.R_world_camera[:, 2]
+        near = (np.linalg.norm(offset, axis=1) < LAMP_RANGE_M) & (ahead > -LAMP_BEHIND_M)
+        lamps_world = lamps_world[near]
     if env.headlights <= 0.0:
-        return packed.lights
+        return np.ascontiguousarray(lamps_world)
     R = camera.R_world_camera
     forward, right, down = R[:, 2], R[:, 0], R[:, 1]
     lamps = [camera.p_world_camera + forward * 1.5 + right * side * 0.75 + down * 2.3 for side in (-1.0, 1.0)]
     rows = np.array([[*p, 1.0, 0.95, 0.85, env.headlights] for p in lamps])
-    return np.concatenate([packed.lights, rows])
+    return np.concatenate([lamps_world, rows])
 
 
 def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
