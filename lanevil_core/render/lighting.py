@@ -9,7 +9,6 @@ from ._jit import kernel
 SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
 SKY_SCALE = 1.6
 NORMAL_OFFSET_M = 0.03
-COVERED_AMBIENT = 0.3  # share of the sky's light that reaches ground under a roof
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 
@@ -108,25 +107,14 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
 
 
 @kernel(inline="always")
-def sky_openness(overhead: np.ndarray, params: np.ndarray, px: float, py: float, pz: float) -> float:
-    """1 under open sky, down to COVERED_AMBIENT where a caster stands well above ground point ``p``
-    (bilinear over the top-down map, so the edge of a roof's shade is soft)."""
-    height, width = overhead.shape
-    x = (px - params[0]) * params[2] - 0.5
-    y = (py - params[1]) * params[2] - 0.5
-    if x < 0.0 or y < 0.0 or x >= width - 1 or y >= height - 1:
+def sky_openness(openness: np.ndarray, params: np.ndarray, px: float, py: float) -> float:
+    """Share of the sky's light reaching ground point (px, py): 1 in the open, less under roofs and decks."""
+    height, width = openness.shape
+    x = int((px - params[0]) * params[2])
+    y = int((py - params[1]) * params[2])
+    if x < 0 or y < 0 or x >= width or y >= height:
         return 1.0
-    x0 = int(x)
-    y0 = int(y)
-    fx = x - x0
-    fy = y - y0
-    covered = 0.0
-    for dy in range(2):
-        for dx in range(2):
-            w = (fx if dx else 1.0 - fx) * (fy if dy else 1.0 - fy)
-            if overhead[y0 + dy, x0 + dx] > pz + 1.5:
-                covered += w
-    return 1.0 - (1.0 - COVERED_AMBIENT) * covered
+    return openness[y, x]
 
 
 @kernel(inline="always")

@@ -66,7 +66,7 @@ class PackedScene:
     stripes: FloatArray  # (k, STRIPE_COLUMNS)
     layers: LayerAtlas
     lights: FloatArray  # (l, 7): x, y, z, r, g, b, intensity
-    overhead: Float32Array  # (H, W) height of the highest caster above each ground cell (-inf: open sky)
+    overhead: Float32Array  # (H, W) share of the sky each ground cell sees (1 = open)
     overhead_params: FloatArray  # (3,) x0, y0, cells per metre
 
 
@@ -155,21 +155,30 @@ def _face_normals(vertices: FloatArray, faces: IntArray) -> Float32Array:
 OVERHEAD_CELL_M = 0.25
 OVERHEAD_MAX_CELLS = 2048
 OVERHEAD_MARGIN_M = 25.0
+COVER_HEIGHT_M = 1.5
+COVERED_AMBIENT = 0.3  # share of the sky's light that reaches ground under a roof
 
 
 def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
-    """Top-down map of the highest shadow caster over the ground near the carriageways.
+    """Top-down map of how much sky the ground near the carriageways sees (1 = open sky).
 
-    Ground under a bridge deck, a tunnel roof or a tree crown sees less of the sky; the renderer dims its
-    ambient light accordingly.
+    A cell is covered where the highest shadow caster above it stands more than COVER_HEIGHT_M over the road
+    surface there (a bridge deck, a tunnel roof, a tree crown); covered ground gets COVERED_AMBIENT of the
+    sky's light, and a 3x3 box blur softens the edges.
     """
     near_road = road.vertices[np.abs(road.st[:, 1]) < np.abs(road.st[:, 1]).min() + OVERHEAD_MARGIN_M + 20.0]
     lo, hi = near_road[:, :2].min(axis=0) - OVERHEAD_MARGIN_M, near_road[:, :2].max(axis=0) + OVERHEAD_MARGIN_M
     cell = max(OVERHEAD_CELL_M, float(max(hi - lo)) / OVERHEAD_MAX_CELLS)
     size = (int(np.ceil((hi[0] - lo[0]) / cell)) + 1, int(np.ceil((hi[1] - lo[1]) / cell)) + 1)
     v_down = np.stack([packed.vertices[:, 0], packed.vertices[:, 1], -packed.vertices[:, 2]], axis=-1)
-    depth = depth_orthographic(v_down, packed.faces, packed.shadow_faces, size, 1.0 / cell, lo[0], lo[1])
-    return np.ascontiguousarray(-depth), np.array([lo[0], lo[1], 1.0 / cell])
+    road_faces = np.arange(len(road.faces), dtype=np.int32)  # the road surface comes first in the packed faces
+    top = -depth_orthographic(v_down, packed.faces, packed.shadow_faces, size, 1.0 / cell, lo[0], lo[1])
+    ground = -depth_orthographic(v_down, packed.faces, road_faces, size, 1.0 / cell, lo[0], lo[1])
+    covered = (top > np.where(np.isfinite(ground), ground, -np.inf) + COVER_HEIGHT_M).astype(np.float32)
+    padded = np.pad(covered, 1, mode="edge")
+    blurred = sum(padded[i:i + covered.shape[0], j:j + covered.shape[1]] for i in range(3) for j in range(3)) / 9.0
+    openness = 1.0 - (1.0 - COVERED_AMBIENT) * blurred
+    return np.ascontiguousarray(openness, np.float32), np.array([lo[0], lo[1], 1.0 / cell])
 
 
 def pack_scene(scene: CompiledScene) -> PackedScene:

@@ -197,7 +197,7 @@ def shade(
                 spec_b += lights[i, 5] * k_spec
             up = 0.6 + 0.4 * nz
             if material >= 0:  # ground under a roof, deck or crown sees less sky
-                up *= sky_openness(overhead, overhead_params, px, py, pz)
+                up *= sky_openness(overhead, overhead_params, px, py)
             r = r * (light_r + amb_r * up) + spec_r + face_emission[f, 0]
             g = g * (light_g + amb_g * up) + spec_g + face_emission[f, 1]
             b = b * (light_b + amb_b * up) + spec_b + face_emission[f, 2]
