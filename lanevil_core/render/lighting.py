@@ -84,14 +84,8 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
         if x < 2 or y < 2 or x > size - 2 or y > size - 2:
             continue
         bias = (1.5 + 1.5 * slope) / scale
-        # Nearest caster within a coarse cell and its neighbours: no caster above the point -> fully lit.
-        cx = int(x) >> COARSE_SHIFT
-        cy = int(y) >> COARSE_SHIFT
-        cn = coarse.shape[1]
-        nearest = np.inf
-        for j in range(max(cy - 1, 0), min(cy + 2, cn)):
-            for i in range(max(cx - 1, 0), min(cx + 2, cn)):
-                nearest = min(nearest, coarse[c, j, i])
+        # Nearest caster within the point's coarse cell and its neighbours (pre-dilated): none -> fully lit.
+        nearest = coarse[c, int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT]
         if nearest >= d - bias:
             return 1.0
         # The caster right above the point (else the nearest one around) sets the penumbra width.
@@ -133,14 +127,24 @@ def glossy_lobe(n_dot_h: float, roughness: float) -> float:
 
 @kernel
 def min_pool(maps: np.ndarray, shift: int) -> np.ndarray:
-    """(C, S >> shift, S >> shift): the nearest caster depth in each 2**shift square of every cascade."""
+    """(C, S >> shift, S >> shift): the nearest caster depth in each 2**shift square of every cascade and its
+    eight neighbours (so one lookup answers "is any caster near enough to shade this point?")."""
     cascades, size, _ = maps.shape
     cells = size >> shift
-    out = np.full((cascades, cells, cells), np.inf, np.float32)
+    pooled = np.full((cascades, cells, cells), np.inf, np.float32)
     for c in range(cascades):
         for y in range(size):
             for x in range(size):
                 v = maps[c, y, x]
-                if v < out[c, y >> shift, x >> shift]:
-                    out[c, y >> shift, x >> shift] = v
+                if v < pooled[c, y >> shift, x >> shift]:
+                    pooled[c, y >> shift, x >> shift] = v
+    out = np.full((cascades, cells, cells), np.inf, np.float32)
+    for c in range(cascades):
+        for y in range(cells):
+            for x in range(cells):
+                nearest = np.inf
+                for j in range(max(y - 1, 0), min(y + 2, cells)):
+                    for i in range(max(x - 1, 0), min(x + 2, cells)):
+                        nearest = min(nearest, pooled[c, j, i])
+                out[c, y, x] = nearest
     return out

@@ -27,8 +27,9 @@ WHITE_PAINT = (0.70, 0.70, 0.67)
 YELLOW_PAINT = (0.72, 0.46, 0.04)
 STOP_LINE_M = 0.4
 
-# Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots), on, period, r, g, b
-STRIPE_COLUMNS = 11
+# Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots), on, period, r, g, b,
+# boundary index (-1: not tied to a lane boundary)
+STRIPE_COLUMNS = 12
 
 
 @dataclass
@@ -64,6 +65,7 @@ class PackedScene:
     shadow_faces: IntArray  # faces drawn into the sun's shadow map
     mirror_faces: IntArray  # object faces that wet roads mirror
     stripes: FloatArray  # (k, STRIPE_COLUMNS)
+    stripe_index: np.ndarray  # (pieces, boundaries + 1, 2) see stripe_index()
     layers: LayerAtlas
     lights: FloatArray  # (l, 7): x, y, z, r, g, b, intensity
     overhead: Float32Array  # (H, W) share of the sky each ground cell sees (1 = open)
@@ -108,12 +110,26 @@ def paint_stripes(network: RoadNetwork, markings: list[Marking]) -> FloatArray:
                 if side and g_side == side:
                     spans = [(a, b) for a0, b0 in spans for a, b in ((a0, min(b0, g0)), (max(a0, g1), b0)) if b > a]
             for s0, s1 in spans:
-                rows += _stripes_of_boundary(index, float(t), marking, s0, s1)
+                rows += [[*row, k] for row in _stripes_of_boundary(index, float(t), marking, s0, s1)]
         if index:  # a stop line across the arm's lanes that lead into the junction
             s0 = piece.s_start + 1.5
             rows.append([index, -piece.half_width / 2, piece.half_width / 2, s0, s0 + STOP_LINE_M, 0,
-                         1.0, 1.0, *WHITE_PAINT])
+                         1.0, 1.0, *WHITE_PAINT, -1])
     return np.array(rows, np.float64).reshape(-1, STRIPE_COLUMNS)
+
+
+def stripe_index(stripes: FloatArray, pieces: int, boundaries: int) -> np.ndarray:
+    """(pieces, boundaries + 1, 2) int64 [start, stop) rows of the stripe table per piece and boundary; the last
+    slot holds stripes not tied to one boundary (stop lines). The shader looks only at the boundaries near a
+    pixel instead of every stripe."""
+    index = np.zeros((pieces, boundaries + 1, 2), np.int64)
+    piece_of, boundary_of = stripes[:, 0].astype(int), stripes[:, 11].astype(int)
+    for p in range(pieces):
+        for k in range(-1, boundaries):
+            rows = np.flatnonzero((piece_of == p) & (boundary_of == k))
+            if rows.size:
+                index[p, k if k >= 0 else boundaries] = (rows[0], rows[-1] + 1)
+    return index
 
 
 def _mips(rgba: np.ndarray, wet: np.ndarray | None) -> list[np.ndarray]:
@@ -213,6 +229,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         offset += len(mesh.vertices)
     all_v = np.concatenate(verts)
     all_f = np.concatenate(faces).astype(np.int32)
+    stripes = paint_stripes(scene.network, scene.case.road.markings)
     lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
                       np.float64).reshape(-1, 7)
     packed = PackedScene(
@@ -224,7 +241,8 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),
         shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
         mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),
-        stripes=paint_stripes(scene.network, scene.case.road.markings), layers=layer_atlas(scene), lights=lights,
+        stripes=stripes, stripe_index=stripe_index(stripes, len(scene.network.pieces), len(scene.case.road.markings)),
+        layers=layer_atlas(scene), lights=lights,
         overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )
     packed.overhead, packed.overhead_params = overhead_map(packed, road)

@@ -46,16 +46,6 @@ def _env_vector(env: Environment) -> np.ndarray:
                      env.cloudiness, env.penumbra], np.float64)
 
 
-def _stripe_ranges(packed: PackedScene, pieces: int) -> np.ndarray:
-    ranges = np.zeros((pieces, 2), np.int64)
-    stripe_piece = packed.stripes[:, 0].astype(int)
-    for p in range(pieces):
-        idx = np.flatnonzero(stripe_piece == p)
-        if idx.size:
-            ranges[p] = (idx[0], idx[-1] + 1)
-    return ranges
-
-
 def _no_shadows() -> ShadowMaps:
     return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1), np.inf, np.float32),
                       np.array([[0.0, 0.0, 1.0]]), np.eye(3))
@@ -156,7 +146,8 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
     fine, coarse = noise_textures()
     shade(frags.face, frags.depth, st_buf, piece_buf, camera.R_world_camera, camera.p_world_camera,
           k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
-          packed.face_normal, MATERIAL_ALBEDO, packed.stripes, _stripe_ranges(packed, len(scene.network.pieces)),
+          packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
+          float(scene.network.lanes_per_direction), scene.network.lane_width,
           packed.layers.texels, packed.layers.table, packed.layers.first_level, _frame_lights(packed, camera, env),
           fine, coarse,
           _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),

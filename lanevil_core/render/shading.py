@@ -61,7 +61,7 @@ def _difference(st_buf: np.ndarray, piece_buf: np.ndarray, row: int, col: int, d
 def shade(
     face_buf, depth_buf, st_buf, piece_buf, R_wc, c_world, fx, fy, cx, cy,
     face_material, face_color, face_emission, face_gloss, face_normal, material_albedo,
-    stripes, stripe_range, layer_texels, layer_table, layer_first, lights,
+    stripes, stripe_index, lanes, lane_width, layer_texels, layer_table, layer_first, lights,
     noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
     shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, out,
 ):
@@ -129,7 +129,15 @@ def shade(
                 if material == ASPHALT:
                     r, g, b, wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft, False,
                                                  r, g, b)
-                    r, g, b = paint(stripes, stripe_range[piece, 0], stripe_range[piece, 1], s, t, fs, ft, r, g, b)
+                    # Only the lane boundaries within the footprint can paint this pixel (boundary k: t = (n - k) w).
+                    last = stripe_index.shape[1] - 1
+                    k0 = max(int(np.floor(lanes - (t + ft + 0.5) / lane_width + 0.5)), 0)
+                    k1 = min(int(np.floor(lanes - (t - ft - 0.5) / lane_width + 0.5)), last - 1)
+                    for k in range(k0, k1 + 1):
+                        r, g, b = paint(stripes, stripe_index[piece, k, 0], stripe_index[piece, k, 1], s, t, fs, ft,
+                                        r, g, b)
+                    r, g, b = paint(stripes, stripe_index[piece, last, 0], stripe_index[piece, last, 1], s, t, fs, ft,
+                                    r, g, b)
                     r, g, b, wet_over = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft,
                                                       True, r, g, b)
                     wet = max(wet, wet_over)
