@@ -151,7 +151,7 @@ def paint_mesh(network: RoadNetwork, markings: list[Marking]) -> tuple[FloatArra
     stripes = paint_stripes(network, markings).reshape(-1, STRIPE_COLUMNS)
     vertices, faces, colors = [], [], []
     count = 0
-    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b in stripes:
+    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary in stripes:
         line = network.pieces[int(piece)].line
         for a, b_end in _dash_spans(s0, s1, int(pattern), on, period):
             s_road = np.append(np.arange(a, b_end, PAINT_STEP_M), b_end)
