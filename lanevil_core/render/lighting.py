@@ -9,6 +9,7 @@ from ._jit import kernel
 SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
 SKY_SCALE = 1.6
 NORMAL_OFFSET_M = 0.03
+LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 
@@ -118,11 +119,20 @@ def fresnel_schlick(cos_theta: float, f0: float) -> float:
 
 
 @kernel(inline="always")
-def glossy_lobe(n_dot_h: float, roughness: float) -> float:
-    """Normalized Blinn-Phong lobe standing in for GGX: narrow and tall for smooth water, wide for asphalt."""
+def lobe_shape(roughness: float) -> tuple[float, float, float]:
+    """(exponent, normalisation, cutoff) of a normalised Blinn-Phong lobe standing in for GGX: narrow and tall for
+    smooth water, wide for asphalt. Below ``cutoff`` (of n.h) the lobe is under LOBE_FLOOR of its peak."""
     alpha = max(roughness * roughness, 1e-4)
     exponent = 2.0 / alpha - 2.0
-    return (exponent + 2.0) / (2.0 * np.pi) * max(n_dot_h, 0.0) ** exponent
+    return exponent, (exponent + 2.0) / (2.0 * np.pi), np.exp(np.log(LOBE_FLOOR) / max(exponent, 1.0))
+
+
+@kernel(inline="always")
+def glossy_lobe(n_dot_h: float, exponent: float, normalisation: float, cutoff: float) -> float:
+    """The lobe at n.h (0 below the cutoff, where it is negligible; skips the power for most pixel-lamp pairs)."""
+    if n_dot_h <= cutoff:
+        return 0.0
+    return normalisation * np.exp(exponent * np.log(n_dot_h))
 
 
 @kernel

@@ -18,7 +18,7 @@ from .shadow_map import ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
 MIRROR_BLUR_PX_AT_1280 = 10
-LAMP_RANGE_M = 110.0
+LAMP_RANGE_M = 75.0
 LAMP_BEHIND_M = 12.0
 
 

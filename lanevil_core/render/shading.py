@@ -10,7 +10,15 @@ import numpy as np
 
 from ._jit import kernel
 
-from .lighting import SUN_SCALE, fresnel_schlick, glossy_lobe, sky_openness, sky_radiance, sun_visibility
+from .lighting import (
+    SUN_SCALE,
+    fresnel_schlick,
+    glossy_lobe,
+    lobe_shape,
+    sky_openness,
+    sky_radiance,
+    sun_visibility,
+)
 from .surface import paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
@@ -164,6 +172,7 @@ def shade(
                     roughness = 0.03
             shiny = surface_wet + gloss
             spec_f0 = max(f0, gloss * 0.08)
+            exponent, normalisation, cutoff = lobe_shape(roughness)
             light_r = light_g = light_b = 0.0
             spec_r = spec_g = spec_b = 0.0
             # Direct sun.
@@ -178,7 +187,8 @@ def shade(
                 if vis > 0.0 and shiny > 0.0:
                     hx, hy, hz = lx_sun - dx, ly_sun - dy, lz_sun - dz
                     n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-                    k = vis * glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, spec_f0) * 0.25 * shiny
+                    k = (vis * glossy_lobe(n_dot_h, exponent, normalisation, cutoff)
+                         * fresnel_schlick(n_dot_v, spec_f0) * 0.25 * shiny)
                     spec_r += sun_r * k
                     spec_g += sun_g * k
                     spec_b += sun_b * k
@@ -195,7 +205,8 @@ def shade(
                 power = lights[i, 6] / (d2 + 1.0)
                 hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
                 n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-                k_spec = power * glossy_lobe(n_dot_h, roughness) * fresnel_schlick(n_dot_v, spec_f0) * (0.1 + shiny)
+                k_spec = (power * glossy_lobe(n_dot_h, exponent, normalisation, cutoff)
+                          * fresnel_schlick(n_dot_v, spec_f0) * (0.1 + shiny))
                 k_diff = power * ndl
                 light_r += lights[i, 3] * k_diff
                 light_g += lights[i, 4] * k_diff
