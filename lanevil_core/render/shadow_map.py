@@ -17,7 +17,7 @@ from .lighting import COARSE_SHIFT, min_pool
 from .raster import depth_orthographic
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)
-CASCADE_SIZE = 1024
+CASCADE_SIZE = 1024  # at 1280 pixels wide
 GROUND_BAND_M = (-4.0, 14.0)  # heights around the camera's ground that receive shadows worth mapping
 
 
@@ -58,9 +58,15 @@ def _slice_points_world(camera: PinholeCamera, near: float, far: float) -> Float
     return p_world
 
 
+def cascade_size(image_width: int) -> int:
+    """Texels per cascade side for an image width: shadow detail follows pixel size (1024 at 1280 wide)."""
+    return int(min(max(2 ** round(np.log2(image_width * CASCADE_SIZE / 1280)), 256), 2048))
+
+
 def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world: FloatArray,
-                      size: int = CASCADE_SIZE) -> ShadowMaps:
-    """Rasterize every shadow-casting face into each cascade."""
+                      size: int | None = None) -> ShadowMaps:
+    """Rasterize every shadow-casting face into each cascade (``size`` texels a side; default from the image)."""
+    size = size if size is not None else cascade_size(camera.intrinsics.width)
     R_light_world = light_rotation(sun_dir_world)
     v_light = packed.vertices @ R_light_world.T
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
