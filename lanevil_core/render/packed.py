@@ -61,6 +61,7 @@ class PackedScene:
     face_emission: Float32Array  # (m, 3)
     face_gloss: Float32Array  # (m,)
     face_normal: Float32Array  # (m, 3) world, unit
+    face_grad_st: Float32Array  # (m, 6) world gradients of s and of t on each road face (0 for objects)
     camera_faces: IntArray  # faces drawn in the camera
     shadow_faces: IntArray  # faces drawn into the sun's shadow map
     mirror_faces: IntArray  # object faces that wet roads mirror
@@ -197,6 +198,25 @@ def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, 
     return np.ascontiguousarray(openness, np.float32), np.array([lo[0], lo[1], 1.0 / cell])
 
 
+def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_faces: int) -> Float32Array:
+    """(m, 6) float32: the world-space gradients of s and t over each of the first ``road_faces`` faces (the road
+    surface, where s and t are affine on every triangle); zeros for the rest."""
+    grads = np.zeros((len(faces), 6), np.float32)
+    tri = vertices[faces[:road_faces]]
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    normal = np.cross(e1, e2)
+    area2 = np.einsum("ij,ij->i", normal, normal)
+    ok = area2 > 1e-12
+    values = st[faces[:road_faces]]  # (k, 3, 2)
+    for column in range(2):
+        d1 = values[:, 1, column] - values[:, 0, column]
+        d2 = values[:, 2, column] - values[:, 0, column]
+        # Gradient g in the triangle's plane with g.e1 = d1 and g.e2 = d2.
+        g = (d1[:, None] * np.cross(e2, normal) + d2[:, None] * np.cross(normal, e1)) / np.where(ok, area2, 1.0)[:, None]
+        grads[:road_faces, 3 * column:3 * column + 3] = np.where(ok[:, None], g, 0.0)
+    return grads
+
+
 def pack_scene(scene: CompiledScene) -> PackedScene:
     """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
     cached = scene.cache.get("packed")
@@ -238,6 +258,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         face_object=np.concatenate(obj), face_color=np.concatenate(color).astype(np.float32),
         face_emission=np.concatenate(emission).astype(np.float32), face_gloss=np.concatenate(gloss),
         face_normal=_face_normals(all_v, all_f),
+        face_grad_st=_st_gradients(all_v, all_f, np.concatenate(st), len(road.faces)),
         camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),
         shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
         mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),

@@ -13,7 +13,7 @@ from ..typed import Float32Array, IntArray, UInt8Array
 from .packed import MATERIAL_ALBEDO, PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
 from .raster import rasterize_perspective
-from .shading import road_coordinates, shade, shade_mirror
+from .shading import shade, shade_mirror
 from .shadow_map import ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
@@ -138,13 +138,10 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
     else:
         refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
     lap("mirror")
-    st_buf = np.zeros((k.height, k.width, 2), np.float32)
-    piece_buf = np.empty((k.height, k.width), np.int32)
-    road_coordinates(frags.face, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
-                     packed.face_material, st_buf, piece_buf)
     hdr = np.empty((k.height, k.width, 3), np.float32)
     fine, coarse = noise_textures()
-    shade(frags.face, frags.depth, st_buf, piece_buf, camera.R_world_camera, camera.p_world_camera,
+    shade(frags.face, frags.depth, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
+          packed.face_grad_st, camera.R_world_camera, camera.p_world_camera,
           k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
           packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
           float(scene.network.lanes_per_direction), scene.network.lane_width,

@@ -25,49 +25,23 @@ from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 # env_f layout
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA = range(8)
 ASPHALT, CONCRETE, KERB = 0, 1, 4
-WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
+WET_FILM_MIRROR = 0.45
+FOOTPRINT_SCALE = 0.75  # box-filter width in pixels' worth of road coordinate
+MAX_FOOTPRINT_M = 50.0  # a wet film mirrors less than standing water
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 
 
-@kernel
-def road_coordinates(face_buf: np.ndarray, bary_buf: np.ndarray, faces: np.ndarray, vertex_st: np.ndarray,
-                     vertex_piece: np.ndarray, face_material: np.ndarray, st_buf: np.ndarray,
-                     piece_buf: np.ndarray) -> None:
-    """Interpolate road-frame (s, t) and the piece index for every road-surface pixel (piece -1 elsewhere)."""
-    height, width = face_buf.shape
-    for row in range(height):
-        for col in range(width):
-            f = face_buf[row, col]
-            if f < 0 or face_material[f] < 0:
-                piece_buf[row, col] = -1
-                continue
-            b1 = bary_buf[row, col, 0]
-            b2 = bary_buf[row, col, 1]
-            b0 = 1.0 - b1 - b2
-            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
-            st_buf[row, col, 0] = b0 * vertex_st[i0, 0] + b1 * vertex_st[i1, 0] + b2 * vertex_st[i2, 0]
-            st_buf[row, col, 1] = b0 * vertex_st[i0, 1] + b1 * vertex_st[i1, 1] + b2 * vertex_st[i2, 1]
-            piece_buf[row, col] = vertex_piece[i0]
-
-
 @kernel(inline="always")
-def _difference(st_buf: np.ndarray, piece_buf: np.ndarray, row: int, col: int, drow: int, dcol: int,
-                axis: int) -> float:
-    height, width = piece_buf.shape
-    p = piece_buf[row, col]
-    r2, c2 = row + drow, col + dcol
-    if 0 <= r2 < height and 0 <= c2 < width and piece_buf[r2, c2] == p:
-        return abs(st_buf[r2, c2, axis] - st_buf[row, col, axis])
-    r2, c2 = row - drow, col - dcol
-    if 0 <= r2 < height and 0 <= c2 < width and piece_buf[r2, c2] == p:
-        return abs(st_buf[r2, c2, axis] - st_buf[row, col, axis])
-    return 0.0
+def coordinate_step(gx: float, gy: float, gz: float, ux: float, uy: float, uz: float, vx: float, vy: float,
+                    vz: float) -> float:
+    """How much a road coordinate with world gradient g changes across one pixel (steps u and v)."""
+    return FOOTPRINT_SCALE * (abs(gx * ux + gy * uy + gz * uz) + abs(gx * vx + gy * vy + gz * vz)) + 1e-3
 
 
 @kernel
 def shade(
-    face_buf, depth_buf, st_buf, piece_buf, R_wc, c_world, fx, fy, cx, cy,
+    face_buf, depth_buf, bary_buf, faces, vertex_st, vertex_piece, face_grad_st, R_wc, c_world, fx, fy, cx, cy,
     face_material, face_color, face_emission, face_gloss, face_normal, material_albedo,
     stripes, stripe_index, lanes, lane_width, layer_texels, layer_table, layer_first, lights,
     noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
@@ -120,13 +94,29 @@ def shade(
             roughness = 0.25
             f0 = 0.04
             if material >= 0:
-                piece = piece_buf[row, col]
-                s = st_buf[row, col, 0]
-                t = st_buf[row, col, 1]
-                fs = 0.75 * (_difference(st_buf, piece_buf, row, col, 0, 1, 0)
-                             + _difference(st_buf, piece_buf, row, col, 1, 0, 0)) + 1e-3
-                ft = 0.75 * (_difference(st_buf, piece_buf, row, col, 0, 1, 1)
-                             + _difference(st_buf, piece_buf, row, col, 1, 0, 1)) + 1e-3
+                # Road coordinates from the face's vertices, and their change across the pixel by ray
+                # differentials on the face's plane (exact for the affine (s, t) of a road triangle).
+                b1 = bary_buf[row, col, 0]
+                b2 = bary_buf[row, col, 1]
+                b0 = 1.0 - b1 - b2
+                i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+                piece = vertex_piece[i0]
+                s = b0 * vertex_st[i0, 0] + b1 * vertex_st[i1, 0] + b2 * vertex_st[i2, 0]
+                t = b0 * vertex_st[i0, 1] + b1 * vertex_st[i1, 1] + b2 * vertex_st[i2, 1]
+                n_dot_r = -max(n_dot_v, 1e-4) * norm  # n faces the viewer, so n.ray < 0
+                k_u = (nx * R_wc[0, 0] + ny * R_wc[1, 0] + nz * R_wc[2, 0]) / n_dot_r
+                k_v = (nx * R_wc[0, 1] + ny * R_wc[1, 1] + nz * R_wc[2, 1]) / n_dot_r
+                su, sv = depth / fx, depth / fy
+                ux = su * (R_wc[0, 0] - dx * norm * k_u)
+                uy = su * (R_wc[1, 0] - dy * norm * k_u)
+                uz = su * (R_wc[2, 0] - dz * norm * k_u)
+                vx = sv * (R_wc[0, 1] - dx * norm * k_v)
+                vy = sv * (R_wc[1, 1] - dy * norm * k_v)
+                vz = sv * (R_wc[2, 1] - dz * norm * k_v)
+                fs = min(coordinate_step(face_grad_st[f, 0], face_grad_st[f, 1], face_grad_st[f, 2],
+                                         ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
+                ft = min(coordinate_step(face_grad_st[f, 3], face_grad_st[f, 4], face_grad_st[f, 5],
+                                         ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
                 footprint = max(fs, ft)
                 grain = sample_noise(noise_fine, FINE_TEXEL_M, s, t, footprint)
                 blotch = sample_noise(noise_coarse, COARSE_TEXEL_M, s * 0.5, t, footprint)
