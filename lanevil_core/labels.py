@@ -161,7 +161,9 @@ def _closer(surface_depth: FloatArray, point_depth: FloatArray, margin: tuple[fl
     return surface_depth < point_depth * (1.0 - relative) - absolute
 
 
-def label_boundary(view: BoundaryInView, v_image: FloatArray, size: tuple[int, int], frame: Frame | None = None) -> LaneLabel:
+def label_boundary(
+    view: BoundaryInView, v_image: FloatArray, size: tuple[int, int], frame: Frame | None = None,
+) -> LaneLabel:
     """Cut one boundary with the image lines ``v_image``; drop points outside the image or behind a crest.
 
     ``frame`` (the rendered frame of the same camera) supplies depth and object ids for the crest and occlusion

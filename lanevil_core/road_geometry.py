@@ -89,7 +89,9 @@ class ReferenceLine:
         left = np.stack([-sin_h, cos_h, np.zeros_like(cos_h)], axis=-1)
         return np.stack([x, y, z], axis=-1), tangent, left
 
-    def to_world(self, s_road: FloatArray | float, t_road: FloatArray | float, h_road: FloatArray | float = 0.0) -> FloatArray:
+    def to_world(
+        self, s_road: FloatArray | float, t_road: FloatArray | float, h_road: FloatArray | float = 0.0,
+    ) -> FloatArray:
         """World points (..., 3) of road-frame points: ``t_road`` to the left, ``h_road`` straight up."""
         s_road, t_road, h_road = np.broadcast_arrays(
             np.asarray(s_road, np.float64), np.asarray(t_road, np.float64), np.asarray(h_road, np.float64)

@@ -51,7 +51,8 @@ class RoadPiece:
     strips: tuple[Strip, ...]
     boundaries_t: FloatArray  # (k,) t of every lane boundary, left to right
     s_start: float = 0.0  # arms start at the main road's edge
-    gaps: list[tuple[float, float, int]] = field(default_factory=list)  # (s0, s1, side) without edge strips; side +1 left / -1 right
+    # (s0, s1, side): where the roadside of one side (+1 left, -1 right) gives way to a junction arm
+    gaps: list[tuple[float, float, int]] = field(default_factory=list)
 
 
 @dataclass

@@ -136,8 +136,8 @@ def stripe_index(stripes: FloatArray, pieces: int, boundaries: int) -> np.ndarra
 def _mips(rgba: np.ndarray, wet: np.ndarray | None) -> list[np.ndarray]:
     rgba = np.asarray(rgba, np.float32)
     premultiplied = np.concatenate([rgba[..., :3] * rgba[..., 3:4], rgba[..., 3:4]], axis=-1)
-    level = np.concatenate([premultiplied, (wet if wet is not None else np.zeros(rgba.shape[:2], np.float32))[..., None]],
-                           axis=-1).astype(np.float32)
+    wet = wet if wet is not None else np.zeros(rgba.shape[:2], np.float32)
+    level = np.concatenate([premultiplied, wet[..., None]], axis=-1).astype(np.float32)
     levels = [level]
     while min(level.shape[:2]) > 2 and len(levels) < 10:
         h, w = (level.shape[0] // 2) * 2, (level.shape[1] // 2) * 2
@@ -212,7 +212,8 @@ def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_fa
         d1 = values[:, 1, column] - values[:, 0, column]
         d2 = values[:, 2, column] - values[:, 0, column]
         # Gradient g in the triangle's plane with g.e1 = d1 and g.e2 = d2.
-        g = (d1[:, None] * np.cross(e2, normal) + d2[:, None] * np.cross(normal, e1)) / np.where(ok, area2, 1.0)[:, None]
+        g = d1[:, None] * np.cross(e2, normal) + d2[:, None] * np.cross(normal, e1)
+        g /= np.where(ok, area2, 1.0)[:, None]
         grads[:road_faces, 3 * column:3 * column + 3] = np.where(ok[:, None], g, 0.0)
     return grads
 

@@ -11,9 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._jit import kernel
-
 from ..typed import Float32Array, IntArray
+from ._jit import kernel
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import kernel
-
 from .lighting import (
     SUN_SCALE,
     fresnel_schlick,

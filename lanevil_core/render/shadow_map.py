@@ -12,8 +12,8 @@ import numpy as np
 
 from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
-from .packed import PackedScene
 from .lighting import COARSE_SHIFT, min_pool
+from .packed import PackedScene
 from .raster import depth_orthographic
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)

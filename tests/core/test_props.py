@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from lanevil_core import props
+from lanevil_core.case import Road
 from lanevil_core.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
 from lanevil_core.road_layout import build_network
-from lanevil_core.case import Road
 from lanevil_core.scene import Mesh
 
 
