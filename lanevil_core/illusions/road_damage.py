@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import surface_textures as tex
+from ..environment import sun_direction
 from ..scene import SurfaceLayer
 from .base import Category, CompileContext, Illusion, register
 
@@ -382,4 +383,4 @@ def _shadow_sun(heading: float, side: float, height: float, reach: float) -> np.
     throws the shadow of an edge ``height`` m up ``reach`` m across the road."""
     azimuth = heading + side * (np.pi / 2 + SUN_SWING_RAD)
     altitude = np.arctan2(height * np.cos(SUN_SWING_RAD), reach)
-    return np.array([np.cos(altitude) * np.cos(azimuth), np.cos(altitude) * np.sin(azimuth), np.sin(altitude)])
+    return sun_direction(float(np.degrees(azimuth)), float(np.degrees(altitude)))

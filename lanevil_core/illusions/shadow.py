@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
+from ..environment import sun_direction
 from ..primitives import pose_on_road, transformed
 from ..structures import clear_runs, fence, ground_height, outside_gaps, overhead_rail, power_lines, streetlight
 from .base import Category, CompileContext, Illusion, register
@@ -61,8 +62,6 @@ class SunShadowIllusion(Illusion):
         ``side_sign`` is +1 when the shadow-casting structure stands left of the road, -1 when right; ``ahead``
         (degrees from square-on towards the direction of travel) defaults to the table's ``sun_ahead``.
         """
-        from ..environment import sun_direction  # imported here: environment imports the case model
-
         level = self.level()
         altitude = self.altitude()
         azimuth = self.sun_azimuth

@@ -162,6 +162,17 @@ class TrafficIllusion(Illusion):
                 slots.append(Slot(s, t, yaw_of(rng, t)))
         return slots
 
+    def add_crowd(self, ctx: CompileContext, slots: list[Slot], make: Callable[[int], Mesh],
+                  follow_grade: bool = True) -> None:
+        """Build participant ``index`` with ``make`` for every slot and put it there, squeezed off the ego's path
+        and inside the paved road (slots with no room are skipped)."""
+        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        for index, slot in enumerate(slots):
+            mesh = make(index)
+            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
+            if placed is not None:
+                self.add(ctx, mesh, placed, index, follow_grade=follow_grade)
+
     def add(self, ctx: CompileContext, mesh: Mesh, slot: Slot, index: int, follow_grade: bool = True) -> None:
         """Put a local-frame participant at ``slot``, pitched with the road's grade (wheels on the slope)
         unless it stands upright (people)."""
@@ -247,14 +258,12 @@ class Pedestrian(TrafficIllusion):
                 return float(np.pi / 2 if r.random() < 0.5 else -np.pi / 2)
             return float(np.pi + r.uniform(-0.6, 0.6))
 
-        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
-        for index, slot in enumerate(self.crowd_slots(ctx, rng, group, share, yaw_of)):
+        def person(index: int) -> Mesh:
             shirt = None if not self.shirt_colors else self.shirt_colors[index % len(self.shirt_colors)]
             height = self.height * float(rng.uniform(0.94, 1.06))
-            mesh = props.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
-            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
-            if placed is not None:
-                self.add(ctx, mesh, placed, index, follow_grade=False)
+            return props.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
+
+        self.add_crowd(ctx, self.crowd_slots(ctx, rng, group, share, yaw_of), person, follow_grade=False)
 
 
 @register
@@ -291,13 +300,11 @@ class Bicycle(TrafficIllusion):
                 return float(r.uniform(-0.05, 0.05) + (np.pi if t > 0 else 0.0))
             return float(np.pi / 2 if r.random() < 0.5 else -np.pi / 2)
 
-        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
-        for index, slot in enumerate(self.crowd_slots(ctx, rng, group, share, yaw_of)):
+        def cyclist(index: int) -> Mesh:
             color = None if not self.frame_colors else self.frame_colors[index % len(self.frame_colors)]
-            mesh = props.bicycle_with_rider(rng, frame_color=color)
-            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
-            if placed is not None:
-                self.add(ctx, mesh, placed, index)
+            return props.bicycle_with_rider(rng, frame_color=color)
+
+        self.add_crowd(ctx, self.crowd_slots(ctx, rng, group, share, yaw_of), cyclist)
 
 
 @register
