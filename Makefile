@@ -5,17 +5,22 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.lanevil-installed
 
-.PHONY: run test test-fast test-slow bench clean
+.PHONY: run preview test test-fast test-slow test-browser bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# The web backend, demo website, study and viser editor, on the stock library (Ctrl+C stops both servers).
 run: $(STAMP)
-	$(PY) -m lanevil_core.cli preview --out out
+	$(PY) -m app.cli serve
 
-test: test-fast test-slow
+# Frame 0 of every stock case (and a labelled copy) under out/.
+preview: $(STAMP)
+	$(PY) -m app.cli preview --out out
+
+test: test-fast test-slow test-browser
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -n auto
@@ -23,6 +28,11 @@ test-fast: $(STAMP)
 # pytest exits 5 when no test carries the mark; that is not a failure.
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -n auto -m slow || test $$? -eq 5
+
+# Headless Debian Chromium driven by Playwright; scripts/install-chromium installs it when missing.
+test-browser: $(STAMP)
+	scripts/install-chromium
+	$(PY) -m pytest -q -m browser || test $$? -eq 5
 
 bench: $(STAMP)
 	$(PY) -m lanevil_core.cli bench

@@ -253,9 +253,9 @@ def build_parser(commands: dict[str, Command]) -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit status (0 ok, 2 user error)."""
-    commands = all_commands()
+def main(argv: Sequence[str] | None = None, extra_commands: dict[str, Command] | None = None) -> int:
+    """Run the command line with ``extra_commands`` added; return the exit status (0 ok, 2 user error)."""
+    commands = {**all_commands(), **(extra_commands or {})}
     try:
         args = build_parser(commands).parse_args(argv)
         return commands[args.command].run(args)

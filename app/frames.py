@@ -1,0 +1,197 @@
+"""Rendering for the web front ends: one service, content-addressed LRU caches, no duplicate work.
+
+Every image the API, the demo site, the editor and the study serve comes from ``FrameService``. A request is keyed
+by the SHA-256 of the canonical case JSON plus frame, size and overlay, so equal requests never render twice, and
+an edited case never gets a stale picture. Compiled scenes are cached too (scrubbing frames of one case compiles
+once). Concurrent requests for the same key wait for the one render in flight.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass
+from typing import Any, Generic, Literal, TypeVar
+
+import numpy as np
+from PIL import Image
+
+from lanevil_core.case import Case, case_json
+from lanevil_core.compile import compile_scene
+from lanevil_core.export import png_bytes
+from lanevil_core.labels import tusimple_record
+from lanevil_core.overlay import draw_lanes
+from lanevil_core.render import render_frame
+from lanevil_core.scene import CompiledScene
+
+ImageFormat = Literal["png", "jpg"]
+MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
+JPEG_QUALITY = 90
+SCENE_CACHE_ENTRIES = 8
+
+K = TypeVar("K", bound=Hashable)
+V = TypeVar("V")
+
+
+class LRUCache(Generic[K, V]):
+    """A thread-safe LRU map bounded by the summed ``weigh(value)`` (bytes, or 1 per entry)."""
+
+    def __init__(self, budget: int, weigh: Callable[[V], int] = lambda value: 1) -> None:
+        self.budget = budget
+        self._weigh = weigh
+        self._items: OrderedDict[K, tuple[V, int]] = OrderedDict()
+        self._total = 0
+        self._lock = threading.Lock()
+        self.hits = 0
+        self.misses = 0
+
+    def get(self, key: K) -> V | None:
+        with self._lock:
+            item = self._items.get(key)
+            if item is None:
+                self.misses += 1
+                return None
+            self._items.move_to_end(key)
+            self.hits += 1
+            return item[0]
+
+    def put(self, key: K, value: V) -> None:
+        weight = self._weigh(value)
+        with self._lock:
+            if key in self._items:
+                self._total -= self._items.pop(key)[1]
+            if weight > self.budget:
+                return
+            self._items[key] = (value, weight)
+            self._total += weight
+            while self._total > self.budget:
+                self._total -= self._items.popitem(last=False)[1][1]
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    @property
+    def total(self) -> int:
+        return self._total
+
+
+def case_hash(case: Case) -> str:
+    """SHA-256 (hex) of the canonical case JSON: the identity of everything rendered from it."""
+    return hashlib.sha256(case_json(case).encode("utf-8")).hexdigest()
+
+
+def apply_overrides(case: Case, severity: int | None = None, sun_azimuth: float | None = None,
+                    sun_altitude: float | None = None, sun_intensity: float | None = None) -> Case:
+    """A copy of ``case`` with every illusion at ``severity`` and/or the sun moved (for scrubbing without saving).
+
+    Values are validated by the case model: an out-of-range override raises ``pydantic.ValidationError``."""
+    data: dict[str, Any] = case.model_dump(mode="json")
+    if severity is not None:
+        for illusion in data["illusions"]:
+            illusion["severity"] = severity
+    for name, value in (("azimuth", sun_azimuth), ("altitude", sun_altitude), ("intensity", sun_intensity)):
+        if value is not None:
+            data["sun"][name] = value
+    return Case.model_validate(data)
+
+
+def encode(rgb: np.ndarray, fmt: ImageFormat) -> bytes:
+    """PNG (no metadata, deterministic) or baseline JPEG bytes of an (H, W, 3) uint8 image."""
+    if fmt == "png":
+        return png_bytes(rgb)
+    buffer = io.BytesIO()
+    Image.fromarray(rgb, "RGB").save(buffer, format="JPEG", quality=JPEG_QUALITY, optimize=True)
+    return buffer.getvalue()
+
+
+@dataclass(frozen=True)
+class RenderedFrame:
+    """A rendered frame (overlay applied if asked) and its TuSimple record, at the size it was rendered."""
+
+    rgb: np.ndarray
+    record: dict[str, Any]
+    key: str
+
+
+@dataclass(frozen=True)
+class EncodedImage:
+    """Image bytes for an HTTP response; ``etag`` is the content key."""
+
+    data: bytes
+    media_type: str
+    etag: str
+
+
+class FrameService:
+    """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
+
+    def __init__(self, cache_bytes: int = 256_000_000) -> None:
+        self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
+        self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
+        self.images: LRUCache[str, EncodedImage] = LRUCache(cache_bytes // 2, lambda item: len(item.data))
+        self._inflight: dict[str, threading.Lock] = {}
+        self._inflight_lock = threading.Lock()
+        self.renders = 0  # frames actually rendered (not served from a cache)
+
+    def _single_flight(self, key: str) -> threading.Lock:
+        with self._inflight_lock:
+            return self._inflight.setdefault(key, threading.Lock())
+
+    def _release(self, key: str) -> None:
+        with self._inflight_lock:
+            self._inflight.pop(key, None)
+
+    def scene(self, case: Case) -> CompiledScene:
+        """The compiled scene of ``case`` (cached by content hash)."""
+        key = case_hash(case)
+        scene = self.scenes.get(key)
+        if scene is None:
+            scene = compile_scene(case)
+            self.scenes.put(key, scene)
+        return scene
+
+    def frame(self, case: Case, index: int, size: tuple[int, int] | None = None,
+              overlay: bool = False) -> RenderedFrame:
+        """Frame ``index`` of ``case`` at ``size`` (default: the case camera's), lane overlay drawn if asked."""
+        if not 0 <= index < case.ego.frames:
+            raise IndexError(f"frame {index} is outside 0..{case.ego.frames - 1}")
+        width, height = size or (case.camera.width, case.camera.height)
+        key = f"{case_hash(case)}:{index}:{width}x{height}:{int(overlay)}"
+        cached = self.frames.get(key)
+        if cached is not None:
+            return cached
+        lock = self._single_flight(key)
+        with lock:
+            cached = self.frames.get(key)
+            if cached is None:
+                cached = self._render(case, index, (width, height), overlay, key)
+                self.frames.put(key, cached)
+        self._release(key)
+        return cached
+
+    def _render(self, case: Case, index: int, size: tuple[int, int], overlay: bool, key: str) -> RenderedFrame:
+        if overlay:  # the overlay is drawn on the plain frame, which is then cached too
+            plain = self.frame(case, index, size, overlay=False)
+            return RenderedFrame(draw_lanes(plain.rgb, plain.record), plain.record, key)
+        scene = self.scene(case)
+        frame = render_frame(scene, index, size)
+        self.renders += 1
+        record = tusimple_record(scene, index, frame, raw_file=f"{index:06d}.png")
+        rgb = np.ascontiguousarray(frame.rgb)
+        rgb.setflags(write=False)
+        return RenderedFrame(rgb, record, key)
+
+    def image(self, case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
+              fmt: ImageFormat = "png") -> EncodedImage:
+        """Encoded bytes of ``frame(...)``, cached by the same key plus the format."""
+        rendered = self.frame(case, index, size, overlay)
+        key = f"{rendered.key}:{fmt}"
+        cached = self.images.get(key)
+        if cached is None:
+            etag = hashlib.sha256(key.encode("ascii")).hexdigest()[:32]
+            cached = EncodedImage(encode(rendered.rgb, fmt), MEDIA_TYPES[fmt], etag)
+            self.images.put(key, cached)
+        return cached

@@ -1,0 +1,127 @@
+"""Background jobs with progress (long exports), so no request hangs while hundreds of frames render.
+
+``JobManager.submit`` runs ``work(progress)`` on a small worker pool; ``progress(done, total)`` updates the job
+that ``GET /api/exports/{job_id}`` and the editor's notifications read. Finished zips live under
+``<data>/exports/<job_id>.zip``.
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+import threading
+import time
+import uuid
+import zipfile
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+from typing import Any, Literal
+
+from lanevil_core.case import Case
+from lanevil_core.export import export_case
+
+JobStatus = Literal["queued", "running", "done", "failed"]
+Progress = Callable[[int, int], None]
+JOB_ID_PATTERN = re.compile(r"^[0-9a-f]{32}$")
+EXPORTS_FOLDER = "exports"
+
+
+class JobNotFound(LookupError):
+    """No job with that id (404)."""
+
+
+@dataclass
+class Job:
+    """One background job; fields are read by pollers while the worker updates them."""
+
+    id: str
+    kind: str
+    total: int
+    done: int = 0
+    status: JobStatus = "queued"
+    error: str | None = None
+    result: Path | None = None
+    created_at: float = field(default_factory=time.time)
+    finished_at: float | None = None
+    finished: threading.Event = field(default_factory=threading.Event, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"id": self.id, "kind": self.kind, "status": self.status, "done": self.done, "total": self.total,
+                "progress": self.done / self.total if self.total else 1.0, "error": self.error,
+                "created_at": self.created_at, "finished_at": self.finished_at}
+
+
+class JobManager:
+    """Runs jobs on ``workers`` threads and keeps their state (and result files under ``root/exports``)."""
+
+    def __init__(self, root: Path, workers: int = 1) -> None:
+        self.folder = Path(root) / EXPORTS_FOLDER
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="lanevil-job")
+        self._jobs: dict[str, Job] = {}
+        self._lock = threading.Lock()
+
+    def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path]) -> Job:
+        """Queue ``work(job, progress) -> result path``; return the job at once."""
+        job = Job(id=uuid.uuid4().hex, kind=kind, total=total)
+        with self._lock:
+            self._jobs[job.id] = job
+        self._pool.submit(self._run, job, work)
+        return job
+
+    def _run(self, job: Job, work: Callable[[Job, Progress], Path]) -> None:
+        job.status = "running"
+
+        def progress(done: int, total: int) -> None:
+            job.done, job.total = done, total
+
+        try:
+            job.result = work(job, progress)
+            job.done = job.total
+            job.status = "done"
+        except Exception as error:  # noqa: BLE001 - a failed job reports its error instead of killing the worker
+            job.error = f"{type(error).__name__}: {error}"
+            job.status = "failed"
+        job.finished_at = time.time()
+        job.finished.set()
+
+    def get(self, job_id: str) -> Job:
+        with self._lock:
+            job = self._jobs.get(job_id) if JOB_ID_PATTERN.fullmatch(job_id or "") else None
+        if job is None:
+            raise JobNotFound(f"no job with id {job_id!r}")
+        return job
+
+    def result_path(self, job_id: str) -> Path:
+        """Where a job's zip goes (the id is checked, so the path stays in the exports folder)."""
+        if not JOB_ID_PATTERN.fullmatch(job_id):
+            raise JobNotFound(f"no job with id {job_id!r}")
+        return self.folder / f"{job_id}.zip"
+
+    def shutdown(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+
+def zip_folder(source: Path, target: Path, prefix: PurePosixPath) -> None:
+    """Zip every file under ``source`` as ``prefix/<relative path>`` (sorted, fixed timestamps), atomically."""
+    partial = target.with_name(f".{target.name}.partial")
+    with zipfile.ZipFile(partial, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for path in sorted(p for p in source.rglob("*") if p.is_file()):
+            info = zipfile.ZipInfo(str(prefix / path.relative_to(source).as_posix()), date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            archive.writestr(info, path.read_bytes())
+    partial.replace(target)
+
+
+def export_zip(case: Case, folder: PurePosixPath, frames: Iterable[int], target: Path,
+               progress: Progress | None = None) -> Path:
+    """Render ``frames`` of ``case`` with TuSimple labels into a zip laid out as the benchmark
+    (``folder/000000.png … labels.json case.json``, ``folder`` = ``Category/Type/case``)."""
+    with tempfile.TemporaryDirectory(prefix="lanevil-export-", dir=target.parent) as scratch:
+        export_case(case, scratch, frames=list(frames), formats={"tusimple"}, progress=progress)
+        zip_folder(Path(scratch), target, folder)
+    return target
+

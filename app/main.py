@@ -1,0 +1,39 @@
+"""The FastAPI application: REST API under ``/api``, the demo website at ``/``, the perception study at ``/study``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from fastapi import FastAPI, HTTPException, Request
+from fastapi.responses import RedirectResponse
+
+from .api import router as api_router
+from .settings import Settings
+from .state import AppState
+from .study import router as study_router
+
+STATIC_DIR = Path(__file__).resolve().parent.parent / "static"
+
+
+def create_app(settings: Settings | None = None, state: AppState | None = None) -> FastAPI:
+    """Build the app around ``state`` (default: opened from ``settings``, default: the environment)."""
+    settings = settings or (state.settings if state else Settings())
+    state = state or AppState.open(settings)
+    app = FastAPI(title="LanEvil Studio", version="0.1.0",
+                  description="Editable 3D lane-detection robustness cases: store, render, export, study.")
+    app.state.lanevil = state
+    app.include_router(api_router, prefix="/api")
+    app.include_router(study_router)
+    app.state.editor_port = None  # set by the server once the viser editor listens
+    app.add_api_route("/editor", _editor_redirect, methods=["GET"], include_in_schema=False)
+    return app
+
+
+def _editor_redirect(request: Request) -> RedirectResponse:
+    """``/editor`` -> the viser editor on the same host name, so users need only the backend's address."""
+    port = request.app.state.editor_port
+    if port is None:
+        raise HTTPException(503, detail="the editor is not running (start it with `lanevil serve`)")
+    host = request.url.hostname or "127.0.0.1"
+    host = f"[{host}]" if ":" in host else host
+    return RedirectResponse(f"{request.url.scheme}://{host}:{port}/", status_code=307)

@@ -1,0 +1,69 @@
+"""One process, one command: the FastAPI backend under uvicorn and the viser editor, sharing one case store.
+
+uvicorn owns the main thread (and its SIGINT/SIGTERM handling); viser runs its own websocket server on a
+background thread. When uvicorn stops, the editor and the job pool are stopped too.
+"""
+
+from __future__ import annotations
+
+import socket
+import sys
+from dataclasses import dataclass
+
+import uvicorn
+
+from .main import create_app
+from .settings import Settings
+from .state import AppState
+
+
+@dataclass(frozen=True)
+class Urls:
+    """Where a running server can be reached."""
+
+    api: str
+    editor: str | None
+
+
+def bind(host: str, port: int) -> socket.socket:
+    """A listening TCP socket on ``host:port`` (port 0: any free port)."""
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    sock.listen(128)
+    sock.set_inheritable(True)
+    return sock
+
+
+def _http_host(host: str) -> str:
+    return f"[{host}]" if ":" in host else host
+
+
+def serve(settings: Settings) -> int:
+    """Run the backend (and the editor, unless ``settings.editor`` is off) until Ctrl+C / SIGTERM."""
+    state = AppState.open(settings)
+    app = create_app(settings, state)
+    sock = bind(settings.host, settings.port)
+    api_port = sock.getsockname()[1]
+    editor = None
+    if settings.editor:
+        from .editor import launch_editor
+
+        editor = launch_editor(state, host=settings.host, port=settings.editor_port)
+        app.state.editor_port = editor.port
+    urls = Urls(api=f"http://{_http_host(settings.host)}:{api_port}/",
+                editor=f"http://{_http_host(settings.host)}:{editor.port}/" if editor else None)
+    print(f"LanEvil Studio: {len(state.store)} cases in {settings.data_dir}", file=sys.stderr)
+    print(f"  website and API  {urls.api}  (API docs {urls.api}docs, study {urls.api}study)", file=sys.stderr)
+    if urls.editor:
+        print(f"  editor           {urls.editor}  (also {urls.api}editor)", file=sys.stderr, flush=True)
+    server = uvicorn.Server(uvicorn.Config(app, log_level="info", timeout_graceful_shutdown=5))
+    try:
+        server.run(sockets=[sock])
+    finally:
+        if editor is not None:
+            editor.stop()
+        state.jobs.shutdown()
+        sock.close()
+    return 0

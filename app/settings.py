@@ -1,0 +1,27 @@
+"""Server settings: from ``LANEVIL_*`` environment variables, overridden by ``lanevil serve`` flags."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+class Settings(BaseSettings):
+    """Everything the backend, the editor and the study read at start-up."""
+
+    model_config = SettingsConfigDict(env_prefix="LANEVIL_", extra="ignore")
+
+    host: str = Field("127.0.0.1", description="address both servers bind (loopback unless set)")
+    port: int = Field(8000, ge=0, le=65535, description="HTTP port of the API, website and study (0 = any free)")
+    editor_port: int = Field(8080, ge=0, le=65535, description="port of the viser editor (0 = any free)")
+    data_dir: Path = Field(Path("data"), description="case store, exports, render cache and study database")
+    scenes_dir: Path = Field(Path("scenes"), description="stock cases copied into an empty store on first start")
+    admin_token: str | None = Field(None, description="bearer token of the perception-study organiser")
+    max_body_bytes: int = Field(2_000_000, ge=1024, description="largest JSON request body")
+    max_upload_bytes: int = Field(20_000_000, ge=1024, description="largest uploaded image")
+    max_width: int = Field(1920, description="largest rendered frame width")
+    max_height: int = Field(1080, description="largest rendered frame height")
+    frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
+    editor: bool = Field(True, description="start the viser editor beside the API")

@@ -1,0 +1,39 @@
+"""What every route and the editor share: settings, the case store, the frame service and the job manager."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from fastapi import Request
+
+from .frames import FrameService
+from .jobs import JobManager
+from .settings import Settings
+from .store import CaseStore
+
+
+@dataclass
+class AppState:
+    """The shared services of one running backend (one per process)."""
+
+    settings: Settings
+    store: CaseStore
+    frames: FrameService
+    jobs: JobManager
+
+    @classmethod
+    def open(cls, settings: Settings) -> AppState:
+        """Open (and on first start seed) the store in ``settings.data_dir``."""
+        data_dir = Path(settings.data_dir)
+        data_dir.mkdir(parents=True, exist_ok=True)
+        store = CaseStore(data_dir)
+        if len(store) == 0 and Path(settings.scenes_dir).is_dir():
+            store.seed_from(Path(settings.scenes_dir))
+        return cls(settings=settings, store=store, frames=FrameService(settings.frame_cache_bytes),
+                   jobs=JobManager(data_dir))
+
+
+def get_state(request: Request) -> AppState:
+    """FastAPI dependency: the ``AppState`` of the app serving this request."""
+    return request.app.state.lanevil

@@ -1,0 +1,120 @@
+"""Shared fixtures of the web tests: an app on a small seeded store, a real uvicorn server, headless Chromium."""
+
+from __future__ import annotations
+
+import shutil
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+import uvicorn
+from fastapi import FastAPI
+from fastapi.testclient import TestClient
+
+from app.main import create_app
+from app.server import bind
+from app.settings import Settings
+from app.state import AppState
+
+REPO = Path(__file__).resolve().parents[2]
+SCENES = REPO / "scenes"
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+# A small store keeps seeding fast: two clean cases and one illusion type's original and levels.
+SMALL_LIBRARY = ["00_clean/00_straight_urban.json", "00_clean/01_bend_suburban.json",
+                 "30_shadow/fence_shadow/00_original.json", "30_shadow/fence_shadow/01_level1.json",
+                 "30_shadow/fence_shadow/03_level3.json", "30_shadow/fence_shadow/05_level5.json"]
+
+
+def small_scenes(target: Path) -> Path:
+    """Copy ``SMALL_LIBRARY`` (same relative paths) under ``target``; return it."""
+    for relative in SMALL_LIBRARY:
+        (target / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(SCENES / relative, target / relative)
+    return target
+
+
+@pytest.fixture
+def settings(tmp_path: Path) -> Settings:
+    """Settings on a fresh data folder seeded from the small library; admin token ``test-admin``."""
+    return Settings(data_dir=tmp_path / "data", scenes_dir=small_scenes(tmp_path / "scenes"), port=0,
+                    editor_port=0, admin_token="test-admin", frame_cache_bytes=64_000_000)
+
+
+@pytest.fixture
+def state(settings: Settings) -> Iterator[AppState]:
+    state = AppState.open(settings)
+    yield state
+    state.jobs.shutdown()
+
+
+@pytest.fixture
+def app(settings: Settings, state: AppState) -> FastAPI:
+    return create_app(settings, state)
+
+
+@pytest.fixture
+def client(app: FastAPI) -> Iterator[TestClient]:
+    with TestClient(app) as test_client:
+        yield test_client
+
+
+@dataclass
+class LiveServer:
+    """A real uvicorn server on a free loopback port, running on a background thread."""
+
+    url: str
+    app: FastAPI
+    state: AppState
+
+
+@pytest.fixture
+def live_server(app: FastAPI, state: AppState) -> Iterator[LiveServer]:
+    sock = bind("127.0.0.1", 0)
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 20
+    while not server.started:
+        if time.monotonic() > deadline or not thread.is_alive():
+            raise RuntimeError("uvicorn did not start")
+        time.sleep(0.02)
+    yield LiveServer(url=f"http://127.0.0.1:{sock.getsockname()[1]}", app=app, state=state)
+    server.should_exit = True
+    thread.join(timeout=10)
+    sock.close()
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """Headless Debian Chromium through Playwright (skipped with a reason when Chromium is not installed)."""
+    if not CHROMIUM.exists():
+        pytest.skip("Debian chromium is not installed (scripts/install-chromium installs it)")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        chromium = playwright.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_ARGS)
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture
+def page(browser):
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    page = context.new_page()
+    yield page
+    context.close()
+
+
+SCREENSHOTS = REPO / "tests" / "web" / "_screenshots"
+
+
+@pytest.fixture
+def screenshot_dir() -> Path:
+    """Where browser tests save what they saw (ignored by git; open the PNGs to look at them)."""
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    return SCREENSHOTS
