@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from fastapi import FastAPI, HTTPException, Request
 from fastapi.responses import RedirectResponse
 
 from .api import router as api_router
 from .settings import Settings
+from .site import mount_static
 from .state import AppState
 from .study import router as study_router
-
-STATIC_DIR = Path(__file__).resolve().parent.parent / "static"
 
 
 def create_app(settings: Settings | None = None, state: AppState | None = None) -> FastAPI:
@@ -24,6 +21,7 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     app.state.lanevil = state
     app.include_router(api_router, prefix="/api")
     app.include_router(study_router)
+    mount_static(app)
     app.state.editor_port = None  # set by the server once the viser editor listens
     app.add_api_route("/editor", _editor_redirect, methods=["GET"], include_in_schema=False)
     return app
