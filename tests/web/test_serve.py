@@ -1,0 +1,66 @@
+"""``lanevil serve`` end to end: one process starts uvicorn and the viser editor, prints both addresses, and
+stops both cleanly on SIGTERM and on Ctrl+C (SIGINT)."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from .conftest import small_scenes
+
+URL_PATTERN = re.compile(r"(website and API|editor)\s+(http://\S+/)")
+
+
+def _start(tmp_path: Path) -> tuple[subprocess.Popen[str], dict[str, str]]:
+    scenes = small_scenes(tmp_path / "scenes")
+    command = [sys.executable, "-m", "app.cli", "serve", "--port", "0", "--editor-port", "0",
+               "--data", str(tmp_path / "data"), "--scenes", str(scenes)]
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    urls: dict[str, str] = {}
+    deadline = time.monotonic() + 120
+    assert process.stderr is not None
+    while len(urls) < 2 and time.monotonic() < deadline:
+        line = process.stderr.readline()
+        if not line:
+            break
+        match = URL_PATTERN.search(line)
+        if match:
+            urls[match.group(1)] = match.group(2)
+    return process, urls
+
+
+def _wait_ready(url: str) -> httpx.Response:
+    deadline = time.monotonic() + 60
+    while True:
+        try:
+            return httpx.get(url, timeout=5)
+        except httpx.TransportError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stop_signal", [signal.SIGTERM, signal.SIGINT])
+def test_serve_runs_backend_and_editor_and_stops_cleanly(tmp_path: Path, stop_signal: signal.Signals) -> None:
+    process, urls = _start(tmp_path)
+    try:
+        assert set(urls) == {"website and API", "editor"}, urls
+        api, editor = urls["website and API"], urls["editor"]
+        assert api.startswith("http://127.0.0.1:") and editor.startswith("http://127.0.0.1:")
+        assert _wait_ready(api + "docs").status_code == 200
+        assert _wait_ready(editor).status_code == 200  # viser serves its client page over HTTP too
+        redirect = httpx.get(api + "editor", follow_redirects=False)
+        assert redirect.status_code == 307 and redirect.headers["location"] == editor
+        assert (tmp_path / "data" / "cases" / "fence_shadow-03_level3.json").is_file()
+    finally:
+        process.send_signal(stop_signal)
+        code = process.wait(timeout=30)
+    assert code == 0
