@@ -19,10 +19,11 @@ from typing import Any, Generic, Literal, TypeVar
 import numpy as np
 from PIL import Image
 
+from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
 from lanevil_core.compile import compile_scene
 from lanevil_core.export import png_bytes
-from lanevil_core.labels import tusimple_record
+from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
 from lanevil_core.overlay import draw_lanes
 from lanevil_core.render import render_frame
 from lanevil_core.scene import CompiledScene
@@ -31,6 +32,7 @@ ImageFormat = Literal["png", "jpg"]
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
 JPEG_QUALITY = 90
 SCENE_CACHE_ENTRIES = 8
+CULANE_CACHE_ENTRIES = 2048  # label texts are small (< 1 kB)
 
 K = TypeVar("K", bound=Hashable)
 V = TypeVar("V")
@@ -83,6 +85,11 @@ def case_hash(case: Case) -> str:
     return hashlib.sha256(case_json(case).encode("utf-8")).hexdigest()
 
 
+def camera_size(case: Case) -> tuple[int, int]:
+    """(width, height) of the case camera: the size a frame renders at unless asked otherwise."""
+    return case.camera.width, case.camera.height
+
+
 def apply_overrides(case: Case, severity: int | None = None, sun_azimuth: float | None = None,
                     sun_altitude: float | None = None, sun_intensity: float | None = None) -> Case:
     """A copy of ``case`` with every illusion at ``severity`` and/or the sun moved (for scrubbing without saving).
@@ -132,6 +139,7 @@ class FrameService:
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
         self.images: LRUCache[str, EncodedImage] = LRUCache(cache_bytes // 2, lambda item: len(item.data))
+        self.culane: LRUCache[str, str] = LRUCache(CULANE_CACHE_ENTRIES)
         self._inflight: dict[str, threading.Lock] = {}
         self._inflight_lock = threading.Lock()
         self.renders = 0  # frames actually rendered (not served from a cache)
@@ -153,13 +161,24 @@ class FrameService:
             self.scenes.put(key, scene)
         return scene
 
+    @staticmethod
+    def frame_key(case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False) -> str:
+        """Cache key of a rendered frame: case content hash, frame, size (default: the camera's), overlay."""
+        width, height = size or camera_size(case)
+        return f"{case_hash(case)}:{index}:{width}x{height}:{int(overlay)}"
+
+    def image_etag(self, case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
+                   fmt: ImageFormat = "png") -> str:
+        """The ETag ``image(...)`` will carry, known without rendering (so a 304 costs no render)."""
+        key = f"{self.frame_key(case, index, size, overlay)}:{fmt}"
+        return hashlib.sha256(key.encode("ascii")).hexdigest()[:32]
+
     def frame(self, case: Case, index: int, size: tuple[int, int] | None = None,
               overlay: bool = False) -> RenderedFrame:
         """Frame ``index`` of ``case`` at ``size`` (default: the case camera's), lane overlay drawn if asked."""
         if not 0 <= index < case.ego.frames:
             raise IndexError(f"frame {index} is outside 0..{case.ego.frames - 1}")
-        width, height = size or (case.camera.width, case.camera.height)
-        key = f"{case_hash(case)}:{index}:{width}x{height}:{int(overlay)}"
+        key = self.frame_key(case, index, size, overlay)
         cached = self.frames.get(key)
         if cached is not None:
             return cached
@@ -167,7 +186,7 @@ class FrameService:
         with lock:
             cached = self.frames.get(key)
             if cached is None:
-                cached = self._render(case, index, (width, height), overlay, key)
+                cached = self._render(case, index, size or camera_size(case), overlay, key)
                 self.frames.put(key, cached)
         self._release(key)
         return cached
@@ -179,7 +198,7 @@ class FrameService:
         scene = self.scene(case)
         frame = render_frame(scene, index, size)
         self.renders += 1
-        record = tusimple_record(scene, index, frame, raw_file=f"{index:06d}.png")
+        record = tusimple_record(scene, index, frame, raw_file=frame_file(index))
         rgb = np.ascontiguousarray(frame.rgb)
         rgb.setflags(write=False)
         return RenderedFrame(rgb, record, key)
@@ -187,11 +206,24 @@ class FrameService:
     def image(self, case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
               fmt: ImageFormat = "png") -> EncodedImage:
         """Encoded bytes of ``frame(...)``, cached by the same key plus the format."""
-        rendered = self.frame(case, index, size, overlay)
-        key = f"{rendered.key}:{fmt}"
+        key = f"{self.frame_key(case, index, size, overlay)}:{fmt}"
         cached = self.images.get(key)
         if cached is None:
-            etag = hashlib.sha256(key.encode("ascii")).hexdigest()[:32]
-            cached = EncodedImage(encode(rendered.rgb, fmt), MEDIA_TYPES[fmt], etag)
+            rendered = self.frame(case, index, size, overlay)
+            cached = EncodedImage(encode(rendered.rgb, fmt), MEDIA_TYPES[fmt], self.image_etag(case, index, size,
+                                                                                                 overlay, fmt))
             self.images.put(key, cached)
         return cached
+
+    def culane_lines(self, case: Case, index: int) -> str:
+        """CULane ``.lines.txt`` text of frame ``index``, from a render at ``CULANE_SIZE`` (cached)."""
+        if not 0 <= index < case.ego.frames:
+            raise IndexError(f"frame {index} is outside 0..{case.ego.frames - 1}")
+        key = f"{case_hash(case)}:{index}:culane"
+        lines = self.culane.get(key)
+        if lines is None:
+            scene = self.scene(case)
+            lines = culane_lines(scene, render_frame(scene, index, CULANE_SIZE))
+            self.renders += 1
+            self.culane.put(key, lines)
+        return lines

@@ -22,7 +22,7 @@ from typing import Any, Literal
 from lanevil_core.case import Case
 from lanevil_core.export import export_case
 
-JobStatus = Literal["queued", "running", "done", "failed"]
+JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
 Progress = Callable[[int, int], None]
 JOB_ID_PATTERN = re.compile(r"^[0-9a-f]{32}$")
 EXPORTS_FOLDER = "exports"
@@ -30,6 +30,10 @@ EXPORTS_FOLDER = "exports"
 
 class JobNotFound(LookupError):
     """No job with that id (404)."""
+
+
+class JobCancelled(Exception):
+    """Raised inside a job's ``progress`` callback once the job was cancelled, to stop its work."""
 
 
 @dataclass
@@ -45,11 +49,13 @@ class Job:
     result: Path | None = None
     created_at: float = field(default_factory=time.time)
     finished_at: float | None = None
+    meta: dict[str, Any] = field(default_factory=dict)  # what the job works on (e.g. case id and frames)
     finished: threading.Event = field(default_factory=threading.Event, repr=False)
+    cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"id": self.id, "kind": self.kind, "status": self.status, "done": self.done, "total": self.total,
-                "progress": self.done / self.total if self.total else 1.0, "error": self.error,
+        return {**self.meta, "id": self.id, "kind": self.kind, "status": self.status, "done": self.done,
+                "total": self.total, "progress": self.done / self.total if self.total else 1.0, "error": self.error,
                 "created_at": self.created_at, "finished_at": self.finished_at}
 
 
@@ -63,24 +69,34 @@ class JobManager:
         self._jobs: dict[str, Job] = {}
         self._lock = threading.Lock()
 
-    def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path]) -> Job:
-        """Queue ``work(job, progress) -> result path``; return the job at once."""
-        job = Job(id=uuid.uuid4().hex, kind=kind, total=total)
+    def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path],
+               meta: dict[str, Any] | None = None) -> Job:
+        """Queue ``work(job, progress) -> result path``; return the job at once. ``meta`` is reported with it."""
+        job = Job(id=uuid.uuid4().hex, kind=kind, total=total, meta=dict(meta or {}))
         with self._lock:
             self._jobs[job.id] = job
         self._pool.submit(self._run, job, work)
         return job
 
     def _run(self, job: Job, work: Callable[[Job, Progress], Path]) -> None:
+        if job.cancel_requested.is_set():
+            job.status = "cancelled"
+            job.finished_at = time.time()
+            job.finished.set()
+            return
         job.status = "running"
 
         def progress(done: int, total: int) -> None:
             job.done, job.total = done, total
+            if job.cancel_requested.is_set():
+                raise JobCancelled(job.id)
 
         try:
             job.result = work(job, progress)
             job.done = job.total
             job.status = "done"
+        except JobCancelled:
+            job.status = "cancelled"
         except Exception as error:  # noqa: BLE001 - a failed job reports its error instead of killing the worker
             job.error = f"{type(error).__name__}: {error}"
             job.status = "failed"
@@ -100,8 +116,20 @@ class JobManager:
             raise JobNotFound(f"no job with id {job_id!r}")
         return self.folder / f"{job_id}.zip"
 
-    def shutdown(self) -> None:
-        self._pool.shutdown(wait=False, cancel_futures=True)
+    def cancel(self, job_id: str) -> Job:
+        """Ask a job to stop: a queued job never starts, a running one stops at its next progress report."""
+        job = self.get(job_id)
+        if job.status in ("queued", "running"):
+            job.cancel_requested.set()
+        return job
+
+    def shutdown(self, wait: bool = False) -> None:
+        """Cancel every unfinished job and stop the workers (a running job stops at its next frame)."""
+        with self._lock:
+            jobs = list(self._jobs.values())
+        for job in jobs:
+            job.cancel_requested.set()
+        self._pool.shutdown(wait=wait, cancel_futures=True)
 
 
 def zip_folder(source: Path, target: Path, prefix: PurePosixPath) -> None:

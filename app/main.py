@@ -5,10 +5,14 @@ from __future__ import annotations
 from fastapi import FastAPI, HTTPException, Request
 from fastapi.responses import RedirectResponse
 
+from .api import BodyLimitMiddleware
 from .api import router as api_router
+from .api.errors import handle_exception
+from .jobs import JobNotFound
 from .settings import Settings
 from .site import mount_static
 from .state import AppState
+from .store import StoreError
 from .study import router as study_router
 
 
@@ -19,6 +23,10 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     app = FastAPI(title="LanEvil Studio", version="0.1.0",
                   description="Editable 3D lane-detection robustness cases: store, render, export, study.")
     app.state.lanevil = state
+    app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes,
+                       max_upload_bytes=settings.max_upload_bytes)
+    for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route
+        app.add_exception_handler(error, handle_exception)
     app.include_router(api_router, prefix="/api")
     app.include_router(study_router)
     mount_static(app)

@@ -1,0 +1,135 @@
+"""Request parameters shared by several routes: frame ranges, image sizes, versions, ETags, render options."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+from fastapi import Depends, Query
+from pydantic import ValidationError
+
+from lanevil_core.case import Case
+
+from ..frames import apply_overrides
+from ..settings import Settings
+from .errors import ApiError, first_error
+
+ImageFormat = Literal["png", "jpg"]
+MIN_SIZE = 64  # smallest rendered width or height (the case camera's lower bound)
+# pydantic locations of the override fields in a case -> the query parameter that set them
+OVERRIDE_FIELDS: dict[tuple[str, ...], str] = {("sun", "azimuth"): "sun_azimuth", ("sun", "altitude"): "sun_altitude",
+                                               ("sun", "intensity"): "sun_intensity"}
+
+
+def frame_range(text: str | None, frames: int, default: range, limit: int | None = None) -> range:
+    """``A:B`` (half-open, either end optional: ``:10``, ``90:``) or a single frame ``N`` -> a range of frames
+    of a case with ``frames`` frames; at most ``limit`` frames. Errors name ``frames``."""
+    if text is None or not text.strip():
+        chosen = default
+    else:
+        chosen = _parse_range(text.strip(), frames)
+    if limit is not None and len(chosen) > limit:
+        raise ApiError(422, f"at most {limit} frames per request (asked for {len(chosen)}: {chosen.start}:"
+                            f"{chosen.stop})", "frames")
+    return chosen
+
+
+def _parse_range(text: str, frames: int) -> range:
+    parts = text.split(":")
+    try:
+        if len(parts) == 1:
+            start = int(parts[0])
+            stop = start + 1
+        elif len(parts) == 2:
+            start = int(parts[0]) if parts[0].strip() else 0
+            stop = int(parts[1]) if parts[1].strip() else frames
+        else:
+            raise ValueError
+    except ValueError:
+        raise ApiError(422, f"{text!r} is not START:STOP or N (e.g. 0:20)", "frames") from None
+    if not 0 <= start < stop <= frames:
+        raise ApiError(422, f"{text!r} must satisfy 0 <= START < STOP <= {frames} (the case has {frames} frames)",
+                       "frames")
+    return range(start, stop)
+
+
+def image_size(width: int | None, height: int | None, case: Case, settings: Settings) -> tuple[int, int]:
+    """The requested (width, height) — both or neither (then the case camera's) — within 64..the server's max."""
+    if (width is None) != (height is None):
+        missing = "height" if height is None else "width"
+        raise ApiError(422, "give width and height together (or neither, for the case camera's size)", missing)
+    if width is None or height is None:
+        width, height = case.camera.width, case.camera.height
+        return min(width, settings.max_width), min(height, settings.max_height)
+    for name, value, largest in (("width", width, settings.max_width), ("height", height, settings.max_height)):
+        if not MIN_SIZE <= value <= largest:
+            raise ApiError(422, f"{value} is outside {MIN_SIZE}..{largest}", name)
+    return width, height
+
+
+def check_frame(case: Case, frame: int, status_code: int = 422) -> int:
+    if not 0 <= frame < case.ego.frames:
+        raise ApiError(status_code, f"{frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} "
+                                    "frames)", "frame")
+    return frame
+
+
+def parse_version(text: str | None, field: str = "If-Match") -> int | None:
+    """A version from ``If-Match`` (``"3"``, ``W/"3"``, ``3``; ``*`` = any version -> None)."""
+    if text is None:
+        return None
+    value = text.strip()
+    if value == "*":
+        return None
+    value = value.removeprefix("W/").strip('"')
+    if not value.isdigit():
+        raise ApiError(422, f"{text!r} is not a case version (send the ETag of the case, e.g. \"3\")", field)
+    return int(value)
+
+
+def etag_matches(if_none_match: str | None, etag: str) -> bool:
+    """Whether an ``If-None-Match`` header names ``etag`` (quoted or not, weak or strong) or is ``*``."""
+    if not if_none_match:
+        return False
+    tags = [tag.strip().removeprefix("W/").strip('"') for tag in if_none_match.split(",")]
+    return "*" in tags or etag in tags
+
+
+@dataclass(frozen=True)
+class RenderQuery:
+    """The query parameters of an image request."""
+
+    overlay: bool
+    width: int | None
+    height: int | None
+    severity: int | None
+    sun_azimuth: float | None
+    sun_altitude: float | None
+    sun_intensity: float | None
+
+    def apply(self, case: Case) -> Case:
+        """``case`` with the overrides applied; an out-of-range override is a 422 naming its query parameter."""
+        if (self.severity, self.sun_azimuth, self.sun_altitude, self.sun_intensity) == (None, None, None, None):
+            return case
+        try:
+            return apply_overrides(case, self.severity, self.sun_azimuth, self.sun_altitude, self.sun_intensity)
+        except ValidationError as error:
+            loc = tuple(str(part) for part in error.errors()[0].get("loc", ()))
+            field, message = first_error(error.errors())
+            name = OVERRIDE_FIELDS.get(loc, "severity" if "severity" in loc else field)
+            raise ApiError(422, message, name) from None
+
+
+def render_query(
+    overlay: Annotated[bool, Query(description="draw the TuSimple lane labels on the image")] = False,
+    width: Annotated[int | None, Query(description="image width (with height; default: the case camera's)")] = None,
+    height: Annotated[int | None, Query(description="image height (with width)")] = None,
+    severity: Annotated[int | None, Query(ge=1, le=5, description="render every illusion at this level")] = None,
+    sun_azimuth: Annotated[float | None, Query(description="sun azimuth override (degrees)")] = None,
+    sun_altitude: Annotated[float | None, Query(description="sun altitude override (degrees)")] = None,
+    sun_intensity: Annotated[float | None, Query(description="sun intensity override")] = None,
+) -> RenderQuery:
+    return RenderQuery(overlay, width, height, severity, sun_azimuth, sun_altitude, sun_intensity)
+
+
+RenderQueryDep = Annotated[RenderQuery, Depends(render_query)]

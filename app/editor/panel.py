@@ -1,0 +1,120 @@
+"""The editor's control panel: every input, with short help, laid out in folders (no behaviour here).
+
+``build_panel`` creates the inputs in the shared (all-tabs) GUI and returns their handles; ``editor.Editor`` wires
+their callbacks. Inputs start at sensible defaults and carry hover hints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import viser
+
+from lanevil_core.illusions import ILLUSION_TYPES
+from lanevil_core.presets import PRESET_NAMES
+from lanevil_core.typed import ROAD_TYPES, SCENE_KINDS
+
+from .params import ParamInputs
+from .preview import PREVIEW_SIZE
+
+PLACE_OFF = "(pick a type, then click the road)"
+NO_SELECTION = "(none)"
+CUSTOM_WEATHER = "(as in the case)"
+HELP = """**LanEvil editor** — build a lane-detection test case in 3D.
+
+1. *Case*: open a stored case or create one from a road template.
+2. *Illusions*: pick a type under **Place**, then click the road. Select one to move it with the arrows,
+   change its severity (1 subtle – 5 most deceptive) and parameters, or delete it.
+3. *Sun & weather*, *Frame*: scrub and watch the camera preview.
+4. **Save** writes the case (Ctrl+Z / Ctrl+Shift+Z undo and redo); *Export* downloads it.
+"""
+
+
+@dataclass
+class Panel:
+    """Handles of every panel input."""
+
+    status: viser.GuiMarkdownHandle
+    case_id: viser.GuiDropdownHandle
+    title: viser.GuiTextHandle
+    save: viser.GuiButtonHandle
+    save_copy: viser.GuiButtonHandle
+    reload: viser.GuiButtonHandle
+    undo: viser.GuiButtonHandle
+    redo: viser.GuiButtonHandle
+    template: viser.GuiDropdownHandle
+    scene_kind: viser.GuiDropdownHandle
+    create: viser.GuiButtonHandle
+    place: viser.GuiDropdownHandle
+    selected: viser.GuiDropdownHandle
+    severity: viser.GuiSliderHandle
+    delete: viser.GuiButtonHandle
+    params: ParamInputs
+    sun_azimuth: viser.GuiSliderHandle
+    sun_altitude: viser.GuiSliderHandle
+    sun_intensity: viser.GuiSliderHandle
+    weather: viser.GuiDropdownHandle
+    frame: viser.GuiSliderHandle
+    play: viser.GuiCheckboxHandle
+    overlay: viser.GuiCheckboxHandle
+    preview: viser.GuiImageHandle
+    preview_info: viser.GuiMarkdownHandle
+    export_case: viser.GuiButtonHandle
+    export_frame: viser.GuiButtonHandle
+    export_sequence: viser.GuiButtonHandle
+
+
+def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
+    """Create the panel's inputs (in display order) and return their handles."""
+    gui.configure_theme(control_width="large", show_share_button=False, brand_color=(214, 98, 32))
+    gui.set_panel_label("LanEvil editor")
+    with gui.add_folder("Help", expand_by_default=False):
+        gui.add_markdown(HELP)
+    status = gui.add_markdown("Opening…")
+    preview = gui.add_image(np.full((PREVIEW_SIZE[1], PREVIEW_SIZE[0], 3), 200, np.uint8), label="Camera preview",
+                            format="jpeg", jpeg_quality=90)
+    preview_info = gui.add_markdown("")
+    with gui.add_folder("Frame"):
+        frame = gui.add_slider("Frame", 0, 99, 1, 0, hint="frame of the ego drive shown in the preview")
+        play = gui.add_checkbox("Play", False, hint="step through the frames (loops)")
+        overlay = gui.add_checkbox("Lane overlay", True, hint="draw the ground-truth lanes on the preview")
+    with gui.add_folder("Case"):
+        case_id = gui.add_dropdown("Open", case_ids or ["(no cases)"], hint="stored cases; choosing one opens it")
+        title = gui.add_text("Title", "", hint="the case's title (saved with it)")
+        save = gui.add_button("Save", icon=viser.Icon.DEVICE_FLOPPY, hint="write to the store (version-checked)")
+        undo, redo = gui.add_button("Undo", icon=viser.Icon.ARROW_BACK_UP, hint="Ctrl+Z"), \
+            gui.add_button("Redo", icon=viser.Icon.ARROW_FORWARD_UP, hint="Ctrl+Shift+Z")
+        reload = gui.add_button("Reload stored version", hint="take the stored case (Undo brings your edits back)")
+        save_copy = gui.add_button("Save as new case", hint="store your edits under a new id")
+    with gui.add_folder("New case", expand_by_default=False):
+        template = gui.add_dropdown("Road", list(ROAD_TYPES), initial_value="straight", hint="road template")
+        scene_kind = gui.add_dropdown("Roadside", list(SCENE_KINDS), initial_value="suburban")
+        create = gui.add_button("Create and open", icon=viser.Icon.PLUS)
+    with gui.add_folder("Illusions"):
+        place = gui.add_dropdown("Place", [PLACE_OFF, *ILLUSION_TYPES],
+                                 hint="pick a type, then click the road in the 3D view to put it there")
+        selected = gui.add_dropdown("Selected", [NO_SELECTION], hint="the illusion the sliders below edit")
+        severity = gui.add_slider("Severity", 1, 5, 1, 3, marks=((1, "subtle"), (3, "3"), (5, "strong")),
+                                  hint="1 = subtle … 5 = most deceptive", disabled=True)
+        delete = gui.add_button("Delete illusion", icon=viser.Icon.TRASH, color="red", disabled=True)
+        params_folder = gui.add_folder("Parameters", expand_by_default=False)
+    with gui.add_folder("Sun & weather"):
+        sun_azimuth = gui.add_slider("Sun azimuth", -180.0, 180.0, 1.0, 30.0,
+                                     hint="degrees counter-clockwise from the road's start heading (90 = left)")
+        sun_altitude = gui.add_slider("Sun altitude", -10.0, 90.0, 1.0, 45.0, hint="degrees above the horizon")
+        sun_intensity = gui.add_slider("Sun intensity", 0.0, 3.0, 0.05, 1.0, hint="1 = clear noon")
+        weather = gui.add_dropdown("Weather preset", [CUSTOM_WEATHER, *PRESET_NAMES],
+                                   hint="fills cloud, rain, puddles, fog and the sun's height")
+    with gui.add_folder("Export", expand_by_default=False):
+        export_case = gui.add_button("Case JSON", icon=viser.Icon.FILE_DOWNLOAD)
+        export_frame = gui.add_button("Current frame (PNG + labels)", icon=viser.Icon.PHOTO)
+        export_sequence = gui.add_button("Whole sequence (zip)", icon=viser.Icon.FILE_ZIP,
+                                         hint="renders every frame with TuSimple labels in the background")
+    return Panel(status=status, case_id=case_id, title=title, save=save, save_copy=save_copy, reload=reload,
+                 undo=undo, redo=redo, template=template, scene_kind=scene_kind, create=create, place=place,
+                 selected=selected, severity=severity, delete=delete,
+                 params=ParamInputs(gui, params_folder, lambda name, value: None),
+                 sun_azimuth=sun_azimuth, sun_altitude=sun_altitude, sun_intensity=sun_intensity, weather=weather,
+                 frame=frame, play=play, overlay=overlay, preview=preview, preview_info=preview_info,
+                 export_case=export_case, export_frame=export_frame, export_sequence=export_sequence)

@@ -1,0 +1,30 @@
+"""The organiser's bearer token (``settings.admin_token``, env ``LANEVIL_ADMIN_TOKEN``) guarding study admin routes."""
+
+from __future__ import annotations
+
+import hmac
+from typing import Annotated
+
+from fastapi import Depends, Header
+
+from ..api.errors import ApiError
+from ..state import AppState, get_state
+
+
+def require_admin(state: Annotated[AppState, Depends(get_state)],
+                  authorization: Annotated[str | None, Header()] = None) -> None:
+    """Pass when ``Authorization: Bearer <token>`` matches the configured token (constant-time compare).
+
+    403 when no token is configured (admin routes are then closed), 401 for a missing or wrong token."""
+    token = state.settings.admin_token
+    if not token:
+        raise ApiError(403, "no organiser token is configured: set LANEVIL_ADMIN_TOKEN (e.g. "
+                            "`LANEVIL_ADMIN_TOKEN=$(openssl rand -hex 16) lanevil serve`) and send it as "
+                            "`Authorization: Bearer <token>`", "authorization")
+    scheme, _, given = (authorization or "").partition(" ")
+    if scheme.lower() != "bearer" or not hmac.compare_digest(given.strip().encode(), token.encode()):
+        raise ApiError(401, "send the organiser token as `Authorization: Bearer <token>`", "authorization",
+                       headers={"WWW-Authenticate": "Bearer"})
+
+
+AdminDep = Annotated[None, Depends(require_admin)]

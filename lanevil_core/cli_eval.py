@@ -1,0 +1,100 @@
+"""``lanevil eval``, ``lanevil detect`` and ``lanevil report``: metrics, classical baselines, robustness tables."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .case import write_atomic
+from .cli import Command, UsageError
+from .metrics.formats import LaneFileError
+from .metrics.tusimple import F1_VARIANTS
+
+METRIC_CHOICES = ("tusimple", "culane")
+
+
+def _eval_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--gt", type=Path, required=True,
+                        help="ground truth: TuSimple JSON lines, or a folder of CULane .lines.txt files")
+    parser.add_argument("--pred", type=Path, required=True, help="predictions in the same format as --gt")
+    parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple", help="default tusimple")
+    parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet",
+                        help="TuSimple F1 variant: ganet (P = 1-FP, R = 1-FN) or clrnet (default ganet)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _format_eval(result: dict) -> str:
+    if result["metric"] == "tusimple":
+        return (f"TuSimple  images {result['images']}  Accuracy {100 * result['accuracy']:.2f} %  "
+                f"FP {result['fp']:.4f}  FN {result['fn']:.4f}  F1({result['f1_variant']}) {100 * result['f1']:.2f} %")
+    return (f"CULane IoU>{result['iou_threshold']}  images {result['images']}  TP {result['tp']}  FP {result['fp']}  "
+            f"FN {result['fn']}  P {100 * result['precision']:.2f} %  R {100 * result['recall']:.2f} %  "
+            f"F1 {100 * result['f1']:.2f} %")
+
+
+def _run_eval(args: argparse.Namespace) -> int:
+    from .metrics.evaluate import evaluate
+
+    try:
+        result = evaluate(args.gt, args.pred, args.metric, args.f1)
+    except LaneFileError as error:
+        raise UsageError(str(error)) from None
+    print(json.dumps(result) if args.json else _format_eval(result))
+    return 0
+
+
+def _detect_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or images")
+    parser.add_argument("--method", choices=("hough", "birdseye"), required=True, help="classical baseline")
+    parser.add_argument("--out", type=Path, required=True, help="predictions file (TuSimple JSON lines)")
+    parser.add_argument("--fixed-run-time", type=float, default=None, metavar="MS",
+                        help="write this run_time instead of the measured one (byte-reproducible output)")
+
+
+def _run_detect(args: argparse.Namespace) -> int:
+    from .detect import detect_split
+
+    def progress(done: int, total: int) -> None:
+        if done % 50 == 0 or done == total:
+            print(f"\rimage {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
+
+    try:
+        records = detect_split(args.split, args.method, progress, args.fixed_run_time)
+    except LaneFileError as error:
+        raise UsageError(str(error)) from None
+    write_atomic(args.out, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
+    print(f"{len(records)} predictions in {args.out}")
+    return 0
+
+
+def _report_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--gt", type=Path, required=True, help="split folder (e.g. DATASET/test)")
+    parser.add_argument("--pred", type=Path, required=True, help="predictions (TuSimple JSON lines)")
+    parser.add_argument("--out", type=Path, required=True, help="report folder")
+    parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet", help="F1 variant (default ganet)")
+    parser.add_argument("--title", default=None, help="report title (default: from the prediction file name)")
+
+
+def _run_report(args: argparse.Namespace) -> int:
+    from .metrics.evaluate import score_tusimple_files
+    from .metrics.formats import split_labels
+    from .report import build_report, write_report
+
+    try:
+        images = score_tusimple_files(split_labels(args.gt), args.pred)
+    except LaneFileError as error:
+        raise UsageError(str(error)) from None
+    title = args.title or f"Robustness report: {args.pred.stem}"
+    for path in write_report(build_report(images, args.f1, title), args.out):
+        print(path)
+    return 0
+
+
+COMMANDS: dict[str, Command] = {
+    "eval": Command("score predictions with the TuSimple or CULane metric", _eval_arguments, _run_eval),
+    "detect": Command("run a classical lane detector over a split folder", _detect_arguments, _run_detect),
+    "report": Command("robustness tables and plot: original vs perturbed per category, type and severity",
+                      _report_arguments, _run_report),
+}

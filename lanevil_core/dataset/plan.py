@@ -1,0 +1,284 @@
+"""Which frames of which cases go where: the test split from case files, the train split from clean variations.
+
+A plan is pure data computed in one process from the case files, the settings and a seed; every worker (a local
+process or a Dask worker) receives its share as ``RenderTask`` values, so the same plan gives the same files
+whatever runs it.
+
+- Test split: every case with an illusion type (its own first illusion's, or for an original with no illusion
+  the type named by its folder, ``.../fence_shadow/00_original.json``) lands in
+  ``test/<Category>/<Type>/<case file stem>/``.
+- Train split: the clean cases (no illusion, no type folder) are the bases of deterministic variations (weather
+  preset, sun angles, seed, ego lane and start, line types), ``TRAIN_FRAMES_PER_VARIANT`` frames each, in
+  ``train/<nnnnn>_<base>_<preset>/``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+from typing import Any
+
+import numpy as np
+
+from ..benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, case_folder, case_illusion_type, frame_file
+from ..case import Case, case_json, load_case, parse_case
+from ..illusions import REGISTRY
+from ..presets import PRESET_NAMES, preset_values
+from ..typed import LineType
+
+TEST_SPLIT = "test"
+TRAIN_SPLIT = "train"
+SPLIT_LABELS = {TEST_SPLIT: "test_label.json", TRAIN_SPLIT: "train_label.json"}
+CLEAN_CATEGORY = "Clean"
+FORMATS: dict[str, str] = {"png": ".png", "jpg": ".jpg"}  # --format -> frame file suffix
+
+TRAIN_FRAMES_PER_VARIANT = 5  # frames of one train variation, evenly spaced over its drive
+CHUNK_FRAMES = 4  # frames per render task: one scene compile (~0.25 s) amortised over ~1.5 s of rendering
+END_MARGIN_M = 60.0  # road the case validator keeps ahead of the last frame
+SUN_ALTITUDE_JITTER_DEG = 10.0
+LANE_LINE_CHOICES: tuple[LineType, ...] = ("white_dashed", "white_solid", "botts_dots", "white_solid_dashed")
+CENTRE_LINE_CHOICES: tuple[LineType, ...] = (
+    "yellow_double_solid", "yellow_solid", "yellow_dashed", "yellow_solid_dashed", "white_double_solid",
+)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What a dataset run renders: frame size (width, height), image format, frames per test case (None = all),
+    total train frames and the seed of the train variations."""
+
+    size: tuple[int, int] = (1280, 720)
+    image_format: str = "png"
+    frames_per_case: int | None = None
+    train_frames: int = 0
+    seed: int = 0
+
+    @property
+    def suffix(self) -> str:
+        """Frame file suffix, ``.png`` or ``.jpg``."""
+        return FORMATS[self.image_format]
+
+
+@dataclass(frozen=True)
+class SourceCase:
+    """A case file found under the cases folder: its path relative to that folder and the parsed case."""
+
+    relative: PurePosixPath
+    case: Case
+
+    @property
+    def folder_type(self) -> str | None:
+        """The illusion type named by the file's folder (``fence_shadow/00_original.json``), if any."""
+        parent = self.relative.parent.name
+        return parent if parent in REGISTRY else None
+
+
+@dataclass(frozen=True)
+class PlannedCase:
+    """One case folder of the output: which case, which frames, and the label fields of its records.
+
+    Attributes:
+        split: ``test`` or ``train``.
+        folder: case folder relative to the split folder, e.g. ``Shadow/Fence/03_level3``.
+        case_text: canonical case JSON (``case_json``); its sha256 identifies the case.
+        frames: case frame indices rendered, ascending.
+        illusion_type: registry type (None for train variations).
+        category, type_folder: benchmark folder names (``Clean`` and None for train variations).
+        severity: the first illusion's severity, 0 for originals and clean cases.
+        source: where the case came from (a case file, or a train variation's base and parameters).
+    """
+
+    split: str
+    folder: PurePosixPath
+    case_text: str
+    frames: tuple[int, ...]
+    illusion_type: str | None
+    category: str
+    type_folder: str | None
+    severity: int
+    source: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def case_sha256(self) -> str:
+        """sha256 of the canonical case JSON."""
+        return hashlib.sha256(self.case_text.encode("utf-8")).hexdigest()
+
+    @property
+    def seed(self) -> int:
+        """The case's own seed."""
+        return parse_case(self.case_text).seed
+
+    def record_extras(self) -> dict[str, Any]:
+        """Fields every TuSimple record of this case carries besides the standard ones."""
+        return {"category": self.category, "type": self.type_folder, "severity": self.severity,
+                "case": str(self.folder), "illusion": self.illusion_type, "split": self.split}
+
+    def raw_file(self, frame_index: int, suffix: str) -> str:
+        """Frame path relative to the split folder, e.g. ``Shadow/Fence/03_level3/000000.png``."""
+        return str(self.folder / frame_file(frame_index, suffix))
+
+
+@dataclass(frozen=True)
+class RenderTask:
+    """A chunk of frames of one case, everything a worker needs (plain data, picklable)."""
+
+    split: str
+    folder: str
+    case_text: str
+    case_sha256: str
+    frames: tuple[int, ...]
+    size: tuple[int, int]
+    image_format: str
+    extras: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class DatasetPlan:
+    """Every case folder of a run, test split first, in a fixed order."""
+
+    settings: Settings
+    cases: tuple[PlannedCase, ...]
+
+    @property
+    def total_frames(self) -> int:
+        """Frames in the plan."""
+        return sum(len(case.frames) for case in self.cases)
+
+    def split_cases(self, split: str) -> list[PlannedCase]:
+        """The planned cases of one split, in plan order."""
+        return [case for case in self.cases if case.split == split]
+
+
+class PlanError(ValueError):
+    """A run that cannot be planned (no cases, clashing folders, no clean case for the train split)."""
+
+
+def evenly_spaced(total: int, count: int | None) -> tuple[int, ...]:
+    """``count`` indices spread evenly over ``0..total-1`` including both ends (all of them when ``count`` is None
+    or at least ``total``); one index is frame 0."""
+    if count is None or count >= total:
+        return tuple(range(total))
+    if count == 1:
+        return (0,)
+    return tuple(i * (total - 1) // (count - 1) for i in range(count))
+
+
+def discover_cases(root: Path) -> list[SourceCase]:
+    """Every ``**/*.json`` case under ``root``, sorted by relative path (a bad file raises ``CaseError``)."""
+    paths = sorted(root.glob("**/*.json"))
+    return [SourceCase(PurePosixPath(path.relative_to(root).as_posix()), load_case(path)) for path in paths]
+
+
+def test_case(source: SourceCase, frames_per_case: int | None) -> PlannedCase:
+    """The test-split entry of a case with an illusion type."""
+    case = source.case
+    illusion_type = case_illusion_type(case, source.folder_type)
+    if illusion_type is None:
+        raise PlanError(f"{source.relative}: a clean case has no test folder")
+    folder = case_folder(case, source.relative.stem, source.folder_type)
+    severity = case.illusions[0].severity if case.illusions else 0
+    return PlannedCase(
+        split=TEST_SPLIT, folder=folder, case_text=case_json(case),
+        frames=evenly_spaced(case.ego.frames, frames_per_case), illusion_type=illusion_type,
+        category=CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY], type_folder=TYPE_FOLDERS[illusion_type],
+        severity=severity, source={"file": str(source.relative)},
+    )
+
+
+def _markings(case: Case, rng: np.random.Generator) -> list[dict[str, Any]]:
+    """The base's paint with one lane-line type for every lane line and a new centre line; edges kept."""
+    lane_line = LANE_LINE_CHOICES[int(rng.integers(len(LANE_LINE_CHOICES)))]
+    centre_line = CENTRE_LINE_CHOICES[int(rng.integers(len(CENTRE_LINE_CHOICES)))]
+    markings = [marking.model_dump() for marking in case.road.markings]
+    centre = len(markings) // 2
+    for index in range(1, len(markings) - 1):
+        markings[index]["type"] = centre_line if index == centre else lane_line
+    return markings
+
+
+def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, Any]]:
+    """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``."""
+    rng = np.random.default_rng([seed, index])
+    preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
+    values = preset_values(preset)
+    altitude = values["sun"]["altitude"]
+    if altitude > 0:
+        altitude = float(np.clip(altitude + rng.uniform(-1, 1) * SUN_ALTITUDE_JITTER_DEG, 5.0, 85.0))
+    azimuth = round(float(rng.uniform(0.0, 360.0)), 1)
+    lane = int(rng.integers(base.road.lanes_per_direction))
+    drive_m = base.ego.speed * (base.ego.frames - 1) / base.ego.fps
+    latest_start = max(0.0, base.road.length - END_MARGIN_M - drive_m - 1.0)
+    start_s = round(float(rng.uniform(0.0, latest_start)), 1)
+    case_seed = int(rng.integers(0, 2**32))
+    data = base.model_dump()
+    data["weather"] = values["weather"]
+    data["sun"] = {**values["sun"], "azimuth": azimuth, "altitude": round(altitude, 1)}
+    data["road"]["markings"] = _markings(base, rng)
+    data["ego"].update(lane=lane, start_s=start_s)
+    data["seed"] = case_seed
+    data["title"] = f"{base.title} ({preset}, variation {index})"
+    parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
+                  "lane": lane, "start_s": start_s, "markings": [m["type"] for m in data["road"]["markings"]]}
+    return parse_case(data, source=f"train variation {index}"), parameters
+
+
+def train_cases(clean: list[SourceCase], train_frames: int, seed: int) -> list[PlannedCase]:
+    """``train_frames`` frames over variations of the clean cases (bases taken in turn, so every road type,
+    scene and line type of the clean library recurs)."""
+    if train_frames <= 0:
+        return []
+    if not clean:
+        raise PlanError("--train-frames needs clean cases (cases with no illusion) under --cases")
+    planned = []
+    for index in range(math.ceil(train_frames / TRAIN_FRAMES_PER_VARIANT)):
+        base = clean[index % len(clean)]
+        case, parameters = train_variation(base.case, seed, index)
+        count = min(TRAIN_FRAMES_PER_VARIANT, train_frames - index * TRAIN_FRAMES_PER_VARIANT)
+        folder = PurePosixPath(f"{index:05d}_{base.relative.stem}_{parameters['preset']}")
+        planned.append(PlannedCase(
+            split=TRAIN_SPLIT, folder=folder, case_text=case_json(case),
+            frames=evenly_spaced(case.ego.frames, count), illusion_type=None, category=CLEAN_CATEGORY,
+            type_folder=None, severity=0,
+            source={"base": str(base.relative), "seed": seed, "variation": index, **parameters},
+        ))
+    return planned
+
+
+def _check_unique(cases: list[PlannedCase]) -> None:
+    seen: dict[tuple[str, PurePosixPath], str] = {}
+    for case in cases:
+        key = (case.split, case.folder)
+        where = str(case.source.get("file", case.source))
+        if key in seen:
+            raise PlanError(f"{seen[key]} and {where} both map to {case.split}/{case.folder}")
+        seen[key] = where
+
+
+def build_plan(sources: list[SourceCase], settings: Settings) -> DatasetPlan:
+    """The test split from the typed cases, the train split from variations of the clean ones."""
+    if not sources:
+        raise PlanError("no case files (*.json) found")
+    typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
+    clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
+    planned = [test_case(source, settings.frames_per_case) for source in typed]
+    planned += train_cases(clean, settings.train_frames, settings.seed)
+    if not planned:
+        raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
+    _check_unique(planned)
+    return DatasetPlan(settings, tuple(planned))
+
+
+def render_tasks(plan: DatasetPlan, pending: dict[tuple[str, str], list[int]],
+                 chunk_frames: int = CHUNK_FRAMES) -> list[RenderTask]:
+    """Tasks of at most ``chunk_frames`` frames covering the ``pending`` frames ((split, folder) -> frames)."""
+    tasks = []
+    settings = plan.settings
+    for case in plan.cases:
+        frames = pending.get((case.split, str(case.folder)), [])
+        for start in range(0, len(frames), chunk_frames):
+            tasks.append(RenderTask(case.split, str(case.folder), case.case_text, case.case_sha256,
+                                    tuple(frames[start:start + chunk_frames]), settings.size,
+                                    settings.image_format, case.record_extras()))
+    return tasks

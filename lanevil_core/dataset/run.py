@@ -1,0 +1,118 @@
+"""A dataset run: plan, keep what is already on disk and verified, render the rest, then write labels and manifest.
+
+Resume: a frame is kept when its sidecar carries the frame's key (``manifest.frame_key``) and the image file still
+has the sha256 the sidecar recorded; anything else (missing, truncated, corrupt, from other settings) is rendered
+again. Label files and the manifest are rebuilt from the sidecars at the end of every run.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .manifest import build_manifest, frame_key, software_versions, source_digest
+from .plan import SPLIT_LABELS, DatasetPlan, PlannedCase, RenderTask, Settings, build_plan, discover_cases, render_tasks
+from .progress import progress_bar
+from .worker import FrameResult, TaskDone
+from .writer import DatasetFolder
+
+Executor = Callable[[Sequence[RenderTask], TaskDone], None]
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What a run did: frames in the plan, frames rendered now, frames kept from disk, wall time (s)."""
+
+    out_dir: Path
+    total: int
+    rendered: int
+    kept: int
+    seconds: float
+
+    @property
+    def frames_per_second(self) -> float:
+        """Rendered frames per second of wall time (0 when nothing was rendered)."""
+        return self.rendered / self.seconds if self.rendered and self.seconds > 0 else 0.0
+
+
+class _Sidecars:
+    """The sidecars of every planned frame, gathered from disk and from finished tasks."""
+
+    def __init__(self, plan: DatasetPlan, folder: DatasetFolder, versions: dict[str, str]) -> None:
+        self.plan = plan
+        self.folder = folder
+        self.cases = {(case.split, str(case.folder)): case for case in plan.cases}
+        self.keys = {(case.split, str(case.folder), index): frame_key(case, index, plan, versions)
+                     for case in plan.cases for index in case.frames}
+        self.found: dict[tuple[str, str, int], dict[str, Any]] = {}
+
+    def scan(self) -> dict[tuple[str, str], list[int]]:
+        """Collect verified frames; return the frames still to render per (split, folder)."""
+        pending: dict[tuple[str, str], list[int]] = {}
+        for case in self.plan.cases:
+            self.folder.remove_partial(case)
+            for index in case.frames:
+                sidecar = self.folder.verified(case, index, self.keys[(case.split, str(case.folder), index)])
+                if sidecar is None:
+                    pending.setdefault((case.split, str(case.folder)), []).append(index)
+                else:
+                    self.found[(case.split, str(case.folder), index)] = sidecar
+        return pending
+
+    def store(self, task: RenderTask, results: list[FrameResult]) -> None:
+        """Write a finished task's frames and sidecars."""
+        case = self.cases[(task.split, task.folder)]
+        for result in results:
+            key = self.keys[(task.split, task.folder, result.frame)]
+            self.found[(task.split, task.folder, result.frame)] = self.folder.write_frame(case, result, key)
+
+    def records(self, case: PlannedCase) -> list[dict[str, Any]]:
+        """The case's TuSimple records in frame order."""
+        return [self.found[(case.split, str(case.folder), index)]["record"] for index in case.frames]
+
+    def hashes(self, case: PlannedCase) -> dict[int, str]:
+        """Frame -> sha256 of its file."""
+        return {index: self.found[(case.split, str(case.folder), index)]["sha256"] for index in case.frames}
+
+
+def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versions: dict[str, str],
+            code_sha256: str) -> None:
+    """Per-case ``case.json`` and ``labels.json``, the split label files, then the manifest."""
+    for split in SPLIT_LABELS:
+        cases = plan.split_cases(split)
+        if not cases:
+            continue
+        split_records = []
+        for case in cases:
+            records = sidecars.records(case)
+            folder.write_case_files(case, records)
+            split_records += records
+        folder.write_split_labels(split, split_records)
+    hashes = {(case.split, str(case.folder)): sidecars.hashes(case) for case in plan.cases}
+    folder.write_manifest(build_manifest(plan, versions, code_sha256, hashes))
+
+
+def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executor: Executor,
+                     show_progress: bool = True) -> RunSummary:
+    """Render the dataset of the cases under ``cases_dir`` into ``out_dir``; frames verified on disk are kept."""
+    start = time.perf_counter()
+    plan = build_plan(discover_cases(cases_dir), settings)
+    versions = software_versions()
+    code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
+    folder = DatasetFolder(out_dir, settings.suffix)
+    sidecars = _Sidecars(plan, folder, versions)
+    pending = sidecars.scan()
+    tasks = render_tasks(plan, pending)
+    kept = len(sidecars.found)
+    with progress_bar(plan.total_frames, kept, show_progress) as bar:
+
+        def on_done(task: RenderTask, results: list[FrameResult]) -> None:
+            sidecars.store(task, results)
+            bar.update(len(results))
+
+        executor(tasks, on_done)
+    _finish(plan, folder, sidecars, versions, code_sha256)
+    return RunSummary(out_dir, plan.total_frames, plan.total_frames - kept, kept, time.perf_counter() - start)

@@ -1,0 +1,26 @@
+"""Lane-detection metrics: the official TuSimple Accuracy/FP/FN (with two F1 variants) and CULane F1."""
+
+from .culane import CulaneSummary, MatchCounts, iou_matrix, match_image
+from .evaluate import METRICS, ScoredImage, evaluate, score_tusimple_files
+from .formats import LaneFileError, LaneRecord, pair_records, read_tusimple
+from .tusimple import F1_VARIANTS, ImageScore, TusimpleSummary, score_image, summarize
+
+__all__ = [
+    "F1_VARIANTS",
+    "METRICS",
+    "CulaneSummary",
+    "ImageScore",
+    "LaneFileError",
+    "LaneRecord",
+    "MatchCounts",
+    "ScoredImage",
+    "TusimpleSummary",
+    "evaluate",
+    "iou_matrix",
+    "match_image",
+    "pair_records",
+    "read_tusimple",
+    "score_image",
+    "score_tusimple_files",
+    "summarize",
+]

@@ -1,0 +1,104 @@
+"""Score a prediction file (or folder) against ground truth with the TuSimple or the CULane metric.
+
+Inputs are recognised by what they are: a file is TuSimple JSON lines, a folder is a tree of CULane
+``.lines.txt`` files. Both sides must have the same format (their pixel frames differ).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+from ..labels import CULANE_SIZE, TUSIMPLE_SIZE
+from . import culane, tusimple
+from .formats import (
+    CULANE_SUFFIX,
+    LaneFileError,
+    LaneRecord,
+    Points,
+    culane_files,
+    pair_records,
+    read_culane_file,
+    read_tusimple,
+    tusimple_points,
+)
+
+Metric = Literal["tusimple", "culane"]
+METRICS: tuple[Metric, ...] = ("tusimple", "culane")
+
+
+@dataclass(frozen=True)
+class ScoredImage:
+    """One GT image with its per-image TuSimple score and the extra GT fields (category, type, severity...)."""
+
+    raw_file: str
+    score: tusimple.ImageScore
+    extra: dict[str, Any]
+
+
+def score_tusimple_files(gt_path: Path, pred_path: Path) -> list[ScoredImage]:
+    """Per-image official TuSimple scores, in GT order."""
+    gt = read_tusimple(gt_path, "gt")
+    pairs = pair_records(gt, read_tusimple(pred_path, "pred"), str(gt_path), str(pred_path))
+    scores = tusimple.score_pairs(pairs)
+    return [ScoredImage(g.raw_file, score, g.extra) for (g, _), score in zip(pairs, scores)]
+
+
+def _interpolated(lanes: list[Points], where: str) -> list[Points]:
+    for lane in lanes:
+        try:
+            culane.interpolate_lane(lane)
+        except culane.LaneInterpolationError as error:
+            raise LaneFileError(f"{where}: {error}") from None
+    return lanes
+
+
+def _culane_pairs_from_json(gt_path: Path, pred_path: Path) -> list[tuple[list[Points], list[Points]]]:
+    def points(record: LaneRecord, h_samples: list[float], name: Path) -> list[Points]:
+        lanes = [tusimple_points(lane, h_samples) for lane in record.lanes]
+        return _interpolated([lane for lane in lanes if len(lane) >= 2], f"{name}:{record.line}")
+
+    pairs = pair_records(read_tusimple(gt_path, "gt"), read_tusimple(pred_path, "pred"), str(gt_path),
+                         str(pred_path), require_run_time=False)
+    return [(points(p, g.h_samples, pred_path), points(g, g.h_samples, gt_path)) for g, p in pairs]
+
+
+def _culane_pairs_from_folders(gt_root: Path, pred_root: Path) -> list[tuple[list[Points], list[Points]]]:
+    gt_names = culane_files(gt_root)
+    if not gt_names:
+        raise LaneFileError(f"{gt_root}: no {CULANE_SUFFIX} files")
+    extra = sorted(set(culane_files(pred_root)) - set(gt_names))
+    if extra:
+        raise LaneFileError(f"{pred_root / extra[0]}: prediction for an image not in the ground truth {gt_root}")
+    pairs = []
+    for name in gt_names:
+        pred_file = pred_root / name
+        # The official evaluator reads a missing prediction file as an image with no lanes.
+        pred = read_culane_file(pred_file) if pred_file.exists() else []
+        pairs.append((_interpolated(pred, str(pred_file)), _interpolated(read_culane_file(gt_root / name),
+                                                                         str(gt_root / name))))
+    return pairs
+
+
+def evaluate(gt_path: str | Path, pred_path: str | Path, metric: Metric = "tusimple",
+             f1_variant: str = "ganet") -> dict[str, Any]:
+    """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``)."""
+    gt_path, pred_path = Path(gt_path), Path(pred_path)
+    for path in (gt_path, pred_path):
+        if not path.exists():
+            raise LaneFileError(f"{path}: no such file or folder")
+    if gt_path.is_dir() != pred_path.is_dir():
+        raise LaneFileError(f"{gt_path} and {pred_path}: give two TuSimple JSON files or two CULane folders")
+    if metric == "tusimple":
+        if gt_path.is_dir():
+            raise LaneFileError(f"{gt_path}: the TuSimple metric reads TuSimple JSON-lines files, not folders")
+        scores = [image.score for image in score_tusimple_files(gt_path, pred_path)]
+        return {"metric": "tusimple", **tusimple.summarize(scores, f1_variant).as_dict()}
+    if gt_path.is_dir():
+        pairs, size = _culane_pairs_from_folders(gt_path, pred_path), CULANE_SIZE
+    else:
+        pairs, size = _culane_pairs_from_json(gt_path, pred_path), TUSIMPLE_SIZE
+    counts = (culane.match_image(pred, gt, size) for pred, gt in pairs)
+    return {"metric": "culane", "iou_threshold": culane.IOU_THRESHOLD, "lane_width": culane.LANE_WIDTH_PX,
+            **culane.summarize(counts).as_dict()}

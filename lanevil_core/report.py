@@ -1,0 +1,240 @@
+"""Robustness report: Original / Perturbed / Gap of TuSimple Accuracy and F1 per category, type and severity.
+
+Images are grouped by the extra fields of the split's labels (``category``, ``type``, ``severity``): severity 0
+marks the clean original cases, 1-5 the perturbed ones. Every figure of a group is the official per-image mean
+over its images (F1 from the group's mean FP and FN), so a category pools the images of its types. Gap =
+Perturbed - Original (negative = the detector lost accuracy under the illusion).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from .case import write_atomic
+from .metrics.evaluate import ScoredImage
+from .metrics.tusimple import summarize
+
+LEVELS = (1, 2, 3, 4, 5)
+ALL = "All"
+CATEGORY_ORDER = ("RoadDamage", "TrafficObstruction", "Shadow", "Reflection")
+REPORT_MD, REPORT_CSV, SEVERITY_CSV, REPORT_PNG = "report.md", "report.csv", "report_severity.csv", "report.png"
+
+
+@dataclass(frozen=True)
+class Stats:
+    """TuSimple figures of one group of images (accuracy, FP, FN, F1 as fractions)."""
+
+    images: int
+    accuracy: float
+    fp: float
+    fn: float
+    f1: float
+
+
+@dataclass(frozen=True)
+class Row:
+    """One table row: a category (type ``All``), a type, or everything (category and type ``All``)."""
+
+    category: str
+    type: str
+    original: Stats | None
+    perturbed: Stats | None
+    levels: dict[int, Stats | None]
+
+    def gap(self, field: str, level: int | None = None) -> float | None:
+        """Perturbed (or one level) minus Original of ``field`` ('accuracy' or 'f1'); None if either is missing."""
+        other = self.perturbed if level is None else self.levels.get(level)
+        if self.original is None or other is None:
+            return None
+        return getattr(other, field) - getattr(self.original, field)
+
+
+@dataclass(frozen=True)
+class Report:
+    """All rows (types, then their category, then everything), the F1 variant and unlabelled image count."""
+
+    rows: list[Row]
+    f1_variant: str
+    title: str
+    unlabelled: int
+
+
+def _stats(images: list[ScoredImage], f1_variant: str) -> Stats | None:
+    if not images:
+        return None
+    summary = summarize([image.score for image in images], f1_variant)
+    return Stats(summary.images, summary.accuracy, summary.fp, summary.fn, summary.f1)
+
+
+def _severity(image: ScoredImage) -> int:
+    return int(image.extra["severity"])
+
+
+def _row(category: str, type_name: str, images: list[ScoredImage], f1_variant: str) -> Row:
+    originals = [image for image in images if _severity(image) == 0]
+    perturbed = [image for image in images if _severity(image) > 0]
+    levels = {level: _stats([image for image in images if _severity(image) == level], f1_variant)
+              for level in LEVELS}
+    return Row(category, type_name, _stats(originals, f1_variant), _stats(perturbed, f1_variant), levels)
+
+
+def _labelled(image: ScoredImage) -> bool:
+    extra = image.extra
+    return all(key in extra for key in ("category", "type", "severity")) and isinstance(extra["severity"], int)
+
+
+def _category_key(category: str) -> tuple[int, str]:
+    return (CATEGORY_ORDER.index(category) if category in CATEGORY_ORDER else len(CATEGORY_ORDER), category)
+
+
+def build_report(images: Iterable[ScoredImage], f1_variant: str = "ganet", title: str = "") -> Report:
+    """Rows for every (category, type) found, each category, and all images together."""
+    chosen = list(images)
+    labelled = [image for image in chosen if _labelled(image)]
+    rows = []
+    for category in sorted({image.extra["category"] for image in labelled}, key=_category_key):
+        in_category = [image for image in labelled if image.extra["category"] == category]
+        for type_name in sorted({image.extra["type"] for image in in_category}):
+            in_type = [image for image in in_category if image.extra["type"] == type_name]
+            rows.append(_row(category, type_name, in_type, f1_variant))
+        rows.append(_row(category, ALL, in_category, f1_variant))
+    rows.append(_row(ALL, ALL, labelled, f1_variant))
+    return Report(rows, f1_variant, title, len(chosen) - len(labelled))
+
+
+# ---------------------------------------------------------------------------------------------- formatting
+
+def _pct(value: float | None, signed: bool = False) -> str:
+    if value is None:
+        return "-"
+    return f"{100 * value:+.2f}" if signed else f"{100 * value:.2f}"
+
+
+def _label(row: Row) -> tuple[str, str]:
+    if row.category == ALL:
+        return "**All**", ""
+    if row.type == ALL:
+        return f"**{row.category}**", "**all types**"
+    return row.category, row.type
+
+
+def _images(stats: Stats | None) -> int:
+    return stats.images if stats is not None else 0
+
+
+def markdown(report: Report) -> str:
+    """report.md: the main Original/Perturbed/Gap table and per-severity tables (values in %)."""
+    lines = [f"# {report.title or 'Robustness report'}", "",
+             f"TuSimple metric; F1 variant `{report.f1_variant}`. Values in %. Gap = Perturbed - Original "
+             "(negative = drop). Original = the clean `00_original` cases of each type.", ""]
+    if report.unlabelled:
+        lines += [f"{report.unlabelled} image(s) without category/type/severity are not in the tables.", ""]
+    lines += ["| Category | Type | Images orig/pert | Acc Original | Acc Perturbed | Acc Gap | F1 Original "
+              "| F1 Perturbed | F1 Gap |", "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for row in report.rows:
+        category, type_name = _label(row)
+        cells = [category, type_name, f"{_images(row.original)}/{_images(row.perturbed)}"]
+        for field in ("accuracy", "f1"):
+            cells += [_pct(getattr(row.original, field, None)), _pct(getattr(row.perturbed, field, None)),
+                      _pct(row.gap(field), signed=True)]
+        lines.append("| " + " | ".join(cells) + " |")
+    for field, name in (("accuracy", "Accuracy"), ("f1", "F1")):
+        lines += ["", f"## {name} by severity", "",
+                  f"{name} of the originals (level 0) and of each level; in brackets the gap to the originals.", "",
+                  "| Category | Type | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
+                  "|---|---|" + "---:|" * (len(LEVELS) + 1)]
+        for row in report.rows:
+            category, type_name = _label(row)
+            cells = [category, type_name, _pct(getattr(row.original, field, None))]
+            for level in LEVELS:
+                stats = row.levels[level]
+                value = _pct(getattr(stats, field, None))
+                gap = row.gap(field, level)
+                cells.append(value if gap is None else f"{value} ({_pct(gap, signed=True)})")
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _number(value: float | None) -> str:
+    return "" if value is None else f"{value:.6f}"
+
+
+def _csv(rows: list[list[str | int]]) -> str:
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows(rows)
+    return buffer.getvalue()
+
+
+def report_csv(report: Report) -> str:
+    """report.csv: one line per row with original/perturbed/gap accuracy and F1 (fractions)."""
+    header = ["category", "type", "images_original", "images_perturbed", "accuracy_original",
+              "accuracy_perturbed", "accuracy_gap", "f1_original", "f1_perturbed", "f1_gap", "f1_variant"]
+    rows: list[list[str | int]] = [header]
+    for row in report.rows:
+        rows.append([row.category, row.type, _images(row.original), _images(row.perturbed),
+                     _number(getattr(row.original, "accuracy", None)),
+                     _number(getattr(row.perturbed, "accuracy", None)), _number(row.gap("accuracy")),
+                     _number(getattr(row.original, "f1", None)), _number(getattr(row.perturbed, "f1", None)),
+                     _number(row.gap("f1")), report.f1_variant])
+    return _csv(rows)
+
+
+def severity_csv(report: Report) -> str:
+    """report_severity.csv: one line per row and level 0-5 (0 = originals) with accuracy, FP, FN, F1, gaps."""
+    header = ["category", "type", "severity", "images", "accuracy", "fp", "fn", "f1", "accuracy_gap", "f1_gap",
+              "f1_variant"]
+    rows: list[list[str | int]] = [header]
+    for row in report.rows:
+        for level in (0, *LEVELS):
+            stats = row.original if level == 0 else row.levels[level]
+            if stats is None:
+                continue
+            gaps = (0.0, 0.0) if level == 0 else (row.gap("accuracy", level), row.gap("f1", level))
+            rows.append([row.category, row.type, level, stats.images, _number(stats.accuracy), _number(stats.fp),
+                         _number(stats.fn), _number(stats.f1), _number(gaps[0]), _number(gaps[1]),
+                         report.f1_variant])
+    return _csv(rows)
+
+
+def severity_plot(report: Report) -> bytes:
+    """PNG: accuracy drop (Original - level, percentage points) against severity, one line per category."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    for row in report.rows:
+        if row.type != ALL:
+            continue
+        points = [(level, -100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
+        if not points:
+            continue
+        style = {"color": "black", "linestyle": "--", "linewidth": 2.2} if row.category == ALL else {"linewidth": 1.6}
+        ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=row.category, **style)
+    ax.axhline(0.0, color="grey", linewidth=0.8)
+    ax.set_xticks(list(LEVELS))
+    ax.set_xlabel("severity level")
+    ax.set_ylabel("accuracy drop vs original (percentage points)")
+    ax.set_title(report.title or "Accuracy drop by severity")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def write_report(report: Report, out_dir: str | Path) -> list[Path]:
+    """Write report.md, report.csv, report_severity.csv and report.png into ``out_dir``; return their paths."""
+    out_dir = Path(out_dir)
+    files = {REPORT_MD: markdown(report).encode("utf-8"), REPORT_CSV: report_csv(report).encode("utf-8"),
+             SEVERITY_CSV: severity_csv(report).encode("utf-8"), REPORT_PNG: severity_plot(report)}
+    for name, data in files.items():
+        write_atomic(out_dir / name, data)
+    return [out_dir / name for name in files]

@@ -1,0 +1,260 @@
+/**
+ * One illusion card: the stock original next to a perturbed frame, with severity and sun sliders.
+ *
+ * A card does nothing until `activate()` (called when it scrolls near the viewport). It then looks up the type's
+ * cases in the store: `<type>-00_original` for the left frame and a level case (`<type>-03_level3` preferred)
+ * re-rendered at the slider's severity for the right one. Types the store lacks get a "not in this library" card.
+ */
+
+import { caseDocument, casesOfType, frameUrl } from "./api.js";
+import { LatestImage } from "./latest-image.js";
+
+const PREFERRED_LEVEL = 3;
+const LEVELS = 5;
+
+/** "fence_shadow" -> "Fence shadow". */
+export function typeTitle(type) {
+  const words = type.replaceAll("_", " ");
+  return words.charAt(0).toUpperCase() + words.slice(1);
+}
+
+/** The stock id of `type`'s original, or of its `level` case. */
+export function stockId(type, level = 0) {
+  return level === 0 ? `${type}-00_original` : `${type}-0${level}_level${level}`;
+}
+
+/** Ids of the original (or null) and of the case to re-render at any severity (or null) among `rows`. */
+export function pickCases(type, rows) {
+  const ids = new Set(rows.map((row) => row.id));
+  const original = ids.has(stockId(type)) ? stockId(type) : null;
+  const levels = [PREFERRED_LEVEL, 1, 2, 4, 5].map((level) => stockId(type, level)).filter((id) => ids.has(id));
+  const anyPerturbed = rows.find((row) => row.id !== original && row.type === type && row.illusions > 0);
+  return { original, perturbed: levels[0] ?? anyPerturbed?.id ?? null };
+}
+
+/** Degrees in [0, 360). */
+function wrapDegrees(degrees) {
+  return ((degrees % 360) + 360) % 360;
+}
+
+/** "sun_altitude" -> "sun altitude"; numbers rounded for reading. */
+function levelSummary(row) {
+  return Object.entries(row)
+    .map(([key, value]) => `${key.replaceAll("_", " ")} ${typeof value === "number" ? +value.toFixed(3) : value}`)
+    .join(" · ");
+}
+
+/** Compass-style words for an azimuth (0 = straight ahead at the start, 90 = left). */
+function azimuthWords(degrees) {
+  const names = ["ahead", "ahead-left", "left", "behind-left", "behind", "behind-right", "right", "ahead-right"];
+  return names[Math.round(wrapDegrees(degrees) / 45) % 8];
+}
+
+export class IllusionCard {
+  /**
+   * @param {HTMLTemplateElement} template the card markup
+   * @param {{name: string, description: string, severity: object[]}} info the type's registry entry
+   * @param {{overlay: boolean}} display page-wide display options
+   */
+  constructor(template, info, display) {
+    this.info = info;
+    this.type = info.name;
+    this.title = typeTitle(info.name);
+    this.display = display;
+    this.ids = { original: null, perturbed: null };
+    this.sunDefault = null;  // {azimuth, altitude} of the case, once read
+    // shadow and reflection illusions place the sun themselves unless a sun override is given
+    this.sunAuto = "sun_azimuth" in (info.parameters ?? {}) || "sun_altitude" in (info.severity?.[0] ?? {});
+    this.sunTouched = false;
+    this.activated = false;
+    this.el = template.content.firstElementChild.cloneNode(true);
+    this.build();
+  }
+
+  /** Fill the cloned template: ids, labels, texts, listeners. */
+  build() {
+    const el = this.el;
+    el.id = `card-${this.type}`;
+    el.dataset.type = this.type;
+    el.setAttribute("aria-labelledby", `${this.type}-title`);
+    const title = el.querySelector(".card__title");
+    title.id = `${this.type}-title`;
+    title.textContent = this.title;
+    el.querySelector(".card__desc").textContent = this.info.description;
+    this.inputs = {};
+    this.outputs = {};
+    for (const input of el.querySelectorAll("input[data-control]")) {
+      const name = input.dataset.control;
+      input.id = `${this.type}-${name}`;
+      el.querySelector(`label[data-for="${name}"]`).htmlFor = input.id;
+      const output = el.querySelector(`output[data-output="${name}"]`);
+      output.htmlFor = input.id;
+      this.inputs[name] = input;
+      this.outputs[name] = output;
+      input.addEventListener("input", () => this.onInput(name));
+    }
+    this.frames = {};
+    for (const figure of el.querySelectorAll("figure[data-role]")) {
+      const role = figure.dataset.role;
+      const img = figure.querySelector("img");
+      const loader = new LatestImage(img, {
+        onBusy: (busy) => this.setBusy(figure, busy),
+        onError: (error) => this.setFrameError(figure, error),
+      });
+      figure.querySelector(".frame__retry").addEventListener("click", () => loader.retry());
+      this.frames[role] = { figure, img, loader };
+    }
+    el.querySelector(".card__reset").addEventListener("click", () => this.reset());
+    this.showValues();
+  }
+
+  /** Look up the type's cases and show the first frames (once). */
+  async activate() {
+    if (this.activated) return;
+    this.activated = true;
+    this.setState("loading");
+    let rows;
+    try {
+      rows = await casesOfType(this.type);
+    } catch (error) {
+      this.setState("error");
+      this.activated = false;
+      this.showCardError(`Could not list the ${this.title.toLowerCase()} cases: ${error.message}`,
+        () => this.activate());
+      return;
+    }
+    this.showCardError("");
+    this.ids = pickCases(this.type, rows);
+    for (const [role, id] of Object.entries(this.ids)) {
+      this.frames[role].figure.querySelector(".frame__missing").hidden = id !== null;
+    }
+    if (!this.ids.original && !this.ids.perturbed) {
+      this.setState("missing");
+      const note = this.el.querySelector(".card__missing");
+      const heading = Object.assign(document.createElement("strong"), { textContent: "Not in this library" });
+      note.replaceChildren(heading, `This server stores no ${this.type} cases. Seed it with the stock library `
+        + "(lanevil library) or build one in the editor.");
+      note.hidden = false;
+      return;
+    }
+    this.setState("ready");
+    this.inputs.severity.disabled = !this.ids.perturbed;
+    this.el.querySelector(".card__reset").disabled = false;
+    this.refresh({ immediate: true });
+    this.readSun(this.ids.perturbed ?? this.ids.original);
+  }
+
+  /** Read the case's sun to start the sun sliders from; night scenes keep them off. */
+  async readSun(id) {
+    try {
+      const document = await caseDocument(id);
+      const sun = document.sun;
+      this.sunDefault = { azimuth: wrapDegrees(sun.azimuth), altitude: sun.altitude };
+      const night = sun.intensity <= 0 || sun.altitude <= 0;
+      this.inputs.azimuth.disabled = night;
+      this.inputs.altitude.disabled = night;
+      const note = this.el.querySelector(".card__note");
+      note.hidden = !night && !this.sunAuto;
+      note.textContent = night ? "Night scene: lit by street lamps and headlights, so there is no sun to move."
+        : "Sun “auto”: the illusion places the sun itself until you move a sun slider.";
+      this.resetSun();
+    } catch (error) {
+      this.showCardError(`Could not read the case's sun (${error.message}); the sun sliders stay off.`);
+    }
+  }
+
+  setState(state) {
+    this.el.dataset.state = state;
+  }
+
+  setBusy(figure, busy) {
+    figure.classList.toggle("is-busy", busy);
+    figure.setAttribute("aria-busy", String(busy));
+  }
+
+  setFrameError(figure, error) {
+    const box = figure.querySelector(".frame__error");
+    box.hidden = !error;
+    box.querySelector(".frame__error-text").textContent = error ? `Render failed: ${error.message}` : "";
+    figure.classList.toggle("has-error", Boolean(error));
+  }
+
+  /** Show `message` under the frames (none: hide it), with a Retry button when `retry` is given. */
+  showCardError(message, retry = null) {
+    const box = this.el.querySelector(".card__error");
+    box.querySelector(".card__error-text").textContent = message;
+    box.hidden = !message;
+    const button = box.querySelector(".card__retry");
+    button.hidden = !retry;
+    button.onclick = retry;
+  }
+
+  onInput(name) {
+    if (name !== "severity") this.sunTouched = true;
+    this.showValues();
+    this.refresh();
+  }
+
+  /** Page-wide options changed (the lane overlay). */
+  displayChanged() {
+    if (this.el.dataset.state === "ready") this.refresh({ immediate: true });
+  }
+
+  reset() {
+    this.inputs.severity.value = String(PREFERRED_LEVEL);
+    this.resetSun();
+    this.refresh({ immediate: true });
+  }
+
+  resetSun() {
+    this.sunTouched = false;
+    if (this.sunDefault) {
+      this.inputs.azimuth.value = String(this.sunDefault.azimuth);
+      this.inputs.altitude.value = String(this.sunDefault.altitude);
+    }
+    this.showValues();
+  }
+
+  /** The control values that go into frame URLs; the sun only once the user moved it. */
+  settings() {
+    const sun = this.sunTouched
+      ? { sunAzimuth: Number(this.inputs.azimuth.value), sunAltitude: Number(this.inputs.altitude.value) }
+      : {};
+    return { severity: Number(this.inputs.severity.value), overlay: this.display.overlay, ...sun };
+  }
+
+  showValues() {
+    const { severity, azimuth, altitude } = this.inputs;
+    this.outputs.severity.textContent = `${severity.value} / ${LEVELS}`;
+    severity.setAttribute("aria-valuetext", `level ${severity.value} of ${LEVELS}`);
+    const known = this.sunDefault !== null;
+    const auto = this.sunAuto && !this.sunTouched;
+    this.outputs.azimuth.textContent = !known ? "–" : auto ? "auto" : `${azimuth.value}°`;
+    this.outputs.azimuth.title = auto ? "" : azimuthWords(Number(azimuth.value));
+    azimuth.setAttribute("aria-valuetext", auto ? "set by the illusion" : `${azimuth.value} degrees, `
+      + azimuthWords(Number(azimuth.value)));
+    this.outputs.altitude.textContent = !known ? "–" : auto ? "auto" : `${altitude.value}°`;
+    altitude.setAttribute("aria-valuetext", auto ? "set by the illusion" : `${altitude.value} degrees above the horizon`);
+    const row = this.info.severity?.[Number(severity.value) - 1];
+    this.el.querySelector(".card__level").textContent = row ? `Level ${severity.value}: ${levelSummary(row)}` : "";
+    this.el.querySelector('figure[data-role="perturbed"] figcaption').textContent =
+      `Perturbed · level ${severity.value}`;
+  }
+
+  /** Ask both frames for the pictures of the current settings. */
+  refresh({ immediate = false } = {}) {
+    const { severity, overlay, sunAzimuth, sunAltitude } = this.settings();
+    const sun = sunAzimuth === undefined ? "" : `, sun at ${sunAzimuth}° azimuth and ${sunAltitude}° altitude`;
+    const lanes = overlay ? ", ground-truth lanes drawn" : "";
+    if (this.ids.original) {
+      const url = frameUrl(this.ids.original, { overlay, sunAzimuth, sunAltitude });
+      this.frames.original.loader.request(url, `${this.title}: original frame without the illusion${sun}${lanes}`,
+        { immediate });
+    }
+    if (this.ids.perturbed) {
+      const url = frameUrl(this.ids.perturbed, { overlay, severity, sunAzimuth, sunAltitude });
+      this.frames.perturbed.loader.request(url, `${this.title} at severity ${severity} of ${LEVELS}${sun}${lanes}`,
+        { immediate });
+    }
+  }
+}

@@ -1,0 +1,266 @@
+"""``lanevil dataset``: layout and labels, manifest, determinism, resume, CLI errors (tiny frames, few cases)."""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import shutil
+import socket
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from lanevil_core.case import case_json, load_case
+from lanevil_core.cli import main
+from lanevil_core.dataset import Settings, generate_dataset
+from lanevil_core.dataset.local import run_local
+from lanevil_core.dataset.writer import PROGRESS_DIR
+from lanevil_core.labels import h_samples_for
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+SIZE = "160x90"
+CASE_FILES = (
+    "30_shadow/fence_shadow/00_original.json",
+    "30_shadow/fence_shadow/01_level1.json",
+    "10_road_damage/road_crack/03_level3.json",
+    "00_clean/00_straight_urban.json",
+)
+EXPECTED_TEST = {  # case folder -> (category, type, severity, source file)
+    "Shadow/Fence/00_original": ("Shadow", "Fence", 0, CASE_FILES[0]),
+    "Shadow/Fence/01_level1": ("Shadow", "Fence", 1, CASE_FILES[1]),
+    "RoadDamage/RoadCrack/03_level3": ("RoadDamage", "RoadCrack", 3, CASE_FILES[2]),
+}
+ARGS = ["--size", SIZE, "--frames-per-case", "2", "--train-frames", "3", "--quiet"]
+
+
+def copy_cases(root: Path, files: tuple[str, ...] = CASE_FILES) -> Path:
+    """A cases folder holding copies of some stock cases under their stock relative paths."""
+    for relative in files:
+        target = root / relative
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(SCENES / relative, target)
+    return root
+
+
+def run_cli(*argv: str) -> int:
+    return main(["dataset", *argv])
+
+
+def tree(root: Path) -> dict[str, str]:
+    """Relative path -> sha256 of every file under ``root``."""
+    return {path.relative_to(root).as_posix(): hashlib.sha256(path.read_bytes()).hexdigest()
+            for path in sorted(root.rglob("*")) if path.is_file()}
+
+
+def read_lines(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+@pytest.fixture(scope="module")
+def cases_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return copy_cases(tmp_path_factory.mktemp("cases"))
+
+
+@pytest.fixture(scope="module")
+def dataset(cases_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One generated dataset (one worker), shared by the read-only tests."""
+    out = tmp_path_factory.mktemp("dataset")
+    assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "1", *ARGS) == 0
+    return out
+
+
+def test_test_split_layout_and_labels(dataset: Path) -> None:
+    split = dataset / "test"
+    folders = sorted(p.parent.relative_to(split).as_posix() for p in split.rglob("labels.json"))
+    assert folders == sorted(EXPECTED_TEST)
+    all_records = []
+    for folder, (category, type_folder, severity, _) in EXPECTED_TEST.items():
+        records = read_lines(split / folder / "labels.json")
+        assert [r["frame"] for r in records] == [0, 99]  # two frames spread over the 100-frame drive
+        for record in records:
+            assert record["raw_file"] == f"{folder}/{record['frame']:06d}.png"
+            with Image.open(split / record["raw_file"]) as image:
+                assert image.size == (160, 90) and image.format == "PNG"
+            assert record["h_samples"] == h_samples_for(90)
+            assert 2 <= len(record["lanes"]) <= 5
+            assert all(len(lane) == len(record["h_samples"]) for lane in record["lanes"])
+            assert all(x == -2 or 0 <= x < 160 for lane in record["lanes"] for x in lane)
+            assert (record["category"], record["type"], record["severity"], record["case"]) == (
+                category, type_folder, severity, folder)
+            assert {"visibility", "line_types"} <= record.keys()
+        all_records += records
+    # The split file holds the same lines as the case files (case folders sorted by source path).
+    split_records = read_lines(split / "test_label.json")
+    assert sorted(map(json.dumps, split_records)) == sorted(map(json.dumps, all_records))
+    assert (split / "Shadow/Fence/01_level1/case.json").is_file()
+
+
+def test_train_split_from_clean_variations(dataset: Path) -> None:
+    records = read_lines(dataset / "train" / "train_label.json")
+    assert len(records) == 3
+    for record in records:
+        assert (dataset / "train" / record["raw_file"]).is_file()
+        assert record["category"] == "Clean" and record["severity"] == 0 and record["split"] == "train"
+        case = load_case(dataset / "train" / record["case"] / "case.json")
+        assert not case.illusions
+        assert record["raw_file"].startswith("00000_00_straight_urban_")
+
+
+def test_manifest_pins_inputs_and_hashes(dataset: Path, cases_dir: Path) -> None:
+    manifest = json.loads((dataset / "manifest.json").read_text())
+    assert {"lanevil", "numpy", "numba", "python", "pillow", "renderer_source_sha256"} <= manifest["versions"].keys()
+    assert manifest["settings"]["size"] == [160, 90] and manifest["settings"]["format"] == "png"
+    assert manifest["splits"]["test"] == {"labels": "test/test_label.json", "cases": 3, "frames": 6}
+    by_case = {entry["case"]: entry for entry in manifest["cases"] if entry["split"] == "test"}
+    assert by_case.keys() == EXPECTED_TEST.keys()
+    for folder, (_, _, severity, source) in EXPECTED_TEST.items():
+        entry = by_case[folder]
+        case = load_case(cases_dir / source)
+        assert entry["case_sha256"] == hashlib.sha256(case_json(case).encode()).hexdigest()
+        assert entry["seed"] == case.seed and entry["severity"] == severity
+        assert entry["illusion_type"] == ("road_crack" if "Crack" in folder else "fence_shadow")
+        assert entry["source"] == {"file": source}
+        assert [f["frame"] for f in entry["frames"]] == [0, 99]
+        for frame in entry["frames"]:
+            assert hashlib.sha256((dataset / frame["file"]).read_bytes()).hexdigest() == frame["sha256"]
+    train = [entry for entry in manifest["cases"] if entry["split"] == "train"]
+    assert train[0]["source"]["base"] == CASE_FILES[3] and train[0]["source"]["preset"]
+
+
+def test_lanevil_render_regenerates_a_frame_byte_identically(dataset: Path, tmp_path: Path) -> None:
+    manifest = json.loads((dataset / "manifest.json").read_text())
+    entry = next(entry for entry in manifest["cases"] if entry["split"] == "train")
+    frame = entry["frames"][-1]
+    target = tmp_path / "again.png"
+    assert main(["render", str(dataset / entry["case_file"]), "--frame", str(frame["frame"]), "--size", SIZE,
+                 "--out", str(target)]) == 0
+    assert hashlib.sha256(target.read_bytes()).hexdigest() == frame["sha256"]
+
+
+def test_rerun_keeps_every_verified_frame(dataset: Path, cases_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    before = tree(dataset)
+    assert run_cli("--cases", str(cases_dir), "--out", str(dataset), "--workers", "1", *ARGS) == 0
+    assert "(0 rendered, 9 kept)" in capsys.readouterr().out
+    assert tree(dataset) == before
+
+
+def test_process_pool_writes_the_same_bytes_as_one_process(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "two_workers"
+    assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "2", *ARGS) == 0
+    assert tree(out) == tree(dataset)
+
+
+def test_resume_repairs_exactly_the_damaged_frames(
+    dataset: Path, cases_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
+    out = tmp_path / "damaged"
+    shutil.copytree(dataset, out)
+    expected = tree(dataset)
+    case_dir = out / "test/Shadow/Fence/01_level1"
+    missing, truncated = case_dir / "000000.png", case_dir / "000099.png"
+    flipped = out / "test/RoadDamage/RoadCrack/03_level3/000000.png"
+    missing.unlink()
+    truncated.write_bytes(truncated.read_bytes()[:100])
+    data = bytearray(flipped.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    flipped.write_bytes(bytes(data))
+    partial = case_dir / ".000000.png.tmp123"  # what an interrupted atomic write leaves behind
+    partial.write_bytes(b"\x89PNG partial")
+    untouched = {path: path.stat().st_mtime_ns for path in out.rglob("*.png") if path not in (truncated, flipped)}
+    assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "1", *ARGS) == 0
+    assert "(3 rendered, 6 kept)" in capsys.readouterr().out
+    assert not partial.exists()
+    assert tree(out) == expected
+    assert all(path.stat().st_mtime_ns == mtime for path, mtime in untouched.items())
+
+
+def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "interrupted"
+    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3)
+
+    def interrupt_after_two_tasks(tasks, on_done) -> None:  # noqa: ANN001 - an Executor
+        done = []
+
+        def counting(task, results) -> None:  # noqa: ANN001
+            on_done(task, results)
+            done.append(task)
+            if len(done) == 2:
+                raise KeyboardInterrupt
+
+        run_local(tasks, counting, workers=1)
+
+    with pytest.raises(KeyboardInterrupt):
+        generate_dataset(cases_dir, out, settings, interrupt_after_two_tasks, show_progress=False)
+    assert not (out / "manifest.json").exists()
+    written = sorted(out.rglob("*.png"))
+    assert 0 < len(written) < 9
+    summary = generate_dataset(cases_dir, out, settings, functools.partial(run_local, workers=1),
+                               show_progress=False)
+    assert (summary.kept, summary.rendered) == (len(written), 9 - len(written))
+    assert tree(out) == tree(dataset)
+
+
+def test_frames_from_other_settings_are_not_reused(dataset: Path, cases_dir: Path, tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "resized"
+    shutil.copytree(dataset, out)
+    assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "1", "--size", "128x72",
+                   "--frames-per-case", "1", "--quiet") == 0
+    assert "(3 rendered, 0 kept)" in capsys.readouterr().out
+    with Image.open(out / "test/Shadow/Fence/00_original/000000.png") as image:
+        assert image.size == (128, 72)
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert [entry["split"] for entry in manifest["cases"]] == ["test"] * 3
+
+
+def test_jpg_format(cases_dir: Path, tmp_path: Path) -> None:
+    cases = copy_cases(tmp_path / "cases", CASE_FILES[:1])
+    out = tmp_path / "jpg"
+    assert run_cli("--cases", str(cases), "--out", str(out), "--size", SIZE, "--frames-per-case", "1",
+                   "--format", "jpg", "--workers", "1", "--quiet") == 0
+    record = read_lines(out / "test" / "test_label.json")[0]
+    assert record["raw_file"] == "Shadow/Fence/00_original/000000.jpg"
+    assert (out / "test" / record["raw_file"]).read_bytes()[:3] == b"\xff\xd8\xff"
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--cases", "{tmp}/nowhere"], "no such folder"),
+    (["--cases", "{tmp}/empty"], "no case files"),
+    (["--cases", "{cases}", "--size", "160by90"], "is not WIDTHxHEIGHT"),
+    (["--cases", "{cases}", "--size", "10x10"], "must lie in 64..4096"),
+    (["--cases", "{cases}", "--format", "gif"], "invalid choice"),
+    (["--cases", "{cases}", "--frames-per-case", "0"], "--frames-per-case must be at least 1"),
+    (["--cases", "{cases}", "--scheduler", "localhost:8786"], "is not tcp://HOST:PORT"),
+    (["--cases", "{cases}", "--scheduler", "tcp://127.0.0.1:{port}", "--scheduler-timeout", "1"],
+     "cannot reach the Dask scheduler"),
+    (["--cases", "{typed}", "--train-frames", "5"], "--train-frames needs clean cases"),
+])
+def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path: Path, cases_dir: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "empty").mkdir()
+    typed = copy_cases(tmp_path / "typed", CASE_FILES[:1])
+    values = {"tmp": tmp_path, "cases": cases_dir, "typed": typed, "port": _free_port()}
+    argv = [part.format(**values) for part in argv]
+    assert run_cli(*argv, "--out", str(tmp_path / "out"), "--quiet") == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err, err
+    assert not (tmp_path / "out" / "manifest.json").exists()
+
+
+@pytest.mark.slow
+def test_dask_cluster_writes_the_same_bytes_as_the_local_run(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        out = tmp_path / "dask"
+        assert run_cli("--cases", str(cases_dir), "--out", str(out), "--scheduler", cluster.scheduler_address,
+                       *ARGS) == 0
+    assert tree(out) == tree(dataset)

@@ -1,0 +1,86 @@
+"""Dataset plans: frame spacing, folders of the stock library, train variations, the renderer's source set."""
+
+from __future__ import annotations
+
+from pathlib import Path, PurePosixPath
+
+import pytest
+
+from lanevil_core.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS
+from lanevil_core.case import Case
+from lanevil_core.dataset import PlanError, Settings, build_plan, discover_cases, evenly_spaced
+from lanevil_core.dataset.manifest import _PACKAGE, source_files
+from lanevil_core.dataset.plan import SourceCase, render_tasks, train_variation
+from lanevil_core.illusions import REGISTRY
+from lanevil_core.presets import PRESET_NAMES
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+
+
+@pytest.mark.parametrize(("total", "count", "expected"), [
+    (100, 1, (0,)),
+    (100, 2, (0, 99)),
+    (100, 4, (0, 33, 66, 99)),
+    (5, None, (0, 1, 2, 3, 4)),
+    (5, 9, (0, 1, 2, 3, 4)),
+])
+def test_evenly_spaced(total: int, count: int | None, expected: tuple[int, ...]) -> None:
+    assert evenly_spaced(total, count) == expected
+
+
+@pytest.fixture(scope="module")
+def stock() -> list[SourceCase]:
+    return discover_cases(SCENES)
+
+
+def test_stock_library_plan(stock: list[SourceCase]) -> None:
+    plan = build_plan(stock, Settings(frames_per_case=10, train_frames=160))
+    test = plan.split_cases("test")
+    assert len(test) == 6 * len(REGISTRY)  # an original and five levels per illusion type
+    assert len({case.folder for case in test}) == len(test)
+    for case in test:
+        category, type_folder, name = case.folder.parts
+        assert category in CATEGORY_FOLDERS.values() and type_folder in TYPE_FOLDERS.values()
+        assert case.severity == (0 if name == "00_original" else int(name[-1]))
+        assert len(case.frames) == 10
+    assert str(test[0].folder) == "RoadDamage/GuardRail/00_original"  # sorted by source path
+    assert sum(len(case.frames) for case in plan.split_cases("train")) == 160
+    assert plan.total_frames == 1000
+
+
+def test_train_variations_are_seeded_valid_and_varied(stock: list[SourceCase]) -> None:
+    clean = [source for source in stock if source.relative.parts[0] == "00_clean"]
+    assert len(clean) == 9
+    variations = [train_variation(source.case, 7, index) for index, source in enumerate(clean * 3)]
+    again = [train_variation(source.case, 7, index) for index, source in enumerate(clean * 3)]
+    assert variations == again
+    assert train_variation(clean[0].case, 8, 0) != variations[0]
+    for case, parameters in variations:
+        assert isinstance(case, Case) and not case.illusions
+        assert parameters["preset"] in PRESET_NAMES
+        assert 0 <= case.ego.lane < case.road.lanes_per_direction
+    assert len({p["preset"] for _, p in variations}) >= 6
+    assert len({tuple(p["markings"]) for _, p in variations}) >= 6
+
+
+def test_clashing_folders_and_missing_cases_are_plan_errors(stock: list[SourceCase]) -> None:
+    original = next(source for source in stock if source.relative.name == "01_level1.json")
+    twin = SourceCase(PurePosixPath("copy") / original.relative, original.case)
+    with pytest.raises(PlanError, match="both map to test/"):
+        build_plan([original, twin], Settings())
+    with pytest.raises(PlanError, match="no case files"):
+        build_plan([], Settings())
+
+
+def test_tasks_cover_the_pending_frames_in_chunks(stock: list[SourceCase]) -> None:
+    plan = build_plan(stock[:12], Settings(frames_per_case=10))
+    pending = {(case.split, str(case.folder)): list(case.frames) for case in plan.cases}
+    tasks = render_tasks(plan, pending, chunk_frames=4)
+    assert sum(len(task.frames) for task in tasks) == plan.total_frames
+    assert max(len(task.frames) for task in tasks) == 4
+
+
+def test_renderer_sources_reach_the_render_path_only() -> None:
+    names = {path.relative_to(_PACKAGE).as_posix() for path in source_files()}
+    assert {"dataset/worker.py", "render/renderer.py", "labels.py", "compile.py", "export.py"} <= names
+    assert not any(name.startswith(("cli", "dataset/local", "dataset/run")) for name in names)

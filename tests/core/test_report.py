@@ -1,0 +1,110 @@
+"""Robustness report: hand-checked grouping on synthetic scores, and a small end-to-end run
+(render -> detect -> eval -> report) on tiny frames of stock cases."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from lanevil_core.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, frame_file
+from lanevil_core.case import load_case
+from lanevil_core.cli import main
+from lanevil_core.compile import compile_scene
+from lanevil_core.export import png_bytes
+from lanevil_core.illusions import REGISTRY
+from lanevil_core.labels import tusimple_record
+from lanevil_core.metrics.evaluate import ScoredImage, score_tusimple_files
+from lanevil_core.metrics.tusimple import ImageScore, f1_ganet
+from lanevil_core.render import render_frame
+from lanevil_core.report import ALL, build_report, markdown, severity_csv
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+SIZE = (320, 180)
+
+
+def scored(category: str, type_name: str, severity: int, accuracy: float, fp: float = 0.0, fn: float = 0.0):
+    extra = {"category": category, "type": type_name, "severity": severity, "case": f"0{severity}"}
+    return ScoredImage(f"{category}/{type_name}/{severity}.png", ImageScore(accuracy, fp, fn), extra)
+
+
+def test_groups_original_perturbed_and_gap():
+    images = [scored("Shadow", "Fence", 0, 1.0), scored("Shadow", "Fence", 1, 0.8, 0.2, 0.0),
+              scored("Shadow", "Fence", 5, 0.4, 0.0, 0.5), scored("Shadow", "Wire", 0, 0.9),
+              scored("Shadow", "Wire", 5, 0.9), scored("RoadDamage", "RoadCrack", 0, 0.5),
+              scored("RoadDamage", "RoadCrack", 2, 0.7)]
+    report = build_report(images + [ScoredImage("x.png", ImageScore(0.0, 0.0, 1.0), {})], "ganet")
+    rows = {(row.category, row.type): row for row in report.rows}
+    assert [key for key in rows][:3] == [("RoadDamage", "RoadCrack"), ("RoadDamage", ALL), ("Shadow", "Fence")]
+    fence = rows[("Shadow", "Fence")]
+    assert fence.original.accuracy == 1.0 and fence.perturbed.accuracy == pytest.approx(0.6)
+    assert fence.gap("accuracy") == pytest.approx(-0.4)
+    assert fence.gap("accuracy", 5) == pytest.approx(-0.6) and fence.levels[3] is None
+    assert fence.perturbed.f1 == pytest.approx(f1_ganet(0.1, 0.25))
+    shadow = rows[("Shadow", ALL)]
+    assert shadow.original.accuracy == pytest.approx(0.95) and shadow.perturbed.images == 3
+    assert rows[(ALL, ALL)].original.images == 3 and report.unlabelled == 1
+    text = markdown(report)
+    assert "| Shadow | Fence | 1/2 | 100.00 | 60.00 | -40.00 |" in text
+    assert "40.00 (-60.00)" in text and "1 image(s) without category" in text
+    levels = list(csv.DictReader(severity_csv(report).splitlines()))
+    assert [r["severity"] for r in levels if r["type"] == "Fence"] == ["0", "1", "5"]
+
+
+CASES = [("fence_shadow", "00_original", 0), ("fence_shadow", "05_level5", 5), ("road_crack", "00_original", 0),
+         ("road_crack", "03_level3", 3)]
+
+
+def _stock_path(illusion_type: str, name: str) -> Path:
+    return next(SCENES.glob(f"*/{illusion_type}/{name}.json"))
+
+
+@pytest.fixture(scope="module")
+def tiny_split(tmp_path_factory) -> Path:
+    """A two-type test split (one frame per case at 320x180) in the benchmark layout."""
+    split = tmp_path_factory.mktemp("dataset") / "test"
+    lines = []
+    for illusion_type, name, severity in CASES:
+        category = CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY]
+        type_folder = TYPE_FOLDERS[illusion_type]
+        scene = compile_scene(load_case(_stock_path(illusion_type, name)))
+        frame = render_frame(scene, 10, SIZE)
+        raw_file = f"{category}/{type_folder}/{name}/{frame_file(0)}"
+        (split / raw_file).parent.mkdir(parents=True, exist_ok=True)
+        (split / raw_file).write_bytes(png_bytes(frame.rgb))
+        record = tusimple_record(scene, 10, frame, raw_file)
+        lines.append(json.dumps({**record, "category": category, "type": type_folder, "severity": severity,
+                                 "case": name}))
+    (split / "test_label.json").write_text("\n".join(lines) + "\n")
+    return split
+
+
+def test_end_to_end_detect_eval_report(tiny_split, tmp_path, capsys):
+    preds = tmp_path / "birdseye.json"
+    assert main(["detect", str(tiny_split), "--method", "birdseye", "--out", str(preds)]) == 0
+    assert main(["eval", "--gt", str(tiny_split / "test_label.json"), "--pred", str(preds), "--json"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    overall = json.loads(lines[-1])
+    out = tmp_path / "report"
+    assert main(["report", "--gt", str(tiny_split), "--pred", str(preds), "--out", str(out)]) == 0
+    for name in ("report.md", "report.csv", "report_severity.csv", "report.png"):
+        assert (out / name).stat().st_size > 0
+    assert (out / "report.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rows = {(r["category"], r["type"]): r for r in csv.DictReader((out / "report.csv").read_text().splitlines())}
+    assert set(rows) == {("RoadDamage", "RoadCrack"), ("RoadDamage", ALL), ("Shadow", "Fence"), ("Shadow", ALL),
+                         (ALL, ALL)}
+    images = score_tusimple_files(tiny_split / "test_label.json", preds)
+    everything = rows[(ALL, ALL)]
+    # The table agrees with the per-image scores and with eval over the whole split.
+    originals = [image.score.accuracy for image in images if image.extra["severity"] == 0]
+    assert float(everything["accuracy_original"]) == pytest.approx(sum(originals) / 2, abs=1e-6)
+    n_orig, n_pert = int(everything["images_original"]), int(everything["images_perturbed"])
+    pooled = (float(everything["accuracy_original"]) * n_orig + float(everything["accuracy_perturbed"]) * n_pert)
+    assert pooled / (n_orig + n_pert) == pytest.approx(overall["accuracy"], abs=1e-5)
+    for row in rows.values():
+        gap = float(row["accuracy_perturbed"]) - float(row["accuracy_original"])
+        assert float(row["accuracy_gap"]) == pytest.approx(gap, abs=2e-6)
+    text = (out / "report.md").read_text()
+    assert "| Shadow | Fence | 1/1 |" in text and "F1 variant `ganet`" in text

@@ -1,0 +1,209 @@
+"""The demo website in headless Chromium against a live server on the small test store (only ``fence_shadow``).
+
+Checks that sliders re-render the frames (debounced, ending on the latest value), the overlay toggle, error and
+"not in this library" states, keyboard use, and layouts at desktop and phone widths (screenshots saved).
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+CARD = "#card-fence_shadow"
+PERTURBED = f'{CARD} figure[data-role="perturbed"] img'
+ORIGINAL = f'{CARD} figure[data-role="original"] img'
+TIMEOUT_MS = 20_000
+
+# True once the picture of `sel` shows a new API URL (not `old`), decoded and no longer loading.
+SHOWS_NEW = """([sel, old]) => {
+  const img = document.querySelector(sel);
+  return img && !img.hidden && img.dataset.src && img.dataset.src !== old && img.complete && img.naturalWidth > 0
+    && img.closest("figure").getAttribute("aria-busy") === "false";
+}"""
+# FNV-1a over the decoded pixels of an <img>: equal pictures hash equal.
+PIXEL_HASH = """(sel) => {
+  const img = document.querySelector(sel);
+  const canvas = document.createElement("canvas");
+  canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+  const context = canvas.getContext("2d");
+  context.drawImage(img, 0, 0);
+  const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
+  let hash = 0x811c9dc5;
+  for (let i = 0; i < data.length; i += 1) hash = Math.imul(hash ^ data[i], 16777619) >>> 0;
+  return hash;
+}"""
+BROKEN_IMAGES = """() => [...document.images].filter((img) => !img.hidden && img.offsetParent !== null
+  && (!img.complete || img.naturalWidth === 0)).length"""
+SETTLED = """() => [...document.querySelectorAll(".card")].every((card) =>
+  ["ready", "missing", "error"].includes(card.dataset.state)
+  && [...card.querySelectorAll("figure")].every((figure) => figure.getAttribute("aria-busy") !== "true"))"""
+
+
+def shown(page, sel: str) -> dict:
+    return page.eval_on_selector(sel, "(img) => ({src: img.src, url: img.dataset.src, width: img.naturalWidth})")
+
+
+def wait_new(page, sel: str, old: str | None) -> dict:
+    page.wait_for_function(SHOWS_NEW, arg=[sel, old or ""], timeout=TIMEOUT_MS)
+    return shown(page, sel)
+
+
+def open_card(page, live_server) -> tuple[dict, dict]:
+    page.goto(live_server.url + "/")
+    page.locator(CARD).scroll_into_view_if_needed()
+    return wait_new(page, ORIGINAL, None), wait_new(page, PERTURBED, None)
+
+
+def load_every_card(page) -> None:
+    """Scroll to the end (cards load lazily) and wait until every card has settled."""
+    page.wait_for_selector("body[data-ready]")
+    for card in page.locator(".card").all():
+        card.scroll_into_view_if_needed()
+    page.wait_for_function(SETTLED, timeout=TIMEOUT_MS)
+    page.evaluate("window.scrollTo(0, 0)")
+
+
+def test_sliders_and_overlay_rerender_the_frames(page, live_server) -> None:
+    original, perturbed = open_card(page, live_server)
+    assert "severity=3" in perturbed["url"] and "overlay=false" in perturbed["url"]
+    assert perturbed["width"] == 480
+    level3 = page.evaluate(PIXEL_HASH, PERTURBED)
+
+    slider = page.locator(f"{CARD} input[data-control=severity]")
+    slider.focus()
+    page.keyboard.press("ArrowRight")
+    page.keyboard.press("ArrowRight")  # keyboard: 3 -> 5
+    assert slider.input_value() == "5"
+    level5 = wait_new(page, PERTURBED, perturbed["url"])
+    assert "severity=5" in level5["url"] and level5["src"] != perturbed["src"]
+    assert page.evaluate(PIXEL_HASH, PERTURBED) != level3
+    assert page.locator(f'{CARD} figure[data-role="perturbed"] figcaption').inner_text() == "Perturbed · level 5"
+    assert shown(page, ORIGINAL)["url"] == original["url"]  # severity leaves the original alone
+
+    azimuth_value = page.locator(f'{CARD} output[data-output="azimuth"]')
+    assert azimuth_value.inner_text() == "auto"  # the shadow illusion places its own sun until overridden
+    before = page.evaluate(PIXEL_HASH, ORIGINAL)
+    page.locator(f"{CARD} input[data-control=azimuth]").fill("120")
+    assert azimuth_value.inner_text() == "120°"
+    assert "behind-left" in page.get_attribute(f"{CARD} input[data-control=azimuth]", "aria-valuetext")
+    moved = wait_new(page, ORIGINAL, original["url"])
+    assert "sun_azimuth=120" in moved["url"]
+    assert page.evaluate(PIXEL_HASH, ORIGINAL) != before
+    sunny = wait_new(page, PERTURBED, level5["url"])
+    assert "sun_azimuth=120" in sunny["url"] and "severity=5" in sunny["url"]
+
+    before = page.evaluate(PIXEL_HASH, PERTURBED)
+    page.locator(f"{CARD} input[data-control=altitude]").fill("20")
+    low_sun = wait_new(page, PERTURBED, sunny["url"])
+    assert "sun_altitude=20" in low_sun["url"]
+    assert page.evaluate(PIXEL_HASH, PERTURBED) != before
+
+    before = page.evaluate(PIXEL_HASH, PERTURBED)
+    page.locator("label[for=overlay-toggle]").click()
+    overlaid = wait_new(page, PERTURBED, low_sun["url"])
+    assert "overlay=true" in overlaid["url"]
+    assert page.evaluate(PIXEL_HASH, PERTURBED) != before
+    assert "overlay=true" in wait_new(page, ORIGINAL, moved["url"])["url"]
+    assert "lanes drawn" in page.get_attribute(PERTURBED, "alt")
+
+
+def test_a_slider_drag_ends_on_the_latest_value_with_few_requests(page, live_server) -> None:
+    _, perturbed = open_card(page, live_server)
+    requested: list[str] = []
+    page.on("request", lambda request: requested.append(request.url) if "/frames/" in request.url else None)
+    slider = page.locator(f"{CARD} input[data-control=severity]")
+    for value in ("1", "2", "4", "5", "1"):  # faster than the debounce delay
+        slider.fill(value)
+    final = wait_new(page, PERTURBED, perturbed["url"])
+    assert "severity=1" in final["url"]
+    page.wait_for_timeout(400)
+    assert shown(page, PERTURBED)["url"] == final["url"]
+    assert len(requested) == 1, requested
+
+
+def test_reset_returns_to_the_first_render(page, live_server) -> None:
+    original, perturbed = open_card(page, live_server)
+    page.locator(f"{CARD} input[data-control=severity]").fill("1")
+    page.locator(f"{CARD} input[data-control=azimuth]").fill("200")
+    changed = wait_new(page, PERTURBED, perturbed["url"])["url"]
+    moved = wait_new(page, ORIGINAL, original["url"])["url"]
+    page.locator(f"{CARD} .card__reset").click()
+    assert wait_new(page, PERTURBED, changed)["url"] == perturbed["url"]
+    assert wait_new(page, ORIGINAL, moved)["url"] == original["url"]
+    assert page.locator(f"{CARD} input[data-control=severity]").input_value() == "3"
+
+
+def test_api_errors_are_shown_on_the_card(page, live_server) -> None:
+    _, perturbed = open_card(page, live_server)
+    body = json.dumps({"detail": "severity: the renderer is out of paint", "field": "severity"})
+    page.route("**/frames/0.jpg?*severity=2*", lambda route: route.fulfill(
+        status=422, content_type="application/json", body=body))
+    page.locator(f"{CARD} input[data-control=severity]").fill("2")
+    error = page.locator(f'{CARD} figure[data-role="perturbed"] .frame__error')
+    error.wait_for(state="visible", timeout=TIMEOUT_MS)
+    assert "severity: the renderer is out of paint" in error.inner_text()
+    assert shown(page, PERTURBED)["url"] == perturbed["url"]  # the last good picture stays
+    page.unroute("**/frames/0.jpg?*severity=2*")
+    error.locator("button").click()
+    assert "severity=2" in wait_new(page, PERTURBED, perturbed["url"])["url"]
+    assert error.is_hidden()
+
+
+def test_types_missing_from_the_store_say_so(page, live_server) -> None:
+    page.goto(live_server.url + "/")
+    load_every_card(page)
+    assert page.locator(".card").count() == 14
+    missing = page.locator('.card[data-state="missing"]')
+    assert missing.count() == 13
+    crack = page.locator("#card-road_crack")
+    assert crack.get_attribute("data-state") == "missing"
+    assert "Not in this library" in crack.locator(".card__missing").inner_text()
+    assert crack.locator("img:visible").count() == 0
+    assert crack.locator(".controls").is_hidden()
+    assert page.evaluate(BROKEN_IMAGES) == 0
+    assert page.locator(f'{CARD}[data-state="ready"] img:visible').count() == 2
+
+
+@pytest.mark.parametrize(("name", "width", "height"), [("desktop", 1280, 900), ("phone", 390, 844)])
+def test_layout_screenshots(browser, live_server, screenshot_dir, name, width, height) -> None:
+    context = browser.new_context(viewport={"width": width, "height": height}, device_scale_factor=1)
+    page = context.new_page()
+    try:
+        page.goto(live_server.url + "/")
+        load_every_card(page)
+        assert page.evaluate("document.documentElement.scrollWidth") <= width  # no sideways scrolling
+        columns = page.evaluate("""() => getComputedStyle(document.querySelector('.cards'))
+          .gridTemplateColumns.split(' ').length""")
+        assert columns == (1 if width < 700 else 2)
+        page.screenshot(path=str(screenshot_dir / f"demo-{name}.png"))
+        page.locator(CARD).scroll_into_view_if_needed()
+        page.locator(CARD).screenshot(path=str(screenshot_dir / f"demo-{name}-card.png"))
+        page.screenshot(path=str(screenshot_dir / f"demo-{name}-full.png"), full_page=True)
+    finally:
+        context.close()
+
+
+def test_listing_and_registry_errors_are_shown(page, live_server) -> None:
+    body = json.dumps({"detail": "store: not reachable"})
+    page.route("**/api/cases?type=fence_shadow", lambda route: route.fulfill(
+        status=503, content_type="application/json", body=body))
+    page.goto(live_server.url + "/")
+    page.locator(CARD).scroll_into_view_if_needed()
+    error = page.locator(f"{CARD} .card__error")
+    error.wait_for(state="visible", timeout=TIMEOUT_MS)
+    assert "store: not reachable" in error.inner_text()
+    assert page.get_attribute(CARD, "data-state") == "error"
+    page.unroute("**/api/cases?type=fence_shadow")
+    error.locator("button").click()
+    wait_new(page, PERTURBED, None)
+    assert error.is_hidden()
+
+    page.route("**/api/illusions", lambda route: route.fulfill(
+        status=500, content_type="application/json", body=json.dumps({"detail": "registry exploded"})))
+    page.reload()
+    banner = page.locator("#page-error")
+    banner.wait_for(state="visible", timeout=TIMEOUT_MS)
+    assert "registry exploded" in banner.inner_text()
