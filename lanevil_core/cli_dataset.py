@@ -5,19 +5,23 @@ from __future__ import annotations
 import argparse
 import functools
 import os
+import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from .cli import Command, UsageError, parse_size
 
 
-def _count(name: str, minimum: int):  # noqa: ANN202 - an argparse type factory
+def _count(minimum: int) -> Callable[[str], int]:
+    """An argparse type: an integer of at least ``minimum`` (argparse names the option in errors)."""
+
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
         if value < minimum:
-            raise argparse.ArgumentTypeError(f"{name} must be at least {minimum}")
+            raise argparse.ArgumentTypeError(f"must be at least {minimum}")
         return value
 
     return parse
@@ -26,20 +30,20 @@ def _count(name: str, minimum: int):  # noqa: ANN202 - an argparse type factory
 def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cases", type=Path, required=True, help="folder of case files (searched recursively)")
     parser.add_argument("--out", type=Path, required=True, help="output folder (reruns resume into it)")
-    parser.add_argument("--train-frames", type=_count("--train-frames", 0), default=0,
+    parser.add_argument("--train-frames", type=_count(0), default=0,
                         help="clean train frames, from variations of the clean cases (default 0)")
-    parser.add_argument("--frames-per-case", type=_count("--frames-per-case", 1), default=None,
+    parser.add_argument("--frames-per-case", type=_count(1), default=None,
                         help="frames per test case, evenly spaced over its drive (default: every frame)")
     parser.add_argument("--size", type=parse_size, default=(1280, 720), help="WIDTHxHEIGHT (default 1280x720)")
     parser.add_argument("--format", choices=("png", "jpg"), default="png", dest="image_format",
                         help="image format (default png)")
-    parser.add_argument("--workers", type=_count("--workers", 1), default=os.cpu_count() or 1,
+    parser.add_argument("--workers", type=_count(1), default=os.cpu_count() or 1,
                         help="local worker processes (default: all cores; ignored with --scheduler)")
     parser.add_argument("--scheduler", default=None,
                         help="run on the Dask cluster of this scheduler, tcp://HOST:PORT")
     parser.add_argument("--scheduler-timeout", type=float, default=10.0,
                         help="seconds to wait for the scheduler (default 10)")
-    parser.add_argument("--seed", type=_count("--seed", 0), default=0, help="seed of the train variations")
+    parser.add_argument("--seed", type=_count(0), default=0, help="seed of the train variations")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -64,6 +68,10 @@ def _run_dataset(args: argparse.Namespace) -> int:
         summary = generate_dataset(args.cases, args.out, settings, executor, show_progress=not args.quiet)
     except (PlanError, SchedulerError) as error:
         raise UsageError(str(error)) from None
+    except KeyboardInterrupt:
+        print(f"interrupted: frames written so far are kept; rerun the same command to resume into {args.out}",
+              file=sys.stderr)
+        return 130
     print(f"{summary.total} frames in {summary.out_dir} ({summary.rendered} rendered, {summary.kept} kept) "
           f"in {summary.seconds:.1f} s, {summary.frames_per_second:.2f} frames/s")
     return 0

@@ -17,7 +17,8 @@ METRIC_CHOICES = ("tusimple", "culane")
 
 def _eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--gt", type=Path, required=True,
-                        help="ground truth: TuSimple JSON lines, or a folder of CULane .lines.txt files")
+                        help="ground truth: TuSimple JSON lines (or a split folder with its *_label.json), "
+                             "or a folder of CULane .lines.txt files")
     parser.add_argument("--pred", type=Path, required=True, help="predictions in the same format as --gt")
     parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple", help="default tusimple")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet",

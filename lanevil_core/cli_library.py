@@ -23,7 +23,7 @@ def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
                 "description")
         parameters[field] = {key: spec[key] for key in keys if key in spec}
     return {"name": cls.model_fields["type"].default, "category": cls.CATEGORY,
-            "description": (cls.__doc__ or "").strip().splitlines()[0], "parameters": parameters,
+            "description": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()), "parameters": parameters,
             "severity": [dict(row) for row in cls.SEVERITY]}
 
 

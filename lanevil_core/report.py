@@ -111,7 +111,8 @@ def build_report(images: Iterable[ScoredImage], f1_variant: str = "ganet", title
 def _pct(value: float | None, signed: bool = False) -> str:
     if value is None:
         return "-"
-    return f"{100 * value:+.2f}" if signed else f"{100 * value:.2f}"
+    percent = round(100 * value, 2) or 0.0  # no "-0.00" from float noise
+    return f"{percent:+.2f}" if signed else f"{percent:.2f}"
 
 
 def _label(row: Row) -> tuple[str, str]:

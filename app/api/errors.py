@@ -51,7 +51,8 @@ def error_response(status_code: int, detail: str, field: str | None = None,
 
 
 def field_path(loc: Sequence[Any]) -> str:
-    """``("body", "road", "lanes")`` -> ``road.lanes``; ``("query", "width")`` -> ``width``; ``("body",)`` -> ``body``."""
+    """``("body", "road", "lanes")`` -> ``road.lanes``, ``("query", "width")`` -> ``width``, ``("body",)`` ->
+    ``body``."""
     parts = [str(part) for part in loc]
     if len(parts) > 1 and parts[0] in REQUEST_SOURCES:
         parts = parts[1:]

@@ -72,8 +72,11 @@ def mesh_parts(meshes: Sequence[Mesh]) -> list[tuple[FloatArray, IntArray, Float
 
 def road_parts(surface: RoadSurface, network: RoadNetwork, case: Case) -> list[tuple[FloatArray, IntArray,
                                                                                      Float32Array]]:
-    """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``."""
-    return [(surface.vertices, surface.faces, MATERIAL_ALBEDO[surface.material]),
+    """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``.
+
+    The swept surface's faces wind clockwise seen from above (the software renderer draws both sides); they are
+    reversed here so the viewer, which culls back faces, shows the road from above."""
+    return [(surface.vertices, surface.faces[:, ::-1], MATERIAL_ALBEDO[surface.material]),
             paint_mesh(network, case.road.markings)]
 
 
@@ -197,7 +200,7 @@ class SceneView:
         wxyz, position = wxyz_of(camera.R_world_camera), camera.p_world_camera
         if self._frustum is None:
             self._frustum = self.scene.add_camera_frustum("/camera", fov=fov_vertical, aspect=k.width / k.height,
-                                                          scale=2.5, color=FRUSTUM_COLOR, thickness=2.5,
+                                                          scale=1.6, color=FRUSTUM_COLOR, thickness=2.5,
                                                           thickness_units="screen",
                                                           wxyz=wxyz, position=position)
         else:

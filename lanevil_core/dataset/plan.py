@@ -171,7 +171,7 @@ def discover_cases(root: Path) -> list[SourceCase]:
     return [SourceCase(PurePosixPath(path.relative_to(root).as_posix()), load_case(path)) for path in paths]
 
 
-def test_case(source: SourceCase, frames_per_case: int | None) -> PlannedCase:
+def planned_test_case(source: SourceCase, frames_per_case: int | None) -> PlannedCase:
     """The test-split entry of a case with an illusion type."""
     case = source.case
     illusion_type = case_illusion_type(case, source.folder_type)
@@ -262,7 +262,7 @@ def build_plan(sources: list[SourceCase], settings: Settings) -> DatasetPlan:
         raise PlanError("no case files (*.json) found")
     typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
     clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
-    planned = [test_case(source, settings.frames_per_case) for source in typed]
+    planned = [planned_test_case(source, settings.frames_per_case) for source in typed]
     planned += train_cases(clean, settings.train_frames, settings.seed)
     if not planned:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -64,16 +65,19 @@ def _encode_and_hash(rgb: UInt8Array, image_format: str) -> tuple[bytes, str]:
 
 
 _SCENES: OrderedDict[str, CompiledScene] = OrderedDict()
+_SCENES_LOCK = threading.Lock()  # a Dask worker may run several tasks on threads of one process
 
 
 def compiled_scene(case_text: str, case_sha256: str) -> CompiledScene:
     """The compiled scene of a case, from this process's small LRU cache keyed by the case hash."""
-    scene = _SCENES.pop(case_sha256, None)
+    with _SCENES_LOCK:
+        scene = _SCENES.pop(case_sha256, None)
     if scene is None:
         scene = compile_scene(parse_case(case_text))
-    _SCENES[case_sha256] = scene
-    while len(_SCENES) > SCENE_CACHE_SIZE:
-        _SCENES.popitem(last=False)
+    with _SCENES_LOCK:
+        _SCENES[case_sha256] = scene
+        while len(_SCENES) > SCENE_CACHE_SIZE:
+            _SCENES.popitem(last=False)
     return scene
 
 

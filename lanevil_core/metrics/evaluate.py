@@ -21,6 +21,7 @@ from .formats import (
     pair_records,
     read_culane_file,
     read_tusimple,
+    split_labels,
     tusimple_points,
 )
 
@@ -83,11 +84,16 @@ def _culane_pairs_from_folders(gt_root: Path, pred_root: Path) -> list[tuple[lis
 
 def evaluate(gt_path: str | Path, pred_path: str | Path, metric: Metric = "tusimple",
              f1_variant: str = "ganet") -> dict[str, Any]:
-    """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``)."""
+    """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``).
+
+    ``gt_path`` may also be a split folder (its ``*_label.json`` is read) when ``pred_path`` is a file.
+    """
     gt_path, pred_path = Path(gt_path), Path(pred_path)
     for path in (gt_path, pred_path):
         if not path.exists():
             raise LaneFileError(f"{path}: no such file or folder")
+    if gt_path.is_dir() and not pred_path.is_dir() and not culane_files(gt_path):
+        gt_path = split_labels(gt_path)  # a split folder: its *_label.json
     if gt_path.is_dir() != pred_path.is_dir():
         raise LaneFileError(f"{gt_path} and {pred_path}: give two TuSimple JSON files or two CULane folders")
     if metric == "tusimple":

@@ -96,12 +96,15 @@ async function showResults(studyId) {
     const reasons = people.excluded_by_reason;
     $("results-title").textContent = `Results: ${results.study.title}`;
     $("results-people").textContent =
-      `${people.total} participant${people.total === 1 ? "" : "s"}, ${people.included} included, ${people.excluded} excluded ` +
+      `${people.total} participant${people.total === 1 ? "" : "s"}, ${people.included} included, ` +
+      `${people.excluded} excluded ` +
       `(failed gold: ${reasons.gold}, failed trap: ${reasons.trap}, incomplete: ${reasons.incomplete}). ` +
       `${results.ratings.used} of ${results.ratings.total} ratings enter the MOS.`;
     const tables = $("results-tables");
     tables.replaceChildren();
-    for (const [name, groups] of Object.entries(results.groups)) tables.append(...groupTable(name, groups, name === "item" ? labels : {}));
+    for (const [name, groups] of Object.entries(results.groups)) {
+      tables.append(...groupTable(name, groups, name === "item" ? labels : {}));
+    }
     $("download-ratings").onclick = () => download(`/api/study/studies/${studyId}/ratings.csv`);
     $("download-summary").onclick = () => download(`/api/study/studies/${studyId}/summary.csv`);
     $("results").hidden = false;

@@ -7,6 +7,7 @@ import hashlib
 import json
 import shutil
 import socket
+from collections.abc import Sequence
 from pathlib import Path
 
 import pytest
@@ -16,7 +17,8 @@ from lanevil_core.case import case_json, load_case
 from lanevil_core.cli import main
 from lanevil_core.dataset import Settings, generate_dataset
 from lanevil_core.dataset.local import run_local
-from lanevil_core.dataset.writer import PROGRESS_DIR
+from lanevil_core.dataset.plan import RenderTask
+from lanevil_core.dataset.worker import FrameResult, TaskDone
 from lanevil_core.labels import h_samples_for
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -180,10 +182,10 @@ def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Pat
     out = tmp_path / "interrupted"
     settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3)
 
-    def interrupt_after_two_tasks(tasks, on_done) -> None:  # noqa: ANN001 - an Executor
+    def interrupt_after_two_tasks(tasks: Sequence[RenderTask], on_done: TaskDone) -> None:
         done = []
 
-        def counting(task, results) -> None:  # noqa: ANN001
+        def counting(task: RenderTask, results: list[FrameResult]) -> None:
             on_done(task, results)
             done.append(task)
             if len(done) == 2:
@@ -237,7 +239,7 @@ def _free_port() -> int:
     (["--cases", "{cases}", "--size", "160by90"], "is not WIDTHxHEIGHT"),
     (["--cases", "{cases}", "--size", "10x10"], "must lie in 64..4096"),
     (["--cases", "{cases}", "--format", "gif"], "invalid choice"),
-    (["--cases", "{cases}", "--frames-per-case", "0"], "--frames-per-case must be at least 1"),
+    (["--cases", "{cases}", "--frames-per-case", "0"], "argument --frames-per-case: must be at least 1"),
     (["--cases", "{cases}", "--scheduler", "localhost:8786"], "is not tcp://HOST:PORT"),
     (["--cases", "{cases}", "--scheduler", "tcp://127.0.0.1:{port}", "--scheduler-timeout", "1"],
      "cannot reach the Dask scheduler"),

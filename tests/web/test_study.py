@@ -117,8 +117,8 @@ def test_large_study_renders_in_a_background_job(client, state) -> None:
 
 
 def test_json_spec_without_uploads(client) -> None:
-    response = client.post("/api/study/studies", headers=ADMIN,
-                           json={"title": "Synthetic only", **SIZE, "generated": {"cases": ["clean-00_straight_urban"]}})
+    spec = {"title": "Synthetic only", **SIZE, "generated": {"cases": ["clean-00_straight_urban"]}}
+    response = client.post("/api/study/studies", headers=ADMIN, json=spec)
     assert response.status_code == 201, response.text
     assert [item["case_id"] for item in response.json()["items"]] == ["clean-00_straight_urban"]
 

@@ -1,0 +1,91 @@
+"""The editor in headless Chromium: the scene loads, a click on the road places an illusion, the severity slider
+changes the preview, Save stores the case. Screenshots go to tests/web/_screenshots/editor_*.png."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from app.editor import Editor, launch_editor
+from app.state import AppState
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+CHROMIUM = Path("/usr/bin/chromium")  # Debian's package, as in conftest's ``browser`` fixture
+# viser draws with WebGL: headless Chromium without a GPU needs SwiftShader allowed explicitly (with conftest's
+# plain arguments a screenshot of the WebGL canvas never completes).
+WEBGL_ARGS = ["--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
+              "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+ROAD_CLICK = (470, 660)  # on the ego's carriageway in the start view (camera behind and above the ego)
+WAIT_S = 90.0
+
+
+@pytest.fixture(scope="module")
+def webgl_browser():
+    if not CHROMIUM.exists():
+        pytest.skip("Debian chromium is not installed")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        chromium = playwright.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=WEBGL_ARGS)
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture
+def editor(state: AppState) -> Iterator[Editor]:
+    editor = launch_editor(state, host="127.0.0.1", port=0)
+    yield editor
+    editor.stop()
+
+
+def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.1)
+
+
+def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor, state: AppState,
+                                                    screenshot_dir: Path) -> None:
+    page = webgl_browser.new_page(viewport={"width": 1280, "height": 900})
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
+    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    preview = page.locator("img[src^='blob:']").first
+    preview.wait_for(timeout=WAIT_S * 1000)
+    time.sleep(4)  # the road mesh fades in
+    page.screenshot(path=str(screenshot_dir / "editor_1_opened.png"))
+
+    case_id = editor.session.case_id
+    page.locator("select").filter(has_text="pedestrian").select_option("vehicle")
+    wait_for(lambda: editor.panel.place.value == "vehicle", "the Place dropdown")
+    page.mouse.click(*ROAD_CLICK)
+    wait_for(lambda: any(ill.type == "vehicle" for ill in editor.case.illusions), "the placed vehicle")
+    assert editor.preview.wait_idle(WAIT_S)
+    time.sleep(3)
+    page.screenshot(path=str(screenshot_dir / "editor_2_placed.png"))
+    before = preview.screenshot()
+    placed = editor.case.illusions[-1]
+    assert editor.selected == len(editor.case.illusions) - 1 and 10.0 < placed.s < 80.0
+
+    severity = page.locator("[role=slider][aria-valuemax='5']")
+    severity.focus()
+    severity.press("ArrowRight")
+    severity.press("ArrowRight")
+    wait_for(lambda: editor.case.illusions[-1].severity == 5, "severity 5")
+    assert editor.preview.wait_idle(WAIT_S)
+    time.sleep(2)
+    after = preview.screenshot()
+    assert after != before, "the preview did not change with the severity"
+    page.screenshot(path=str(screenshot_dir / "editor_3_severity.png"))
+
+    page.get_by_role("button", name="Save", exact=True).click()
+    wait_for(lambda: state.store.get(case_id).version == 2, "the save")
+    stored = state.store.get(case_id).case.illusions[-1]
+    assert stored.type == "vehicle" and stored.severity == 5 and stored.s == placed.s
+    page.close()
