@@ -18,11 +18,13 @@ from typing import Any, Generic, Literal, TypeVar
 
 import numpy as np
 from PIL import Image
+from pydantic.fields import FieldInfo
 
 from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
 from lanevil_core.compile import compile_scene
 from lanevil_core.export import png_bytes
+from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
 from lanevil_core.overlay import draw_lanes
 from lanevil_core.render import render_frame
@@ -94,15 +96,34 @@ def apply_overrides(case: Case, severity: int | None = None, sun_azimuth: float 
                     sun_altitude: float | None = None, sun_intensity: float | None = None) -> Case:
     """A copy of ``case`` with every illusion at ``severity`` and/or the sun moved (for scrubbing without saving).
 
-    Values are validated by the case model: an out-of-range override raises ``pydantic.ValidationError``."""
+    Values are validated by the case model: an out-of-range override raises ``pydantic.ValidationError``.
+    Illusions that place the sun themselves (the shadow types' ``sun_*`` fields) get the sun override too, clamped
+    to their own ranges, so a sun slider moves their shadows; the others keep the sun their severity table sets.
+    """
     data: dict[str, Any] = case.model_dump(mode="json")
-    if severity is not None:
-        for illusion in data["illusions"]:
+    sun = {"azimuth": sun_azimuth, "altitude": sun_altitude, "intensity": sun_intensity}
+    for illusion in data["illusions"]:
+        if severity is not None:
             illusion["severity"] = severity
-    for name, value in (("azimuth", sun_azimuth), ("altitude", sun_altitude), ("intensity", sun_intensity)):
+        fields = REGISTRY[illusion["type"]].model_fields
+        for name, value in sun.items():
+            field = fields.get(f"sun_{name}")
+            if value is not None and field is not None:
+                illusion[f"sun_{name}"] = _clamp_to_field(value, field)
+    for name, value in sun.items():
         if value is not None:
             data["sun"][name] = value
     return Case.model_validate(data)
+
+
+def _clamp_to_field(value: float, field: FieldInfo) -> float:
+    """``value`` clamped to a pydantic field's ``ge``/``le`` bounds."""
+    for bound in field.metadata:
+        if getattr(bound, "ge", None) is not None:
+            value = max(value, bound.ge)
+        if getattr(bound, "le", None) is not None:
+            value = min(value, bound.le)
+    return value
 
 
 def encode(rgb: np.ndarray, fmt: ImageFormat) -> bytes:

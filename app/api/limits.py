@@ -9,10 +9,14 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from .errors import ApiError, error_response
 
 MULTIPART = "multipart/form-data"
+# A multipart request (study images) may carry several uploads; the route reading it checks each file against
+# ``max_upload_bytes``, this bounds the whole request.
+UPLOADS_PER_REQUEST = 50
 
 
 class BodyLimitMiddleware:
-    """413 for bodies over ``max_body_bytes`` (JSON and everything else) or ``max_upload_bytes`` (multipart)."""
+    """413 for bodies over ``max_body_bytes`` (JSON and everything else) or, for multipart uploads,
+    ``UPLOADS_PER_REQUEST * max_upload_bytes``."""
 
     def __init__(self, app: ASGIApp, max_body_bytes: int, max_upload_bytes: int) -> None:
         self.app = app
@@ -21,7 +25,7 @@ class BodyLimitMiddleware:
 
     def limit(self, headers: Headers) -> int:
         content_type = headers.get("content-type", "").lower()
-        return self.max_upload_bytes if content_type.startswith(MULTIPART) else self.max_body_bytes
+        return UPLOADS_PER_REQUEST * self.max_upload_bytes if content_type.startswith(MULTIPART) else self.max_body_bytes
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":

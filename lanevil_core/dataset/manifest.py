@@ -139,7 +139,7 @@ def build_manifest(plan: DatasetPlan, versions: dict[str, str], code_sha256: str
                      "frames_per_case": settings.frames_per_case, "train_frames": settings.train_frames,
                      "seed": settings.seed},
         "splits": splits,
-        "cases": [case_entry(case, plan, frame_hashes[(case.split, str(case.folder))]) for case in plan.cases],
+        "cases": [case_entry(case, plan, frame_hashes[case.key]) for case in plan.cases],
     }
 
 

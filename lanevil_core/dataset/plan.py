@@ -101,6 +101,11 @@ class PlannedCase:
     source: dict[str, Any] = field(default_factory=dict)
 
     @property
+    def key(self) -> tuple[str, str]:
+        """(split, folder): the case folder's identity within a run."""
+        return self.split, str(self.folder)
+
+    @property
     def case_sha256(self) -> str:
         """sha256 of the canonical case JSON."""
         return hashlib.sha256(self.case_text.encode("utf-8")).hexdigest()
@@ -247,9 +252,9 @@ def train_cases(clean: list[SourceCase], train_frames: int, seed: int) -> list[P
 
 
 def _check_unique(cases: list[PlannedCase]) -> None:
-    seen: dict[tuple[str, PurePosixPath], str] = {}
+    seen: dict[tuple[str, str], str] = {}
     for case in cases:
-        key = (case.split, case.folder)
+        key = case.key
         where = str(case.source.get("file", case.source))
         if key in seen:
             raise PlanError(f"{seen[key]} and {where} both map to {case.split}/{case.folder}")
@@ -276,7 +281,7 @@ def render_tasks(plan: DatasetPlan, pending: dict[tuple[str, str], list[int]],
     tasks = []
     settings = plan.settings
     for case in plan.cases:
-        frames = pending.get((case.split, str(case.folder)), [])
+        frames = pending.get(case.key, [])
         for start in range(0, len(frames), chunk_frames):
             tasks.append(RenderTask(case.split, str(case.folder), case.case_text, case.case_sha256,
                                     tuple(frames[start:start + chunk_frames]), settings.size,

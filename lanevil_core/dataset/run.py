@@ -44,8 +44,8 @@ class _Sidecars:
     def __init__(self, plan: DatasetPlan, folder: DatasetFolder, versions: dict[str, str]) -> None:
         self.plan = plan
         self.folder = folder
-        self.cases = {(case.split, str(case.folder)): case for case in plan.cases}
-        self.keys = {(case.split, str(case.folder), index): frame_key(case, index, plan, versions)
+        self.cases = {case.key: case for case in plan.cases}
+        self.keys = {(*case.key, index): frame_key(case, index, plan, versions)
                      for case in plan.cases for index in case.frames}
         self.found: dict[tuple[str, str, int], dict[str, Any]] = {}
 
@@ -55,11 +55,11 @@ class _Sidecars:
         for case in self.plan.cases:
             self.folder.remove_partial(case)
             for index in case.frames:
-                sidecar = self.folder.verified(case, index, self.keys[(case.split, str(case.folder), index)])
+                sidecar = self.folder.verified(case, index, self.keys[(*case.key, index)])
                 if sidecar is None:
-                    pending.setdefault((case.split, str(case.folder)), []).append(index)
+                    pending.setdefault(case.key, []).append(index)
                 else:
-                    self.found[(case.split, str(case.folder), index)] = sidecar
+                    self.found[(*case.key, index)] = sidecar
         return pending
 
     def store(self, task: RenderTask, results: list[FrameResult]) -> None:
@@ -71,11 +71,11 @@ class _Sidecars:
 
     def records(self, case: PlannedCase) -> list[dict[str, Any]]:
         """The case's TuSimple records in frame order."""
-        return [self.found[(case.split, str(case.folder), index)]["record"] for index in case.frames]
+        return [self.found[(*case.key, index)]["record"] for index in case.frames]
 
     def hashes(self, case: PlannedCase) -> dict[int, str]:
         """Frame -> sha256 of its file."""
-        return {index: self.found[(case.split, str(case.folder), index)]["sha256"] for index in case.frames}
+        return {index: self.found[(*case.key, index)]["sha256"] for index in case.frames}
 
 
 def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versions: dict[str, str],
@@ -91,7 +91,7 @@ def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versi
             folder.write_case_files(case, records)
             split_records += records
         folder.write_split_labels(split, split_records)
-    hashes = {(case.split, str(case.folder)): sidecars.hashes(case) for case in plan.cases}
+    hashes = {case.key: sidecars.hashes(case) for case in plan.cases}
     folder.write_manifest(build_manifest(plan, versions, code_sha256, hashes))
 
 

@@ -74,7 +74,7 @@ def test_clashing_folders_and_missing_cases_are_plan_errors(stock: list[SourceCa
 
 def test_tasks_cover_the_pending_frames_in_chunks(stock: list[SourceCase]) -> None:
     plan = build_plan(stock[:12], Settings(frames_per_case=10))
-    pending = {(case.split, str(case.folder)): list(case.frames) for case in plan.cases}
+    pending = {case.key: list(case.frames) for case in plan.cases}
     tasks = render_tasks(plan, pending, chunk_frames=4)
     assert sum(len(task.frames) for task in tasks) == plan.total_frames
     assert max(len(task.frames) for task in tasks) == 4

@@ -7,7 +7,10 @@ import threading
 from pathlib import Path
 
 import pytest
+from fastapi.testclient import TestClient
 
+from app.api.limits import UPLOADS_PER_REQUEST
+from app.main import create_app
 from lanevil_core.illusions import REGISTRY
 
 SHADOW_ID = "fence_shadow-03_level3"
@@ -271,3 +274,17 @@ def test_illusions_registry(client) -> None:
     assert fence["parameters"]["severity"]["maximum"] == 5 and "default" in fence["parameters"]["severity"]
     assert body["categories"]["shadow"] == [name for name, cls in REGISTRY.items() if cls.CATEGORY == "shadow"]
     assert "illusions" in body["case_schema"]["properties"]
+
+
+def test_multipart_uploads_have_their_own_limit(settings, state) -> None:
+    """Multipart bodies (study images) may pass ``max_body_bytes`` up to ``UPLOADS_PER_REQUEST`` uploads' worth."""
+    small = settings.model_copy(update={"max_body_bytes": 1024, "max_upload_bytes": 2048})
+    with TestClient(create_app(small, state)) as client:
+        files = {"files": ("big.bin", b"\0" * 4096, "application/octet-stream")}
+        response = client.post("/api/cases", files=files)
+        assert response.status_code == 422  # not a JSON case: refused by validation, not by the size limit
+        over = b"\0" * (UPLOADS_PER_REQUEST * 2048 + 1)
+        response = client.post("/api/cases", content=over, headers={"content-type": "multipart/form-data; boundary=x"})
+        assert response.status_code == 413 and response.json()["field"] == "body"
+        assert client.post("/api/cases", content=b" " * 1025,
+                           headers={"content-type": "application/json"}).status_code == 413

@@ -21,6 +21,7 @@ WEBGL_ARGS = ["--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-back
               "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 ROAD_CLICK = (470, 660)  # on the ego's carriageway in the start view (camera behind and above the ego)
 WAIT_S = 90.0
+SHOT_MS = 180_000  # SwiftShader draws slowly on a busy machine
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +60,7 @@ def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
     time.sleep(4)  # the road mesh fades in
-    page.screenshot(path=str(screenshot_dir / "editor_1_opened.png"))
+    page.screenshot(path=str(screenshot_dir / "editor_1_opened.png"), timeout=SHOT_MS)
 
     case_id = editor.session.case_id
     page.locator("select").filter(has_text="pedestrian").select_option("vehicle")
@@ -68,8 +69,8 @@ def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor
     wait_for(lambda: any(ill.type == "vehicle" for ill in editor.case.illusions), "the placed vehicle")
     assert editor.preview.wait_idle(WAIT_S)
     time.sleep(3)
-    page.screenshot(path=str(screenshot_dir / "editor_2_placed.png"))
-    before = preview.screenshot()
+    page.screenshot(path=str(screenshot_dir / "editor_2_placed.png"), timeout=SHOT_MS)
+    before = preview.screenshot(timeout=SHOT_MS)
     placed = editor.case.illusions[-1]
     assert editor.selected == len(editor.case.illusions) - 1 and 10.0 < placed.s < 80.0
 
@@ -80,9 +81,9 @@ def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor
     wait_for(lambda: editor.case.illusions[-1].severity == 5, "severity 5")
     assert editor.preview.wait_idle(WAIT_S)
     time.sleep(2)
-    after = preview.screenshot()
+    after = preview.screenshot(timeout=SHOT_MS)
     assert after != before, "the preview did not change with the severity"
-    page.screenshot(path=str(screenshot_dir / "editor_3_severity.png"))
+    page.screenshot(path=str(screenshot_dir / "editor_3_severity.png"), timeout=SHOT_MS)
 
     page.get_by_role("button", name="Save", exact=True).click()
     wait_for(lambda: state.store.get(case_id).version == 2, "the save")

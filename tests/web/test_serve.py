@@ -8,20 +8,17 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
-
 import httpx
 import pytest
 
-from .conftest import small_scenes
+from app.settings import Settings
 
 URL_PATTERN = re.compile(r"(website and API|editor)\s+(http://\S+/)")
 
 
-def _start(tmp_path: Path) -> tuple[subprocess.Popen[str], dict[str, str]]:
-    scenes = small_scenes(tmp_path / "scenes")
+def _start(settings: Settings) -> tuple[subprocess.Popen[str], dict[str, str]]:
     command = [sys.executable, "-m", "app.cli", "serve", "--port", "0", "--editor-port", "0",
-               "--data", str(tmp_path / "data"), "--scenes", str(scenes)]
+               "--data", str(settings.data_dir), "--scenes", str(settings.scenes_dir)]
     process = subprocess.Popen(command, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
     urls: dict[str, str] = {}
     deadline = time.monotonic() + 120
@@ -49,8 +46,8 @@ def _wait_ready(url: str) -> httpx.Response:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("stop_signal", [signal.SIGTERM, signal.SIGINT])
-def test_serve_runs_backend_and_editor_and_stops_cleanly(tmp_path: Path, stop_signal: signal.Signals) -> None:
-    process, urls = _start(tmp_path)
+def test_serve_runs_backend_and_editor_and_stops_cleanly(settings: Settings, stop_signal: signal.Signals) -> None:
+    process, urls = _start(settings)
     try:
         assert set(urls) == {"website and API", "editor"}, urls
         api, editor = urls["website and API"], urls["editor"]
@@ -59,7 +56,7 @@ def test_serve_runs_backend_and_editor_and_stops_cleanly(tmp_path: Path, stop_si
         assert _wait_ready(editor).status_code == 200  # viser serves its client page over HTTP too
         redirect = httpx.get(api + "editor", follow_redirects=False)
         assert redirect.status_code == 307 and redirect.headers["location"] == editor
-        assert (tmp_path / "data" / "cases" / "fence_shadow-03_level3.json").is_file()
+        assert (settings.data_dir / "cases" / "fence_shadow-03_level3.json").is_file()
     finally:
         process.send_signal(stop_signal)
         code = process.wait(timeout=30)
