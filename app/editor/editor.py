@@ -465,8 +465,9 @@ class Editor:
         self.push_log.append((result.request.seq, time.perf_counter()))
         self.last_result = result
         case, scene = result.request.case, result.scene
+        timing = f"rendered in {result.render_ms:.0f} ms" if result.render_ms >= 1.0 else "from the frame cache"
         self.panel.preview_info.content = (f"Frame {result.request.frame} · {result.rgb.shape[1]}×{result.rgb.shape[0]}"
-                                           f" · rendered in {result.render_ms:.0f} ms")
+                                           f" · {timing}")
         selected = self.selected if self.selected is not None and self.selected < len(case.illusions) else None
         road_key = roadside_key(case)
         # An illusion's meshes may depend on those placed before it (traffic keeps clear of earlier footprints).

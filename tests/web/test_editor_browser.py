@@ -54,16 +54,20 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
 def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor, state: AppState,
                                                     screenshot_dir: Path) -> None:
     page = webgl_browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(SHOT_MS)
     page.goto(f"http://127.0.0.1:{editor.port}/")
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
     wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
-    time.sleep(4)  # the road mesh fades in
+    time.sleep(8)  # meshes fade in
     page.screenshot(path=str(screenshot_dir / "editor_1_opened.png"), timeout=SHOT_MS)
 
     case_id = editor.session.case_id
-    page.locator("select").filter(has_text="pedestrian").select_option("vehicle")
+    combos = page.locator("input[role=combobox]")
+    place = combos.nth(combos.evaluate_all("(inputs) => inputs.findIndex((i) => i.value.startsWith('(pick a type'))"))
+    place.click()
+    page.get_by_role("option", name="vehicle", exact=True).click()
     wait_for(lambda: editor.panel.place.value == "vehicle", "the Place dropdown")
     page.mouse.click(*ROAD_CLICK)
     wait_for(lambda: any(ill.type == "vehicle" for ill in editor.case.illusions), "the placed vehicle")
@@ -74,10 +78,12 @@ def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor
     placed = editor.case.illusions[-1]
     assert editor.selected == len(editor.case.illusions) - 1 and 10.0 < placed.s < 80.0
 
-    severity = page.locator("[role=slider][aria-valuemax='5']")
-    severity.focus()
-    severity.press("ArrowRight")
-    severity.press("ArrowRight")
+    # Drag the thumb to the right end (arrow keys would also steer viser's camera).
+    box = page.locator("[role=slider][aria-valuemax='5']").bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.down()
+    page.mouse.move(box["x"] + 300, box["y"] + box["height"] / 2, steps=8)
+    page.mouse.up()
     wait_for(lambda: editor.case.illusions[-1].severity == 5, "severity 5")
     assert editor.preview.wait_idle(WAIT_S)
     time.sleep(2)
