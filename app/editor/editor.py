@@ -435,7 +435,8 @@ class Editor:
                 p.case_id.options = self._case_ids()
             p.case_id.value = session.case_id
             p.title.value = case.title
-            labels = [NO_SELECTION] + [f"{i}: {ill.type} (level {ill.severity})" for i, ill in enumerate(case.illusions)]
+            labels = [NO_SELECTION] + [f"{i}: {illusion.type} (level {illusion.severity})"
+                                       for i, illusion in enumerate(case.illusions)]
             p.selected.options = labels
             p.selected.value = labels[0 if self.selected is None else self.selected + 1]
             illusion = case.illusions[self.selected] if self.selected is not None else None

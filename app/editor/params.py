@@ -99,8 +99,8 @@ class ParamInputs:
             options = [str(option) for option in get_args(inner)]
             if optional:
                 options = [DEFAULT_OPTION, *options]
-            handle = self.gui.add_dropdown(label, options, initial_value=DEFAULT_OPTION if value is None else str(value),
-                                           hint=hint)
+            initial = DEFAULT_OPTION if value is None else str(value)
+            handle = self.gui.add_dropdown(label, options, initial_value=initial, hint=hint)
             self._readers[name] = lambda raw: None if raw == DEFAULT_OPTION else raw
             self._writers[name] = lambda v: DEFAULT_OPTION if v is None else str(v)
         elif inner is bool and not optional:
@@ -119,7 +119,8 @@ class ParamInputs:
                                          step=1 if inner is int else None, hint=hint)
             self._readers[name], self._writers[name] = inner, inner
         else:
-            handle = self.gui.add_text(label, format_text(value), hint=f"{hint} (empty = default)" if optional else hint)
+            hint = f"{hint} (empty = default)" if optional else hint
+            handle = self.gui.add_text(label, format_text(value), hint=hint)
             self._readers[name] = lambda raw, inner=inner: parse_text(raw, inner)
             self._writers[name] = format_text
         self.handles[name] = handle

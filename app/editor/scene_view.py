@@ -95,8 +95,9 @@ def decal_trimesh(network: RoadNetwork, layer: SurfaceLayer) -> trimesh.Trimesh:
     s_grid, t_grid = np.meshgrid(s_road, t_road, indexing="ij")
     p_world = line.to_world(s_grid, t_grid, DECAL_LIFT_M).reshape(-1, 3)
     # trimesh UVs have v = 0 at the bottom image row; image row 0 is s0.
-    uv = np.stack([((t_grid - layer.t0) / (t1 - layer.t0)).ravel(), (1.0 - (s_grid - layer.s0) / (s1 - layer.s0)).ravel()],
-                  axis=-1)
+    u = (t_grid - layer.t0) / (t1 - layer.t0)
+    v = 1.0 - (s_grid - layer.s0) / (s1 - layer.s0)
+    uv = np.stack([u.ravel(), v.ravel()], axis=-1)
     n_s, n_t = len(s_road), len(t_road)
     i, j = np.meshgrid(np.arange(n_s - 1), np.arange(n_t - 1), indexing="ij")
     a = (i * n_t + j).ravel()

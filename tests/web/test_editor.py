@@ -92,7 +92,8 @@ def test_click_off_the_road_while_placing_is_reported(editor: Editor) -> None:
     with pytest.raises(EditError, match="position: click on the road"):
         editor.click(np.array([0.0, 0.0, 5.0]), np.array([1.0, 0.0, 0.5]))  # the sky
     assert len(editor.case.illusions) == count
-    editor.on_scene_click(SimpleNamespace(ray_origin=(0.0, 0.0, 5.0), ray_direction=(1.0, 0.0, 0.5)))  # as from a browser
+    browser_click = SimpleNamespace(ray_origin=(0.0, 0.0, 5.0), ray_direction=(1.0, 0.0, 0.5))
+    editor.on_scene_click(browser_click)  # as a click in a browser arrives
     assert "click on the road" in editor.panel.status.content and len(editor.case.illusions) == count
 
 

@@ -79,7 +79,9 @@ def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor
     assert editor.selected == len(editor.case.illusions) - 1 and 10.0 < placed.s < 80.0
 
     # Drag the thumb to the right end (arrow keys would also steer viser's camera).
-    box = page.locator("[role=slider][aria-valuemax='5']").bounding_box()
+    thumb = page.locator("[role=slider][aria-valuemax='5']")
+    thumb.scroll_into_view_if_needed()
+    box = thumb.bounding_box()
     page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
     page.mouse.down()
     page.mouse.move(box["x"] + 300, box["y"] + box["height"] / 2, steps=8)
