@@ -9,6 +9,9 @@ frame, label file and manifest. Local runs with two workers also pay for spawnin
 the cached numba kernels in them (a real run pays it once); the Dask cluster is started, and warmed by one
 untimed run, before its timed runs, as a long-lived cluster would be.
 
+Wall-clock rates depend on what else runs on the machine, so the CPU time per frame of the local runs (all
+their processes) is printed too: ``cores / cpu_per_frame`` bounds the rate an idle machine could reach.
+
 Usage: ``python bench/dataset_throughput.py [--cases 8] [--frames-per-case 4] [--repeats 3] [--json]``
 """
 
@@ -17,6 +20,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import resource
 import shutil
 import statistics
 import tempfile
@@ -52,13 +56,23 @@ def copy_cases(root: Path, count: int) -> Path:
     return root
 
 
-def timed_runs(cases: Path, work: Path, settings: Settings, executor: Executor, repeats: int) -> list[float]:
-    """frames/s of ``repeats`` runs, each into an empty folder."""
+def cpu_seconds() -> float:
+    """CPU time (user + system) of this process and of its finished child processes."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def timed_runs(cases: Path, work: Path, settings: Settings, executor: Executor, repeats: int,
+               cpu: list[float] | None = None) -> list[float]:
+    """frames/s of ``repeats`` runs, each into an empty folder; CPU s per frame of each run appended to ``cpu``."""
     rates = []
     for repeat in range(repeats):
         out = work / f"run{repeat}"
+        cpu_start = cpu_seconds()
         summary = generate_dataset(cases, out, settings, executor, show_progress=False)
         rates.append(summary.rendered / summary.seconds)
+        if cpu is not None:
+            cpu.append((cpu_seconds() - cpu_start) / summary.rendered)
         shutil.rmtree(out)
     return rates
 
@@ -73,13 +87,16 @@ def dask_executor(workers: int) -> Iterator[Executor]:
 
 
 def measure(cases: Path, work: Path, settings: Settings, repeats: int) -> dict[str, list[float]]:
-    """frames/s per setup: local-1, local-2, dask-1, dask-2."""
+    """frames/s per setup (local-1, local-2, dask-1, dask-2) and CPU s per frame of the local setups
+    (``cpu-local-1``, ``cpu-local-2``: every process of the run, pool start-up included)."""
     results: dict[str, list[float]] = {}
     for workers in (1, 2):
         executor: Executor = functools.partial(run_local, workers=workers)
         if workers == 1:  # load the kernels in this process once, as a spawned worker does per run
             timed_runs(cases, work, settings, executor, 1)
-        results[f"local-{workers}"] = timed_runs(cases, work, settings, executor, repeats)
+        cpu: list[float] = []
+        results[f"local-{workers}"] = timed_runs(cases, work, settings, executor, repeats, cpu)
+        results[f"cpu-local-{workers}"] = cpu
     for workers in (1, 2):
         with dask_executor(workers) as executor:
             timed_runs(cases, work, settings, executor, 1)  # warm-up: workers import and load kernels
@@ -94,10 +111,16 @@ def report(results: dict[str, list[float]], frames: int) -> str:
              f"{len(results['local-1'])} runs",
              f"{'setup':<9} {'frames/s':>9} {'ms/frame':>9} {'vs local-1':>11} {'vs target':>10}  runs"]
     for name, rates in results.items():
+        if name.startswith("cpu-"):
+            continue
         median = statistics.median(rates)
         runs = " ".join(f"{rate:.2f}" for rate in rates)
         lines.append(f"{name:<9} {median:>9.2f} {1000 / median:>9.0f} {median / base:>10.2f}x "
                      f"{median / TARGET_FPS:>9.3f}x  {runs}")
+    cpu_per_frame = statistics.median(results["cpu-local-1"])
+    lines.append(f"CPU per frame: {cpu_per_frame * 1000:.0f} ms with 1 worker, "
+                 f"{statistics.median(results['cpu-local-2']) * 1000:.0f} ms with 2 (pool start-up included); "
+                 f"2 idle cores could give at most {2 / cpu_per_frame:.2f} frames/s")
     lines.append(f"target: {TARGET_FPS:.0f} frames/s on 2 cores")
     return "\n".join(lines)
 
