@@ -25,8 +25,8 @@ def _serve_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--host", default=None, help="address to bind (default 127.0.0.1)")
     parser.add_argument("--port", type=_port, default=None, help="port of the website and API (default 8000)")
     parser.add_argument("--editor-port", type=_port, default=None, help="port of the viser editor (default 8080)")
-    parser.add_argument("--data", type=Path, default=None, help="data folder: case store, exports, study (default ./data)")
-    parser.add_argument("--scenes", type=Path, default=None, help="stock cases seeding an empty store (default scenes/)")
+    parser.add_argument("--data", type=Path, default=None, help="data folder: cases, exports, study (default ./data)")
+    parser.add_argument("--scenes", type=Path, default=None, help="cases that seed an empty store (default scenes/)")
     parser.add_argument("--no-editor", action="store_true", help="serve the API and website only")
 
 

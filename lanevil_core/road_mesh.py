@@ -97,8 +97,9 @@ def _sweep(piece: RoadPiece, index: int, lift: float) -> tuple[FloatArray, IntAr
                 continue
             a, b = row * n_cols + col, row * n_cols + col + 1
             c, d = a + n_cols, b + n_cols
-            # Columns run left to right (t decreasing) and rows forward, so (a, c, b) is counter-clockwise from above.
-            faces += [(a, c, b), (b, c, d)]
+            # Columns run left to right (t decreasing) and rows forward, so (a, b, c) is counter-clockwise from above
+            # (normals up, as glTF viewers that cull back faces expect).
+            faces += [(a, b, c), (b, d, c)]
             face_mats += [mats[col]] * 2
             face_cw += [side == 0] * 2
     return (vertices, np.array(faces, np.int32).reshape(-1, 3), st,

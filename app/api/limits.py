@@ -25,7 +25,9 @@ class BodyLimitMiddleware:
 
     def limit(self, headers: Headers) -> int:
         content_type = headers.get("content-type", "").lower()
-        return UPLOADS_PER_REQUEST * self.max_upload_bytes if content_type.startswith(MULTIPART) else self.max_body_bytes
+        if content_type.startswith(MULTIPART):
+            return UPLOADS_PER_REQUEST * self.max_upload_bytes
+        return self.max_body_bytes
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":

@@ -3,6 +3,6 @@
 ``launch_editor(state, host, port)`` starts it beside the FastAPI backend, sharing its ``AppState``.
 """
 
-from .editor import Editor, EditError, launch_editor
+from .editor import EditError, Editor, launch_editor
 
 __all__ = ["EditError", "Editor", "launch_editor"]

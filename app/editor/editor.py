@@ -358,7 +358,7 @@ class Editor:
         surface = self.view.surface
         if surface is None:
             raise EditError("the 3D view is still loading; click again in a moment")
-        hit = ray_surface_hit(surface, ray_origin_world, ray_dir_world)
+        hit = ray_surface_hit(surface, ray_origin_world, ray_dir_world, self._network().main.line)
         place_type = str(self.panel.place.value)
         if hit is None:
             if place_type != PLACE_OFF:

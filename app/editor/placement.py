@@ -22,6 +22,7 @@ from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.road_mesh import RoadSurface
 from lanevil_core.typed import FloatArray
 
+EDGE_EPS = 1e-9  # barycentric slack, so a ray through an edge between two faces hits one of them
 RAY_EPS = 1e-9
 NEWTON_STEPS = 4
 
@@ -44,10 +45,12 @@ class RoadHit:
     distance: float
 
 
-def ray_surface_hit(surface: RoadSurface, ray_origin_world: FloatArray, ray_dir_world: FloatArray) -> RoadHit | None:
+def ray_surface_hit(surface: RoadSurface, ray_origin_world: FloatArray, ray_dir_world: FloatArray,
+                    main_line: ReferenceLine | None = None) -> RoadHit | None:
     """The nearest intersection of a ray with the road surface mesh, or None if the ray misses it.
 
-    Möller–Trumbore over every face at once; (s, t) is interpolated from the hit face's vertices.
+    Möller–Trumbore over every face at once; (s, t) is interpolated from the hit face's vertices, then, on the main
+    road when ``main_line`` is given, solved exactly from the hit point (flat triangles chord a bend's arcs).
     """
     origin = np.asarray(ray_origin_world, np.float64)
     direction = np.asarray(ray_dir_world, np.float64)
@@ -63,15 +66,20 @@ def ray_surface_hit(surface: RoadSurface, ray_origin_world: FloatArray, ray_dir_
     q_vec = np.cross(t_vec, edge1)
     v = (q_vec @ direction) * inv_det
     dist = np.einsum("ij,ij->i", edge2, q_vec) * inv_det
-    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (dist > 0)
+    hit = ok & (u >= -EDGE_EPS) & (v >= -EDGE_EPS) & (u + v <= 1 + EDGE_EPS) & (dist > 0)  # shared edges count
     if not hit.any():
         return None
     face = int(np.flatnonzero(hit)[np.argmin(dist[hit])])
     corners = surface.faces[face]
     weights = np.array([1.0 - u[face] - v[face], u[face], v[face]])
     s_road, t_road = weights @ surface.st[corners]
-    return RoadHit(p_world=origin + dist[face] * direction, s_road=float(s_road), t_road=float(t_road),
-                   piece=int(surface.piece[corners[0]]), distance=float(dist[face]))
+    p_world = origin + dist[face] * direction
+    piece = int(surface.piece[corners[0]])
+    if main_line is not None and piece == 0:
+        s_exact, t_exact, _h = road_coordinates(main_line, p_world)
+        s_road, t_road = s_exact[0], t_exact[0]
+    return RoadHit(p_world=p_world, s_road=float(s_road), t_road=float(t_road), piece=piece,
+                   distance=float(dist[face]))
 
 
 def road_coordinates(line: ReferenceLine, p_world: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -72,11 +72,8 @@ def mesh_parts(meshes: Sequence[Mesh]) -> list[tuple[FloatArray, IntArray, Float
 
 def road_parts(surface: RoadSurface, network: RoadNetwork, case: Case) -> list[tuple[FloatArray, IntArray,
                                                                                      Float32Array]]:
-    """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``.
-
-    The swept surface's faces wind clockwise seen from above (the software renderer draws both sides); they are
-    reversed here so the viewer, which culls back faces, shows the road from above."""
-    return [(surface.vertices, surface.faces[:, ::-1], MATERIAL_ALBEDO[surface.material]),
+    """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``."""
+    return [(surface.vertices, surface.faces, MATERIAL_ALBEDO[surface.material]),
             paint_mesh(network, case.road.markings)]
 
 

@@ -28,9 +28,22 @@ from .create import SpecError, create_study, items_folder
 from .db import connect, db_path
 from .images import CheckedUpload, UploadError, check_upload
 from .order import participant_order
-from .records import (NotFound, Study, add_participant, add_rating, complete_participant, get_item,
-                      get_participant, get_study, image_url, list_studies, participant_ratings, study_items,
-                      study_participants, study_ratings)
+from .records import (
+    NotFound,
+    Study,
+    add_participant,
+    add_rating,
+    complete_participant,
+    get_item,
+    get_participant,
+    get_study,
+    image_url,
+    list_studies,
+    participant_ratings,
+    study_items,
+    study_participants,
+    study_ratings,
+)
 from .spec import ConsentIn, RatingIn, StudySpec
 from .stats import exclusions, summarize
 from .tables import raw_ratings_csv, summary_csv

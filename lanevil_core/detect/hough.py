@@ -18,7 +18,6 @@ from ..labels import MAX_LANES, RANGE_M
 from ..typed import FloatArray, UInt8Array
 from .common import GroundCamera, lane_columns, sample_rows, useful_lanes
 
-
 WORK_WIDTH = 640  # wider frames are shrunk to this width first (the edges and segments need no more)
 
 

@@ -23,7 +23,8 @@ REPO = Path(__file__).resolve().parents[2]
 SCENES = REPO / "scenes"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]  # WebGL (viser) without a GPU
 # A small store keeps seeding fast: two clean cases and one illusion type's original and levels.
 SMALL_LIBRARY = ["00_clean/00_straight_urban.json", "00_clean/01_bend_suburban.json",
                  "30_shadow/fence_shadow/00_original.json", "30_shadow/fence_shadow/01_level1.json",

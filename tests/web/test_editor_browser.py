@@ -14,26 +14,9 @@ from app.state import AppState
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
-CHROMIUM = Path("/usr/bin/chromium")  # Debian's package, as in conftest's ``browser`` fixture
-# viser draws with WebGL: headless Chromium without a GPU needs SwiftShader allowed explicitly (with conftest's
-# plain arguments a screenshot of the WebGL canvas never completes).
-WEBGL_ARGS = ["--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-              "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 ROAD_CLICK = (470, 660)  # on the ego's carriageway in the start view (camera behind and above the ego)
 WAIT_S = 90.0
 SHOT_MS = 180_000  # SwiftShader draws slowly on a busy machine
-
-
-@pytest.fixture(scope="module")
-def webgl_browser():
-    if not CHROMIUM.exists():
-        pytest.skip("Debian chromium is not installed")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        chromium = playwright.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=WEBGL_ARGS)
-        yield chromium
-        chromium.close()
 
 
 @pytest.fixture
@@ -51,9 +34,9 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
         time.sleep(0.1)
 
 
-def test_place_an_illusion_scrub_severity_and_save(webgl_browser, editor: Editor, state: AppState,
+def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, state: AppState,
                                                     screenshot_dir: Path) -> None:
-    page = webgl_browser.new_page(viewport={"width": 1280, "height": 900})
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SHOT_MS)
     page.goto(f"http://127.0.0.1:{editor.port}/")
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)

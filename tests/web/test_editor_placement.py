@@ -39,7 +39,7 @@ def test_click_ray_hits_the_aimed_road_point(road_type: str, s_road: float, t_ro
     p_target = line.to_world(s_road, t_road)
     direction = np.array([tilt, 0.3 * tilt, -1.0])
     origin = p_target - 40.0 * direction
-    hit = ray_surface_hit(SURFACES[road_type], origin, direction)
+    hit = ray_surface_hit(SURFACES[road_type], origin, direction, line)
     assert hit is not None and hit.piece == 0
     assert hit.s_road == pytest.approx(s_road, abs=0.05)
     assert hit.t_road == pytest.approx(t_road, abs=0.05)

@@ -8,8 +8,7 @@ from pathlib import Path, PurePosixPath
 
 import pytest
 
-from app.store import (CaseExists, CaseNotFound, CaseStore, InvalidId, VersionConflict, check_id, slugify,
-                       stock_id)
+from app.store import CaseExists, CaseNotFound, CaseStore, InvalidId, VersionConflict, check_id, slugify, stock_id
 from lanevil_core.case import Case
 from lanevil_core.illusions import REGISTRY
 

@@ -15,10 +15,9 @@ import httpx
 import numpy as np
 import pytest
 from PIL import Image
+from test_study import ADMIN, image_bytes  # same folder, imported by its base name (no package)
 
 from app.study.db import db_path
-
-from test_study import ADMIN, image_bytes  # same folder, imported by its base name (no package)
 
 PARTICIPANTS = 100
 
