@@ -22,7 +22,7 @@ from pydantic.fields import FieldInfo
 
 from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
-from lanevil_core.compile import compile_scene
+from lanevil_core.compile import compile_scene, roadside_key
 from lanevil_core.export import png_bytes
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
@@ -158,6 +158,7 @@ class FrameService:
 
     def __init__(self, cache_bytes: int = 256_000_000) -> None:
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
+        self.roadsides: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
         self.images: LRUCache[str, EncodedImage] = LRUCache(cache_bytes // 2, lambda item: len(item.data))
         self.culane: LRUCache[str, str] = LRUCache(CULANE_CACHE_ENTRIES)
@@ -174,12 +175,15 @@ class FrameService:
             self._inflight.pop(key, None)
 
     def scene(self, case: Case) -> CompiledScene:
-        """The compiled scene of ``case`` (cached by content hash)."""
+        """The compiled scene of ``case`` (cached by content hash); a case that differs from a recent one only in
+        sun, weather or illusions reuses that one's road and roadside (``compile_scene(case, reuse=...)``)."""
         key = case_hash(case)
         scene = self.scenes.get(key)
         if scene is None:
-            scene = compile_scene(case)
+            side_key = roadside_key(case)
+            scene = compile_scene(case, reuse=self.roadsides.get(side_key))
             self.scenes.put(key, scene)
+            self.roadsides.put(side_key, scene)
         return scene
 
     @staticmethod

@@ -27,13 +27,21 @@ def _mix(a: FloatArray, b: FloatArray, k: float) -> np.ndarray:
     return (np.asarray(a) * (1.0 - k) + np.asarray(b) * k).astype(np.float32)
 
 
+NIGHT_SUN_ALTITUDE_DEG = -2.0  # at or below this sun altitude it is night: lamps glow, headlights are on
+
+
+def is_night(sun_altitude_deg: float) -> bool:
+    """Whether a sun this high (degrees) makes a night scene."""
+    return sun_altitude_deg <= NIGHT_SUN_ALTITUDE_DEG
+
+
 def environment_for(case: Case) -> Environment:
     """Sun, sky, wetness and fog of a case (before illusions change them)."""
     weather, sun = case.weather, case.sun
     cloud = weather.cloudiness / 100.0
     altitude = sun.altitude
-    night = altitude <= -2.0
-    day = float(np.clip((altitude + 2.0) / 12.0, 0.0, 1.0))  # twilight ramp
+    night = is_night(altitude)
+    day = float(np.clip((altitude - NIGHT_SUN_ALTITUDE_DEG) / 12.0, 0.0, 1.0))  # twilight ramp
     low = float(np.clip(1.0 - altitude / 30.0, 0.0, 1.0))  # warm light near the horizon
     sun_color = _mix([1.0, 0.97, 0.92], [1.0, 0.62, 0.32], low * 0.8)
     clear_zenith, clear_horizon = np.array([0.16, 0.32, 0.75]), np.array([0.62, 0.74, 0.92])

@@ -14,6 +14,7 @@ import numpy as np
 
 from . import props
 from .case import Case
+from .environment import is_night
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
@@ -294,7 +295,7 @@ def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
         shop = bool(r.random() < 0.5)
         return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop)
 
-    meshes = streetlights(network, clear, 30.0, emissive=case.sun.altitude <= -2.0)
+    meshes = streetlights(network, clear, 30.0, emissive=is_night(case.sun.altitude))
     if density > 0:  # a few street trees first; the blocks fill the frontage around them
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)

@@ -20,6 +20,7 @@ import viser
 
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, CaseError, parse_case
+from lanevil_core.compile import roadside_key
 from lanevil_core.illusions import REGISTRY, Illusion
 from lanevil_core.presets import preset_values
 from lanevil_core.road_layout import RoadNetwork
@@ -28,7 +29,7 @@ from lanevil_core.scene import CompiledScene
 from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
-from .compiler import SceneCompiler, roadside_key
+from .compiler import SceneCompiler
 from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker

@@ -35,7 +35,7 @@ CLEAN_CATEGORY = "Clean"
 FORMATS: dict[str, str] = {"png": ".png", "jpg": ".jpg"}  # --format -> frame file suffix
 
 TRAIN_FRAMES_PER_VARIANT = 5  # frames of one train variation, evenly spaced over its drive
-CHUNK_FRAMES = 4  # frames per render task: one scene compile (~0.25 s) amortised over ~1.5 s of rendering
+CHUNK_FRAMES = 10  # frames per render task: one scene compile (~0.25 s) amortised over ~3 s of rendering
 END_MARGIN_M = 60.0  # road the case validator keeps ahead of the last frame
 SUN_ALTITUDE_JITTER_DEG = 10.0
 LANE_LINE_CHOICES: tuple[LineType, ...] = ("white_dashed", "white_solid", "botts_dots", "white_solid_dashed")
