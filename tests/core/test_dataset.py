@@ -257,7 +257,6 @@ def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path
     assert not (tmp_path / "out" / "manifest.json").exists()
 
 
-@pytest.mark.slow
 def test_dask_cluster_writes_the_same_bytes_as_the_local_run(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
     from dask.distributed import LocalCluster
 
