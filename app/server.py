@@ -6,8 +6,12 @@ background thread. When uvicorn stops, the editor and the job pool are stopped t
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import socket
 import sys
+import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import uvicorn
@@ -23,6 +27,24 @@ class Urls:
 
     api: str
     editor: str | None
+
+
+class _Server(uvicorn.Server):
+    """uvicorn, but a Ctrl+C / SIGTERM only asks it to stop: the caller then stops the editor and returns, instead
+    of the signal being raised again (uvicorn's default) and killing the process before the editor is closed."""
+
+    @contextlib.contextmanager
+    def capture_signals(self) -> Iterator[None]:
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        handled = (signal.SIGINT, signal.SIGTERM)
+        previous = {sig: signal.signal(sig, self.handle_exit) for sig in handled}
+        try:
+            yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
 
 
 def bind(host: str, port: int) -> socket.socket:
@@ -58,7 +80,7 @@ def serve(settings: Settings) -> int:
     print(f"  website and API  {urls.api}  (API docs {urls.api}docs, study {urls.api}study)", file=sys.stderr)
     if urls.editor:
         print(f"  editor           {urls.editor}  (also {urls.api}editor)", file=sys.stderr, flush=True)
-    server = uvicorn.Server(uvicorn.Config(app, log_level="info", timeout_graceful_shutdown=5))
+    server = _Server(uvicorn.Config(app, log_level="info", timeout_graceful_shutdown=5))
     try:
         server.run(sockets=[sock])
     finally:
@@ -66,4 +88,5 @@ def serve(settings: Settings) -> int:
             editor.stop()
         state.jobs.shutdown()
         sock.close()
+    print("LanEvil Studio: stopped", file=sys.stderr)
     return 0
