@@ -29,7 +29,7 @@ from ..settings import Settings
 from ..store import CaseStore, StoreError
 from .db import connect, db_path, transaction
 from .images import CheckedUpload, decode_rgb, garble, trap_banner
-from .records import Study, get_study, set_status
+from .records import FieldError, Study, get_study, set_status
 from .spec import ItemSpec, StudySpec
 
 SYNC_RENDER_LIMIT = 8
@@ -37,12 +37,8 @@ STUDY_FOLDER = "study"
 Progress = Callable[[int, int], None]
 
 
-class SpecError(ValueError):
+class SpecError(FieldError, ValueError):
     """A study spec that names something that does not exist or does not fit; ``field`` says where (422)."""
-
-    def __init__(self, field: str, message: str) -> None:
-        super().__init__(message)
-        self.field = field
 
 
 @dataclass(frozen=True)

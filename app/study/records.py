@@ -12,12 +12,16 @@ STUDY_ID_PATTERN = re.compile(r"^[0-9a-f]{12}$")
 PARTICIPANT_ID_PATTERN = re.compile(r"^[0-9a-f]{32}$")
 
 
-class NotFound(LookupError):
-    """An unknown study, item or participant; ``field`` names which (404)."""
+class FieldError(Exception):
+    """A study error that names the request field it is about (``field``), for the JSON error body."""
 
     def __init__(self, field: str, message: str) -> None:
         super().__init__(message)
         self.field = field
+
+
+class NotFound(FieldError, LookupError):
+    """An unknown study, item or participant; ``field`` names which (404)."""
 
 
 @dataclass(frozen=True)
