@@ -8,6 +8,7 @@ that ``GET /api/exports/{job_id}`` and the editor's notifications read. Finished
 from __future__ import annotations
 
 import re
+import shutil
 import tempfile
 import threading
 import time
@@ -26,6 +27,8 @@ JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
 Progress = Callable[[int, int], None]
 JOB_ID_PATTERN = re.compile(r"^[0-9a-f]{32}$")
 EXPORTS_FOLDER = "exports"
+KEEP_FINISHED = 32  # finished jobs (and their zips) kept for polling and download; older ones are dropped
+SCRATCH_PREFIX = "lanevil-export-"
 
 
 class JobNotFound(LookupError):
@@ -62,12 +65,35 @@ class Job:
 class JobManager:
     """Runs jobs on ``workers`` threads and keeps their state (and result files under ``root/exports``)."""
 
-    def __init__(self, root: Path, workers: int = 1) -> None:
+    def __init__(self, root: Path, workers: int = 1, keep_finished: int = KEEP_FINISHED) -> None:
         self.folder = Path(root) / EXPORTS_FOLDER
         self.folder.mkdir(parents=True, exist_ok=True)
+        self.keep_finished = keep_finished
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="lanevil-job")
         self._jobs: dict[str, Job] = {}
         self._lock = threading.Lock()
+        self._purge_orphans()
+
+    def _purge_orphans(self) -> None:
+        """Delete what an earlier process left in the exports folder: its jobs lived in its memory, so nobody can
+        poll or download them any more."""
+        for path in self.folder.iterdir():
+            if path.is_dir() and path.name.startswith(SCRATCH_PREFIX):
+                shutil.rmtree(path, ignore_errors=True)
+            elif path.is_file() and (path.suffix == ".zip" or path.name.endswith(".partial")):
+                path.unlink(missing_ok=True)
+
+    def _prune(self) -> None:
+        """Forget all but the newest ``keep_finished`` finished jobs and delete their zips."""
+        with self._lock:
+            finished = sorted((job for job in self._jobs.values() if job.finished.is_set()),
+                              key=lambda job: job.finished_at or 0.0)
+            dropped = finished[:max(len(finished) - self.keep_finished, 0)]
+            for job in dropped:
+                del self._jobs[job.id]
+        for job in dropped:
+            if job.result is not None and job.result.parent == self.folder:
+                job.result.unlink(missing_ok=True)
 
     def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path],
                meta: dict[str, Any] | None = None) -> Job:
@@ -102,6 +128,7 @@ class JobManager:
             job.status = "failed"
         job.finished_at = time.time()
         job.finished.set()
+        self._prune()
 
     def get(self, job_id: str) -> Job:
         with self._lock:
@@ -148,7 +175,7 @@ def export_zip(case: Case, folder: PurePosixPath, frames: Iterable[int], target:
                progress: Progress | None = None) -> Path:
     """Render ``frames`` of ``case`` with TuSimple labels into a zip laid out as the benchmark
     (``folder/000000.png … labels.json case.json``, ``folder`` = ``Category/Type/case``)."""
-    with tempfile.TemporaryDirectory(prefix="lanevil-export-", dir=target.parent) as scratch:
+    with tempfile.TemporaryDirectory(prefix=SCRATCH_PREFIX, dir=target.parent) as scratch:
         export_case(case, scratch, frames=list(frames), formats={"tusimple"}, progress=progress)
         zip_folder(Path(scratch), target, folder)
     return target
