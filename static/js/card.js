@@ -50,6 +50,9 @@ function azimuthWords(degrees) {
   return names[Math.round(wrapDegrees(degrees) / 45) % 8];
 }
 
+/** The two frames of a card: [data-role, caption]. */
+const FRAME_ROLES = [["original", "Original"], ["perturbed", "Perturbed"]];
+
 export class IllusionCard {
   /**
    * @param {HTMLTemplateElement} template the card markup
@@ -92,6 +95,14 @@ export class IllusionCard {
       this.inputs[name] = input;
       this.outputs[name] = output;
       input.addEventListener("input", () => this.onInput(name));
+    }
+    const frameTemplate = document.getElementById("frame-template");
+    const pair = el.querySelector(".pair");
+    for (const [role, caption] of FRAME_ROLES) {
+      const figure = frameTemplate.content.firstElementChild.cloneNode(true);
+      figure.dataset.role = role;
+      figure.querySelector("figcaption").textContent = caption;
+      pair.append(figure);
     }
     this.frames = {};
     for (const figure of el.querySelectorAll("figure[data-role]")) {

@@ -67,7 +67,7 @@ def test_page_structure(page: PageParser) -> None:
     sections = [a["data-category"] for a in page.find("section") if a.get("data-category")]
     assert sections == list(CATEGORIES)  # one section per category, in benchmark order
     assert page.find("script", type="module", src="/static/js/main.js")
-    assert page.find("template", id="card-template")
+    assert page.find("template", id="card-template") and page.find("template", id="frame-template")
     assert page.find("input", type="checkbox", id="overlay-toggle")
     assert page.find("label", for_="overlay-toggle")
     links = {a["href"] for a in page.find("a")}
