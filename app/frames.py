@@ -9,7 +9,6 @@ once). Concurrent requests for the same key wait for the one render in flight.
 from __future__ import annotations
 
 import hashlib
-import io
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
@@ -17,13 +16,12 @@ from dataclasses import dataclass
 from typing import Any, Generic, Literal, TypeVar
 
 import numpy as np
-from PIL import Image
 from pydantic.fields import FieldInfo
 
 from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
 from lanevil_core.compile import compile_scene, roadside_key
-from lanevil_core.export import png_bytes
+from lanevil_core.export import jpeg_bytes, png_bytes
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
 from lanevil_core.overlay import draw_lanes
@@ -128,11 +126,7 @@ def _clamp_to_field(value: float, field: FieldInfo) -> float:
 
 def encode(rgb: np.ndarray, fmt: ImageFormat) -> bytes:
     """PNG (no metadata, deterministic) or baseline JPEG bytes of an (H, W, 3) uint8 image."""
-    if fmt == "png":
-        return png_bytes(rgb)
-    buffer = io.BytesIO()
-    Image.fromarray(rgb, "RGB").save(buffer, format="JPEG", quality=JPEG_QUALITY, optimize=True)
-    return buffer.getvalue()
+    return png_bytes(rgb) if fmt == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
 
 
 @dataclass(frozen=True)
@@ -165,6 +159,8 @@ class FrameService:
         self._inflight: dict[str, threading.Lock] = {}
         self._inflight_lock = threading.Lock()
         self.renders = 0  # frames actually rendered (not served from a cache)
+        self.full_compiles = 0  # scenes compiled from scratch
+        self.partial_compiles = 0  # scenes that reused a recent scene's road and roadside
 
     def _single_flight(self, key: str) -> threading.Lock:
         with self._inflight_lock:
@@ -181,7 +177,12 @@ class FrameService:
         scene = self.scenes.get(key)
         if scene is None:
             side_key = roadside_key(case)
-            scene = compile_scene(case, reuse=self.roadsides.get(side_key))
+            reuse = self.roadsides.get(side_key)
+            scene = compile_scene(case, reuse=reuse)
+            if reuse is None:
+                self.full_compiles += 1
+            else:
+                self.partial_compiles += 1
             self.scenes.put(key, scene)
             self.roadsides.put(side_key, scene)
         return scene

@@ -100,7 +100,7 @@ def main() -> int:
                 "frame_drag": stats(burst(editor, p.frame, list(range(10, 10 + 2 * n)))),
                 "sun_drag": stats(burst(editor, p.sun_altitude, [20.0 + i for i in range(2 * n)])),
                 "renders_dropped_by_coalescing": editor.preview.dropped,
-                "compiles": {"full": editor.compiler.full_compiles, "partial": editor.compiler.partial_compiles},
+                "compiles": {"full": state.frames.full_compiles, "partial": state.frames.partial_compiles},
             }
         finally:
             editor.stop()

@@ -22,6 +22,7 @@ from typing import NoReturn
 import numpy as np
 
 from .case import Case, CaseError, load_case, write_atomic
+from .frame_range import parse_frame_range
 
 PROG = "lanevil"
 EXTENSION_PREFIX = "cli_"
@@ -75,17 +76,10 @@ def parse_formats(text: str) -> frozenset[str]:
 
 def frame_range(text: str, frames: int) -> range:
     """``A:B`` (Python slice, either end optional) -> frames A..B-1 of a case with ``frames`` frames."""
-    parts = text.split(":")
     try:
-        if len(parts) != 2:
-            raise ValueError
-        start = int(parts[0]) if parts[0].strip() else 0
-        stop = int(parts[1]) if parts[1].strip() else frames
-    except ValueError:
-        raise UsageError(f"--frames {text!r} is not START:STOP (e.g. 0:20)") from None
-    if not 0 <= start < stop <= frames:
-        raise UsageError(f"--frames {text!r} must satisfy 0 <= START < STOP <= {frames} (the case has {frames} frames)")
-    return range(start, stop)
+        return parse_frame_range(text, frames)
+    except ValueError as error:
+        raise UsageError(f"--frames {error}") from None
 
 
 def check_frame(case: Case, frame: int) -> None:

@@ -58,6 +58,14 @@ def png_bytes(rgb: UInt8Array) -> bytes:
     return buffer.getvalue()
 
 
+def jpeg_bytes(rgb: UInt8Array, quality: int) -> bytes:
+    """Baseline JPEG (4:2:0) of an (H, W, 3) uint8 image, with no metadata (same pixels -> same bytes)."""
+    buffer = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8), "RGB").save(
+        buffer, format="JPEG", quality=quality, subsampling=2, optimize=False)
+    return buffer.getvalue()
+
+
 def _check_formats(formats: Collection[str]) -> None:
     unknown = sorted(set(formats) - set(FORMATS))
     if unknown:

@@ -9,6 +9,7 @@ from fastapi import Depends, Query
 from pydantic import ValidationError
 
 from lanevil_core.case import Case
+from lanevil_core.frame_range import parse_frame_range
 
 from ..frames import apply_overrides
 from ..settings import Settings
@@ -35,22 +36,10 @@ def frame_range(text: str | None, frames: int, default: range, limit: int | None
 
 
 def _parse_range(text: str, frames: int) -> range:
-    parts = text.split(":")
     try:
-        if len(parts) == 1:
-            start = int(parts[0])
-            stop = start + 1
-        elif len(parts) == 2:
-            start = int(parts[0]) if parts[0].strip() else 0
-            stop = int(parts[1]) if parts[1].strip() else frames
-        else:
-            raise ValueError
-    except ValueError:
-        raise ApiError(422, f"{text!r} is not START:STOP or N (e.g. 0:20)", "frames") from None
-    if not 0 <= start < stop <= frames:
-        raise ApiError(422, f"{text!r} must satisfy 0 <= START < STOP <= {frames} (the case has {frames} frames)",
-                       "frames")
-    return range(start, stop)
+        return parse_frame_range(text, frames, single=True)
+    except ValueError as error:
+        raise ApiError(422, str(error), "frames") from None
 
 
 def image_size(width: int | None, height: int | None, case: Case, settings: Settings) -> tuple[int, int]:

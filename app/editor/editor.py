@@ -29,7 +29,6 @@ from lanevil_core.scene import CompiledScene
 from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
-from .compiler import SceneCompiler
 from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
@@ -57,7 +56,6 @@ class Editor:
         self.state = state
         self.server = server
         self.sessions = SessionRegistry(state.store)
-        self.compiler = SceneCompiler(state.frames)
         self.session: CaseSession | None = None
         self.frame = 0
         self.selected: int | None = None
@@ -345,7 +343,7 @@ class Editor:
             self._stopped.wait(max(0.0, 1.0 / self.case.ego.fps - (time.monotonic() - started)))
 
     def _network(self) -> RoadNetwork:
-        return self.compiler.scene(self.case).network
+        return self.state.frames.scene(self.case).network
 
     def _selection_index(self, label: str) -> int | None:
         return None if label == NO_SELECTION else int(label.split(":", 1)[0])
@@ -457,7 +455,7 @@ class Editor:
         return self.preview.request(self.case, self.frame, bool(self.panel.overlay.value))
 
     def _render(self, request: PreviewRequest) -> tuple[np.ndarray, CompiledScene]:
-        scene = self.compiler.scene(request.case)
+        scene = self.state.frames.scene(request.case)
         rendered = self.state.frames.frame(request.case, request.frame, request.size, request.overlay)
         return rendered.rgb, scene
 

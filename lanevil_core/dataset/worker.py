@@ -8,7 +8,6 @@ caller alone writes files, so workers need no shared file system.
 from __future__ import annotations
 
 import hashlib
-import io
 import threading
 from collections import OrderedDict
 from collections.abc import Callable
@@ -16,13 +15,10 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-from PIL import Image
-
 from ..benchmark_layout import frame_file
 from ..case import parse_case
 from ..compile import compile_scene
-from ..export import png_bytes
+from ..export import jpeg_bytes, png_bytes
 from ..labels import tusimple_record
 from ..render import render_frame
 from ..scene import CompiledScene
@@ -52,10 +48,7 @@ def encode_image(rgb: UInt8Array, image_format: str) -> bytes:
     if image_format == "png":
         return png_bytes(rgb)
     if image_format == "jpg":
-        buffer = io.BytesIO()
-        Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8), "RGB").save(
-            buffer, format="JPEG", quality=JPEG_QUALITY, subsampling=2, optimize=False)
-        return buffer.getvalue()
+        return jpeg_bytes(rgb, JPEG_QUALITY)
     raise ValueError(f"unknown image format {image_format!r} (choose from {', '.join(FORMATS)})")
 
 

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from app.editor import EditError, Editor, launch_editor
-from app.editor.compiler import SceneCompiler
 from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
 from app.frames import FrameService
 from app.state import AppState
@@ -236,7 +235,7 @@ def test_preview_worker_coalesces_and_ends_on_the_latest_state() -> None:
 @pytest.mark.parametrize("illusion", [{"type": "fence_shadow", "severity": 5}, {"type": "vehicle", "severity": 4},
                                       {"type": "road_crack", "severity": 2}])
 def test_partial_recompile_equals_a_full_compile(illusion: dict) -> None:
-    compiler = SceneCompiler(FrameService(0))
+    compiler = FrameService(0)
     compiler.scene(parse_case({"scene": {"kind": "urban"}, "illusions": [{"type": "fence_shadow"}]}))
     case = parse_case({"scene": {"kind": "urban"}, "sun": {"azimuth": 100}, "illusions": [illusion]})
     partial, full = compiler.scene(case), compile_scene(case)
