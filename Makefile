@@ -4,12 +4,15 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.lanevil-installed
+# The CPU build of PyTorch (a plain `torch` from the index is a multi-GB CUDA build); only `lanevil train` needs it.
+TORCH ?= torch==2.13.0
 
 .PHONY: run preview test test-fast test-slow test-browser bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet $(TORCH)
+	$(PY) -m pip install --quiet -e '.[test,learn]'
 	touch $(STAMP)
 
 # The web backend, demo website, study and viser editor, on the stock library (Ctrl+C stops both servers).

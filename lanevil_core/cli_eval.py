@@ -48,7 +48,10 @@ def _run_eval(args: argparse.Namespace) -> int:
 
 def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or images")
-    parser.add_argument("--method", choices=("hough", "birdseye"), required=True, help="classical baseline")
+    parser.add_argument("--method", choices=("ufld", "seg", "hough", "birdseye"), required=True,
+                        help="learned (ufld: row anchors, seg: segmentation; ONNX) or classical baseline")
+    parser.add_argument("--weights", type=Path, default=None,
+                        help="model folder of a learned method (default: the model shipped with lanevil)")
     parser.add_argument("--out", type=Path, required=True, help="predictions file (TuSimple JSON lines)")
     parser.add_argument("--fixed-run-time", type=float, default=None, metavar="MS",
                         help="write this run_time instead of the measured one (byte-reproducible output)")
@@ -62,7 +65,7 @@ def _run_detect(args: argparse.Namespace) -> int:
             print(f"\rimage {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
     try:
-        records = detect_split(args.split, args.method, progress, args.fixed_run_time)
+        records = detect_split(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:
         raise UsageError(str(error)) from None
     write_atomic(args.out, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
@@ -72,7 +75,10 @@ def _run_detect(args: argparse.Namespace) -> int:
 
 def _report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--gt", type=Path, required=True, help="split folder (e.g. DATASET/test)")
-    parser.add_argument("--pred", type=Path, required=True, help="predictions (TuSimple JSON lines)")
+    parser.add_argument("--pred", type=Path, required=True, action="append",
+                        help="predictions (TuSimple JSON lines); repeat for several detectors side by side")
+    parser.add_argument("--name", action="append", default=None,
+                        help="detector name for each --pred, in order (default: the file names)")
     parser.add_argument("--out", type=Path, required=True, help="report folder")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet", help="F1 variant (default ganet)")
     parser.add_argument("--title", default=None, help="report title (default: from the prediction file name)")
@@ -82,20 +88,34 @@ def _run_report(args: argparse.Namespace) -> int:
     from .metrics.evaluate import score_tusimple_files
     from .metrics.formats import split_labels
     from .report import build_report, write_report
+    from .report_compare import Detector, write_comparison
 
+    names = args.name or [path.stem for path in args.pred]
+    if len(names) != len(args.pred):
+        raise UsageError(f"--name: {len(names)} names for {len(args.pred)} --pred files")
+    if len(set(names)) != len(names):
+        raise UsageError("--pred: two detectors have the same name; give each a --name")
+    detectors = []
     try:
-        images = score_tusimple_files(split_labels(args.gt), args.pred)
+        gt = split_labels(args.gt)
+        for name, pred in zip(names, args.pred, strict=True):
+            title = args.title or f"Robustness report: {name}"
+            detectors.append(Detector(name, build_report(score_tusimple_files(gt, pred), args.f1, title)))
     except LaneFileError as error:
         raise UsageError(str(error)) from None
-    title = args.title or f"Robustness report: {args.pred.stem}"
-    for path in write_report(build_report(images, args.f1, title), args.out):
+    if len(detectors) == 1:
+        paths = write_report(detectors[0].report, args.out)
+    else:
+        paths = write_comparison(detectors, args.out, args.f1)
+    for path in paths:
         print(path)
     return 0
 
 
 COMMANDS: dict[str, Command] = {
     "eval": Command("score predictions with the TuSimple or CULane metric", _eval_arguments, _run_eval),
-    "detect": Command("run a classical lane detector over a split folder", _detect_arguments, _run_detect),
-    "report": Command("robustness tables and plot: original vs perturbed per category, type and severity",
+    "detect": Command("run a lane detector (learned or classical) over a split folder", _detect_arguments, _run_detect),
+    "report": Command("robustness tables and plot: original vs perturbed per category, type and severity, "
+                      "for one detector or several side by side",
                       _report_arguments, _run_report),
 }

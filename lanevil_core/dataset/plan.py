@@ -38,6 +38,12 @@ TRAIN_FRAMES_PER_VARIANT = 5  # frames of one train variation, evenly spaced ove
 CHUNK_FRAMES = 10  # frames per render task: one scene compile (~0.25 s) amortised over ~3 s of rendering
 END_MARGIN_M = 60.0  # road the case validator keeps ahead of the last frame
 SUN_ALTITUDE_JITTER_DEG = 10.0
+# Half the train variations keep the stock camera; the others move its mount so that the lanes' place in the image
+# is not a constant of the data set: lateral offset in the lane (m), height (m) and pitch (degrees, down).
+CAMERA_JITTER_SHARE = 0.5
+CAMERA_Y_RANGE_M = (-0.6, 0.6)
+CAMERA_Z_RANGE_M = (1.4, 3.2)
+CAMERA_PITCH_RANGE_DEG = (0.0, 4.0)
 LANE_LINE_CHOICES: tuple[LineType, ...] = ("white_dashed", "white_solid", "botts_dots", "white_solid_dashed")
 CENTRE_LINE_CHOICES: tuple[LineType, ...] = (
     "yellow_double_solid", "yellow_solid", "yellow_dashed", "yellow_solid_dashed", "white_double_solid",
@@ -203,6 +209,17 @@ def _markings(case: Case, rng: np.random.Generator) -> list[dict[str, Any]]:
     return markings
 
 
+def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
+    """The base's camera, or (``CAMERA_JITTER_SHARE`` of the time) one moved within the mount ranges."""
+    camera = base.camera.model_dump()
+    draws = rng.uniform(0.0, 1.0, 4)  # always four draws, so the variations after this one do not shift
+    if draws[0] < CAMERA_JITTER_SHARE:
+        for key, (lo, hi), u in zip(("y", "z", "pitch"), (CAMERA_Y_RANGE_M, CAMERA_Z_RANGE_M, CAMERA_PITCH_RANGE_DEG),
+                                    draws[1:], strict=True):
+            camera[key] = round(lo + (hi - lo) * float(u), 2)
+    return camera
+
+
 def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, Any]]:
     """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``."""
     rng = np.random.default_rng([seed, index])
@@ -217,7 +234,9 @@ def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, 
     latest_start = max(0.0, base.road.length - END_MARGIN_M - drive_m - 1.0)
     start_s = round(float(rng.uniform(0.0, latest_start)), 1)
     case_seed = int(rng.integers(0, 2**32))
+    camera = _camera_mount(base, rng)
     data = base.model_dump()
+    data["camera"] = camera
     data["weather"] = values["weather"]
     data["sun"] = {**values["sun"], "azimuth": azimuth, "altitude": round(altitude, 1)}
     data["road"]["markings"] = _markings(base, rng)
@@ -225,7 +244,8 @@ def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, 
     data["seed"] = case_seed
     data["title"] = f"{base.title} ({preset}, variation {index})"
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
-                  "lane": lane, "start_s": start_s, "markings": [m["type"] for m in data["road"]["markings"]]}
+                  "lane": lane, "start_s": start_s, "camera": {k: camera[k] for k in ("y", "z", "pitch")},
+                  "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters
 
 

@@ -1,0 +1,75 @@
+"""``lanevil train``: fit a learned lane detector (``ufld`` or ``seg``) on a dataset's clean train split."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .cli import Command, UsageError, parse_size
+from .cli_dataset import _count
+
+
+def _train_arguments(parser: argparse.ArgumentParser) -> None:
+    from .detect.model_spec import BACKBONES, FAMILIES
+
+    parser.add_argument("--data", type=Path, required=True,
+                        help="dataset folder written by `lanevil dataset` (its train/ split and train_label.json)")
+    parser.add_argument("--out", type=Path, required=True, help="model folder to write")
+    parser.add_argument("--model", choices=FAMILIES, default="ufld", help="detector family (default ufld)")
+    parser.add_argument("--backbone", choices=BACKBONES, default="resnet18", help="default resnet18")
+    parser.add_argument("--width", type=float, default=0.25,
+                        help="backbone channel multiplier (1.0 = published ResNet widths; default 0.25)")
+    parser.add_argument("--size", type=parse_size, default=(320, 180), help="network input WxH (default 320x180)")
+    parser.add_argument("--epochs", type=_count(1), default=12, help="default 12")
+    parser.add_argument("--batch", type=_count(1), default=16, help="default 16")
+    parser.add_argument("--lr", type=float, default=2e-3, help="peak learning rate of AdamW (default 2e-3)")
+    parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste"), default="none",
+                        help="training augmentation / defence (default none)")
+    parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
+    parser.add_argument("--seed", type=_count(0), default=0, help="default 0")
+    parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",
+                        help="share of the train split's case folders held out for validation (default 0.1)")
+    parser.add_argument("--init", type=Path, default=None,
+                        help="state dict to initialise the backbone from (e.g. ImageNet ResNet weights)")
+    parser.add_argument("--resume", action="store_true", help="continue from MODEL_DIR/checkpoint.pt")
+    parser.add_argument("--max-steps", type=_count(1), default=None, help="batches per epoch at most (smoke runs)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _run_train(args: argparse.Namespace) -> int:
+    try:
+        import torch  # noqa: F401
+    except ImportError:
+        raise UsageError("lanevil train needs PyTorch: pip install -e '.[learn]'") from None
+    from .detect.model_spec import ModelSpec, ModelSpecError
+    from .learn.train import TrainError, TrainSettings, train
+
+    if not args.data.is_dir():
+        raise UsageError(f"--data {args.data}: no such folder")
+    if args.init is not None and not args.init.is_file():
+        raise UsageError(f"--init {args.init}: no such file")
+    if not 0.0 <= args.val_fraction < 1.0:
+        raise UsageError(f"--val {args.val_fraction}: must lie in [0, 1)")
+    try:
+        spec = ModelSpec(family=args.model, backbone=args.backbone, width=args.width, input_size=args.size)
+        settings = TrainSettings(data=args.data, out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,
+                                 lr=args.lr, augment=args.augment, device=args.device, seed=args.seed,
+                                 val_fraction=args.val_fraction, resume=args.resume, init=args.init,
+                                 max_steps=args.max_steps)
+        summary = train(settings, show_progress=not args.quiet)
+    except (ModelSpecError, TrainError) as error:
+        raise UsageError(str(error)) from None
+    except KeyboardInterrupt:
+        print(f"interrupted: the last finished epoch is in {args.out}; add --resume to continue", file=sys.stderr)
+        return 130
+    accuracy = summary["val_accuracy"]
+    shown = "n/a" if accuracy is None else f"{100 * accuracy:.2f} %"
+    print(f"{args.out}: {summary['epochs']} epochs in {summary['seconds']:.0f} s, validation accuracy {shown}")
+    return 0
+
+
+COMMANDS: dict[str, Command] = {
+    "train": Command("train a learned lane detector (ufld or seg) on a dataset's clean train split",
+                     _train_arguments, _run_train),
+}

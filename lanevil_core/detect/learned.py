@@ -1,0 +1,103 @@
+"""Learned lane detectors at inference: an ONNX model folder run by onnxruntime (no torch needed).
+
+A model folder (written by ``lanevil train``) holds ``config.json`` (a ``ModelSpec``), ``model.onnx`` and
+``training.json``. The network takes ``(N, 3, H, W)`` float32 RGB in 0..1 at the spec's input size and returns
+probabilities: ``row_probs`` ``(N, slots, anchors, grid + 1)`` for ``ufld``, ``mask_probs`` ``(N, slots + 1, h, w)``
+and ``exist_probs`` ``(N, slots)`` for ``seg``. Decoding to TuSimple lanes is ``lane_slots``.
+
+The project ships one small model per family in ``lanevil_core/detect/models/<family>/``; ``--method ufld`` uses
+it when no ``--weights`` folder is given.
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..typed import FloatArray, UInt8Array
+from .lane_slots import LaneLine, anchor_reach, decode_lane_masks, decode_row_anchors, tusimple_lanes
+from .model_spec import FAMILIES, ONNX_FILE, ModelSpec, ModelSpecError
+
+SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
+
+
+def shipped_model_dir(family: str) -> Path:
+    """The folder of the model shipped for ``family`` (``ufld`` or ``seg``)."""
+    if family not in FAMILIES:
+        raise ModelSpecError(f"no shipped model for {family!r} (choose from {', '.join(FAMILIES)})")
+    return SHIPPED_MODELS / family
+
+
+def network_input(rgb: UInt8Array, input_size: tuple[int, int]) -> FloatArray:
+    """(3, H, W) float32 in 0..1: the frame resized (area filter) to the network's input (width, height)."""
+    width, height = input_size
+    if rgb.shape[1] != width or rgb.shape[0] != height:
+        rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
+    return np.ascontiguousarray(rgb.transpose(2, 0, 1), dtype=np.float32) * np.float32(1.0 / 255.0)
+
+
+def providers() -> list[str]:
+    """onnxruntime execution providers: CUDA first when this onnxruntime has it, always the CPU."""
+    import onnxruntime
+
+    available = onnxruntime.get_available_providers()
+    return [p for p in ("CUDAExecutionProvider", "CPUExecutionProvider") if p in available]
+
+
+def decode_outputs(spec: ModelSpec, outputs: dict[str, FloatArray], index: int = 0) -> list[LaneLine | None]:
+    """The lane slots of image ``index`` of a batch of network outputs."""
+    if spec.family == "ufld":
+        return decode_row_anchors(outputs["row_probs"][index], spec.anchor_rows)
+    rows = np.linspace(spec.anchor_rows[0], spec.anchor_rows[-1], 2 * spec.anchors)
+    return decode_lane_masks(outputs["mask_probs"][index], outputs["exist_probs"][index], rows)
+
+
+def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: list[int],
+             size: tuple[int, int]) -> list[list[int]]:
+    """TuSimple lanes at ``h_samples`` of an image of ``size`` from decoded lane slots."""
+    reach = anchor_reach(spec.anchor_rows)
+    return tusimple_lanes(lines, h_samples, size, reach)
+
+
+class LearnedDetector:
+    """An ONNX lane detector: ``detector(rgb, h_samples)`` -> TuSimple lanes in the frame's own pixels."""
+
+    def __init__(self, model_dir: str | Path, threads: int = 0) -> None:
+        import onnxruntime
+
+        self.model_dir = Path(model_dir)
+        self.spec = ModelSpec.load(self.model_dir)
+        onnx_path = self.model_dir / ONNX_FILE
+        if not onnx_path.is_file():
+            raise ModelSpecError(f"{self.model_dir}: no {ONNX_FILE}")
+        options = onnxruntime.SessionOptions()
+        options.intra_op_num_threads = threads
+        options.log_severity_level = 3
+        self._session = onnxruntime.InferenceSession(str(onnx_path), options, providers=providers())
+        self._names = [output.name for output in self._session.get_outputs()]
+        self._lock = threading.Lock()  # one run at a time per session keeps the thread pool from oversubscribing
+
+    def outputs(self, rgb: UInt8Array) -> dict[str, FloatArray]:
+        """The network's named outputs for one frame (batch of one)."""
+        batch = network_input(rgb, self.spec.input_size)[None]
+        with self._lock:
+            values = self._session.run(self._names, {"image": batch})
+        return dict(zip(self._names, values, strict=True))
+
+    def lines(self, rgb: UInt8Array) -> list[LaneLine | None]:
+        """The decoded lane slots of one frame (normalised image coordinates)."""
+        return decode_outputs(self.spec, self.outputs(rgb))
+
+    def __call__(self, rgb: UInt8Array, h_samples: list[int]) -> list[list[int]]:
+        height, width = rgb.shape[:2]
+        return lanes_of(self.spec, self.lines(rgb), h_samples, (width, height))
+
+
+@functools.lru_cache(maxsize=8)
+def load_detector(model_dir: str) -> LearnedDetector:
+    """A cached ``LearnedDetector`` per model folder (sessions are costly to open)."""
+    return LearnedDetector(model_dir)

@@ -1,0 +1,85 @@
+"""Residual backbones (ResNet-18/34) in plain PyTorch, with a channel-width multiplier.
+
+Layer names follow the common ResNet layout (``conv1``, ``bn1``, ``layer1`` ... ``layer4``, blocks with ``conv1``,
+``bn1``, ``conv2``, ``bn2``, ``downsample.0/1``), so a state dict of ImageNet weights at width 1.0 loads by name
+(``load_init``). Trained from scratch otherwise: no weights can be downloaded.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import torch
+from torch import nn
+
+BLOCKS = {"resnet18": (2, 2, 2, 2), "resnet34": (3, 4, 6, 3)}
+BASE_CHANNELS = (64, 128, 256, 512)
+
+
+class BasicBlock(nn.Module):
+    def __init__(self, c_in: int, c_out: int, stride: int) -> None:
+        super().__init__()
+        self.conv1 = nn.Conv2d(c_in, c_out, 3, stride, 1, bias=False)
+        self.bn1 = nn.BatchNorm2d(c_out)
+        self.conv2 = nn.Conv2d(c_out, c_out, 3, 1, 1, bias=False)
+        self.bn2 = nn.BatchNorm2d(c_out)
+        self.relu = nn.ReLU(inplace=True)
+        self.downsample: nn.Module | None = None
+        if stride != 1 or c_in != c_out:
+            self.downsample = nn.Sequential(nn.Conv2d(c_in, c_out, 1, stride, bias=False), nn.BatchNorm2d(c_out))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        identity = x if self.downsample is None else self.downsample(x)
+        out = self.relu(self.bn1(self.conv1(x)))
+        out = self.bn2(self.conv2(out))
+        return self.relu(out + identity)
+
+
+class ResNet(nn.Module):
+    """Stem (stride 4) and four stages (strides 4, 8, 16, 32); ``forward`` returns the last three stages."""
+
+    def __init__(self, depth: str = "resnet18", width: float = 1.0) -> None:
+        super().__init__()
+        self.channels = tuple(max(8, int(round(c * width))) for c in BASE_CHANNELS)
+        c0 = self.channels[0]
+        self.conv1 = nn.Conv2d(3, c0, 7, 2, 3, bias=False)
+        self.bn1 = nn.BatchNorm2d(c0)
+        self.relu = nn.ReLU(inplace=True)
+        self.maxpool = nn.MaxPool2d(3, 2, 1)
+        stages = []
+        c_in = c0
+        for index, (count, c_out) in enumerate(zip(BLOCKS[depth], self.channels, strict=True)):
+            stride = 1 if index == 0 else 2
+            blocks = [BasicBlock(c_in, c_out, stride)] + [BasicBlock(c_out, c_out, 1) for _ in range(count - 1)]
+            stages.append(nn.Sequential(*blocks))
+            c_in = c_out
+        self.layer1, self.layer2, self.layer3, self.layer4 = stages
+        for module in self.modules():
+            if isinstance(module, nn.Conv2d):
+                nn.init.kaiming_normal_(module.weight, mode="fan_out", nonlinearity="relu")
+        for module in self.modules():  # residual branches start as identity (zero-init last BN), easier from scratch
+            if isinstance(module, BasicBlock):
+                nn.init.zeros_(module.bn2.weight)
+
+    def forward(self, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        x = self.maxpool(self.relu(self.bn1(self.conv1(x))))
+        c2 = self.layer2(self.layer1(x))
+        c3 = self.layer3(c2)
+        return c2, c3, self.layer4(c3)
+
+
+def load_init(backbone: ResNet, path: str | Path) -> tuple[int, int]:
+    """Copy the tensors of a state dict file whose names and shapes match (e.g. ImageNet ResNet weights);
+    returns (copied, skipped). A ``fc.*`` classifier or a ``backbone.`` prefix is ignored."""
+    state = torch.load(Path(path), map_location="cpu", weights_only=True)
+    if isinstance(state, dict) and "state_dict" in state:
+        state = state["state_dict"]
+    own = backbone.state_dict()
+    copied = 0
+    for name, tensor in state.items():
+        name = name.removeprefix("module.").removeprefix("backbone.")
+        if name in own and own[name].shape == tensor.shape:
+            own[name] = tensor
+            copied += 1
+    backbone.load_state_dict(own)
+    return copied, len(state) - copied

@@ -1,0 +1,175 @@
+"""Training data: frames with TuSimple labels as network inputs and targets (``torch.utils.data.Dataset``).
+
+Two sources give the same samples:
+- ``LabelledFrames``: a split folder written by ``lanevil dataset`` (its ``*_label.json`` and images), read once
+  and kept in memory at the network's input size.
+- ``RenderedFrames``: case files rendered on the fly (no images on disk) through the renderer and the very
+  labels code the dataset writer uses (``labels.tusimple_record``).
+
+A sample's targets come from ``detect.lane_slots``: lanes placed in slots, row-anchor classes and a lane mask.
+A horizontal flip (half the training samples) mirrors image and slots; ``--augment`` adds one of ``augment``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections import OrderedDict
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import torch
+from torch.utils.data import Dataset
+
+from ..detect.lane_slots import assign_slots, encode_lane_mask, encode_row_anchors, lane_lines, mirror_slots
+from ..detect.learned import network_input
+from ..detect.model_spec import ModelSpec
+from ..detect.split import read_rgb
+from ..metrics.formats import split_labels
+from ..typed import UInt8Array
+from .augment import AUGMENT_PROBABILITY, Augment
+
+
+@dataclass(frozen=True)
+class Targets:
+    """What a network learns from one frame: row-anchor classes ``(slots, anchors)``, lane mask ``(h, w)`` and
+    slot existence ``(slots,)``."""
+
+    rows: np.ndarray
+    mask: np.ndarray
+    exist: np.ndarray
+
+
+def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: ModelSpec, flip: bool) -> Targets:
+    """The targets of a TuSimple record of a frame of ``frame_size`` (width, height)."""
+    placed = assign_slots(lane_lines(record["lanes"], record["h_samples"], frame_size), spec.slots)
+    if flip:
+        placed = mirror_slots(placed)
+    return Targets(encode_row_anchors(placed, spec.anchor_rows, spec.grid),
+                   encode_lane_mask(placed, spec.mask_size),
+                   np.array([line is not None for line in placed], np.float32))
+
+
+def resized(rgb: UInt8Array, input_size: tuple[int, int]) -> UInt8Array:
+    """(H, W, 3) uint8 at the network's input size (area filter, as at inference)."""
+    width, height = input_size
+    if rgb.shape[:2] == (height, width):
+        return rgb
+    return cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
+
+
+class _Frames(Dataset):
+    """Shared sample assembly: subclasses provide ``image(index)``, ``records`` and ``frame_sizes``."""
+
+    def __init__(self, spec: ModelSpec, train: bool, augment: Augment | None, seed: int) -> None:
+        self.spec = spec
+        self.train = train
+        self.augment = augment
+        self.seed = seed
+        self.epoch = 0
+        self.records: list[dict[str, Any]] = []
+        self.frame_sizes: list[tuple[int, int]] = []
+
+    def image(self, index: int) -> UInt8Array:
+        raise NotImplementedError
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    def __getitem__(self, index: int) -> dict[str, torch.Tensor]:
+        image = self.image(index)
+        flip = False
+        if self.train:  # per (seed, epoch, index): the same run draws the same augmentations, also on resume
+            rng = np.random.default_rng([self.seed, self.epoch, index])
+            flip = bool(rng.random() < 0.5)
+            if self.augment is not None and rng.random() < AUGMENT_PROBABILITY:
+                other = self.image(int(rng.integers(len(self))))
+                image = self.augment(image, rng, other)
+            if flip:
+                image = np.ascontiguousarray(image[:, ::-1])
+        targets = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip)
+        return {"image": torch.from_numpy(network_input(image, self.spec.input_size)),
+                "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask),
+                "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index)}
+
+
+def read_records(label_file: Path) -> list[dict[str, Any]]:
+    """The JSON records of a TuSimple label file."""
+    return [json.loads(line) for line in label_file.read_text(encoding="utf-8").splitlines() if line.strip()]
+
+
+def file_sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+class LabelledFrames(_Frames):
+    """Frames of a split folder (``DIR/train``), the chosen ``indices`` of its label file, held in memory."""
+
+    def __init__(self, split_dir: str | Path, spec: ModelSpec, indices: list[int] | None = None, train: bool = True,
+                 augment: Augment | None = None, seed: int = 0) -> None:
+        super().__init__(spec, train, augment, seed)
+        self.split_dir = Path(split_dir)
+        records = read_records(split_labels(self.split_dir))
+        chosen = range(len(records)) if indices is None else indices
+        self.records = [records[i] for i in chosen]
+        images = []
+        for record in self.records:
+            rgb = read_rgb(self.split_dir / record["raw_file"])
+            self.frame_sizes.append((rgb.shape[1], rgb.shape[0]))
+            images.append(resized(rgb, spec.input_size))
+        width, height = spec.input_size
+        self.images = np.stack(images) if images else np.zeros((0, height, width, 3), np.uint8)
+
+    def image(self, index: int) -> UInt8Array:
+        return self.images[index]
+
+
+class RenderedFrames(_Frames):
+    """Frames rendered on the fly from case files: ``items`` are (case file, frame index) pairs, rendered at
+    ``render_size`` and labelled by ``labels.tusimple_record``; the last few compiled scenes are kept."""
+
+    def __init__(self, items: list[tuple[str | Path, int]], spec: ModelSpec, render_size: tuple[int, int] = (640, 360),
+                 train: bool = True, augment: Augment | None = None, seed: int = 0) -> None:
+        super().__init__(spec, train, augment, seed)
+        self.items = [(Path(path), int(frame)) for path, frame in items]
+        self.render_size = render_size
+        self._scenes: OrderedDict[Path, Any] = OrderedDict()
+        self._images: dict[int, UInt8Array] = {}
+        self.records = [self._render(i)[1] for i in range(len(self.items))]
+        self.frame_sizes = [render_size] * len(self.items)
+
+    def _render(self, index: int) -> tuple[UInt8Array, dict[str, Any]]:
+        from ..case import load_case
+        from ..compile import compile_scene
+        from ..labels import tusimple_record
+        from ..render import render_frame
+
+        path, frame_index = self.items[index]
+        scene = self._scenes.pop(path, None) or compile_scene(load_case(path))
+        self._scenes[path] = scene
+        while len(self._scenes) > 2:
+            self._scenes.popitem(last=False)
+        frame = render_frame(scene, frame_index, self.render_size)
+        record = tusimple_record(scene, frame_index, frame, raw_file=f"{path.name}#{frame_index}")
+        self._images[index] = resized(frame.rgb, self.spec.input_size)
+        return self._images[index], record
+
+    def image(self, index: int) -> UInt8Array:
+        return self._images[index]
+
+
+def split_indices(count: int, groups: list[str], val_fraction: float, seed: int) -> tuple[list[int], list[int]]:
+    """(train, val) record indices; whole groups (case folders) go to one side, drawn by ``seed``."""
+    unique = sorted(set(groups))
+    rng = np.random.default_rng(seed)
+    order = rng.permutation(len(unique))
+    n_val = int(round(len(unique) * val_fraction)) if val_fraction > 0 else 0
+    if val_fraction > 0 and len(unique) > 1:
+        n_val = min(max(n_val, 1), len(unique) - 1)
+    val_groups = {unique[i] for i in order[:n_val]}
+    train = [i for i in range(count) if groups[i] not in val_groups]
+    val = [i for i in range(count) if groups[i] in val_groups]
+    return train, val

@@ -1,0 +1,135 @@
+"""The lane-detector networks: row-anchor classification (``ufld``) and lane-slot segmentation (``seg``).
+
+Both take ``(N, 3, H, W)`` float RGB in 0..1 (normalised inside the network) at the spec's input size.
+
+- ``UFLDNet`` (Ultra Fast Lane Detection): the last stage squeezed to 8 channels, flattened, and a two-layer
+  classifier giving per lane slot and row anchor the logits of ``grid`` column cells plus "no lane". While
+  training, an auxiliary lane-mask head on the three last stages (as in UFLD) adds a segmentation loss.
+- ``SegNet`` (SCNN/ERFNet-like): the three last stages merged at stride 8 (a small feature pyramid), two 3x3
+  convolutions, logits of background + one channel per slot at stride ``mask_stride``; an existence head on the
+  pooled last stage says which slots hold a lane.
+
+``Deployed`` wraps either for export: softmax probabilities under fixed output names (see ``detect.learned``).
+"""
+
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from ..detect.model_spec import ModelSpec
+from .backbone import ResNet
+
+MEAN = (0.485, 0.456, 0.406)
+STD = (0.229, 0.224, 0.225)
+
+
+class Normalize(nn.Module):
+    def __init__(self) -> None:
+        super().__init__()
+        self.register_buffer("mean", torch.tensor(MEAN).view(1, 3, 1, 1))
+        self.register_buffer("std", torch.tensor(STD).view(1, 3, 1, 1))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return (x - self.mean) / self.std
+
+
+def conv_bn_relu(c_in: int, c_out: int, kernel: int = 3) -> nn.Sequential:
+    return nn.Sequential(nn.Conv2d(c_in, c_out, kernel, 1, kernel // 2, bias=False), nn.BatchNorm2d(c_out),
+                         nn.ReLU(inplace=True))
+
+
+class MaskHead(nn.Module):
+    """Stages at strides 8, 16, 32 -> ``classes`` logits at the input size divided by ``stride``."""
+
+    def __init__(self, channels: tuple[int, ...], mid: int, classes: int, out_size: tuple[int, int]) -> None:
+        super().__init__()
+        c2, c3, c4 = channels[1:]
+        self.lateral = nn.ModuleList([nn.Conv2d(c, mid, 1) for c in (c2, c3, c4)])
+        self.fuse = nn.Sequential(conv_bn_relu(mid, mid), conv_bn_relu(mid, mid))
+        self.classify = nn.Conv2d(mid, classes, 1)
+        self.out_size = out_size  # (width, height)
+
+    def forward(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+        size = c2.shape[-2:]
+        x = self.lateral[0](c2)
+        x = x + F.interpolate(self.lateral[1](c3), size=size, mode="bilinear", align_corners=False)
+        x = x + F.interpolate(self.lateral[2](c4), size=size, mode="bilinear", align_corners=False)
+        logits = self.classify(self.fuse(x))
+        width, height = self.out_size
+        return F.interpolate(logits, size=(height, width), mode="bilinear", align_corners=False)
+
+
+def _stage_sizes(backbone: ResNet, input_size: tuple[int, int]) -> tuple[int, int]:
+    """(height, width) of the last stage for an input of ``input_size`` (width, height)."""
+    with torch.no_grad():
+        backbone.eval()
+        _, _, c4 = backbone(torch.zeros(1, 3, input_size[1], input_size[0]))
+        backbone.train()
+    return int(c4.shape[-2]), int(c4.shape[-1])
+
+
+class UFLDNet(nn.Module):
+    def __init__(self, spec: ModelSpec) -> None:
+        super().__init__()
+        self.spec = spec
+        self.normalize = Normalize()
+        self.backbone = ResNet(spec.backbone, spec.width)
+        h, w = _stage_sizes(self.backbone, spec.input_size)
+        self.squeeze = nn.Conv2d(self.backbone.channels[-1], 8, 1)
+        self.classifier = nn.Sequential(
+            nn.Linear(8 * h * w, spec.hidden), nn.ReLU(inplace=True),
+            nn.Linear(spec.hidden, spec.slots * spec.anchors * (spec.grid + 1)),
+        )
+        mid = max(16, self.backbone.channels[1])
+        self.aux = MaskHead(self.backbone.channels, mid, spec.slots + 1, spec.mask_size)
+
+    def forward(self, image: torch.Tensor) -> dict[str, torch.Tensor]:
+        c2, c3, c4 = self.backbone(self.normalize(image))
+        flat = torch.flatten(self.squeeze(c4), 1)
+        logits = self.classifier(flat).view(-1, self.spec.slots, self.spec.anchors, self.spec.grid + 1)
+        out = {"row_logits": logits}
+        if self.training:
+            out["mask_logits"] = self.aux(c2, c3, c4)
+        return out
+
+
+class SegNet(nn.Module):
+    def __init__(self, spec: ModelSpec) -> None:
+        super().__init__()
+        self.spec = spec
+        self.normalize = Normalize()
+        self.backbone = ResNet(spec.backbone, spec.width)
+        mid = max(16, self.backbone.channels[1])
+        self.head = MaskHead(self.backbone.channels, mid, spec.slots + 1, spec.mask_size)
+        self.exist = nn.Sequential(nn.Linear(self.backbone.channels[-1], 64), nn.ReLU(inplace=True),
+                                   nn.Linear(64, spec.slots))
+
+    def forward(self, image: torch.Tensor) -> dict[str, torch.Tensor]:
+        c2, c3, c4 = self.backbone(self.normalize(image))
+        pooled = torch.flatten(F.adaptive_avg_pool2d(c4, 1), 1)
+        return {"mask_logits": self.head(c2, c3, c4), "exist_logits": self.exist(pooled)}
+
+
+def build_model(spec: ModelSpec) -> nn.Module:
+    """The network of a spec, freshly initialised."""
+    return UFLDNet(spec) if spec.family == "ufld" else SegNet(spec)
+
+
+class Deployed(nn.Module):
+    """A trained network in eval mode returning probabilities under the names ``detect.learned`` reads."""
+
+    def __init__(self, model: nn.Module) -> None:
+        super().__init__()
+        self.model = model.eval()
+        self.family = model.spec.family
+
+    def output_names(self) -> list[str]:
+        return ["row_probs"] if self.family == "ufld" else ["mask_probs", "exist_probs"]
+
+    def forward(self, image: torch.Tensor) -> tuple[torch.Tensor, ...]:
+        out = self.model(image)
+        if self.family == "ufld":
+            return (torch.softmax(out["row_logits"], dim=-1),)
+        return torch.softmax(out["mask_logits"], dim=1), torch.sigmoid(out["exist_logits"])

@@ -1,0 +1,220 @@
+"""``lanevil train``: fit a lane detector on a dataset's clean train split and write a model folder.
+
+The model folder holds ``config.json`` (the ``ModelSpec``), ``checkpoint.pt`` (written after every epoch, read by
+``--resume``), ``weights.pt`` (the final state dict in half precision), ``model.onnx`` and ``training.json`` (data
+hash, settings, time, per-epoch loss and validation accuracy). A ``val_fraction`` of the train split's case folders
+is held out by seed; validation accuracy is TuSimple Accuracy on the 1280x720 grid.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch.utils.data import DataLoader
+
+from ..case import write_atomic
+from ..detect.lane_slots import on_tusimple_grid
+from ..detect.learned import decode_outputs, lanes_of
+from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
+from ..metrics.formats import split_labels
+from ..metrics.tusimple import score_image
+from .augment import AUGMENTS
+from .backbone import load_init
+from .data import LabelledFrames, file_sha256, read_records, split_indices
+from .export import export_onnx
+from .losses import detector_loss
+from .models import Deployed, build_model
+
+CHECKPOINT_FILE = "checkpoint.pt"
+WARMUP_STEPS = 100
+
+
+class TrainError(ValueError):
+    """Training that cannot start (no data, a resume that does not match)."""
+
+
+@dataclass(frozen=True)
+class TrainSettings:
+    data: Path
+    out: Path
+    spec: ModelSpec = field(default_factory=ModelSpec)
+    epochs: int = 12
+    batch: int = 16
+    lr: float = 2e-3
+    weight_decay: float = 1e-4
+    augment: str = "none"
+    device: str = "auto"
+    seed: int = 0
+    val_fraction: float = 0.1
+    resume: bool = False
+    init: Path | None = None
+    max_steps: int | None = None  # stop each epoch after this many batches (tests and smoke runs)
+
+
+def pick_device(name: str) -> torch.device:
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    if name == "cuda" and not torch.cuda.is_available():
+        raise TrainError("--device cuda: no CUDA device is available to this torch")
+    return torch.device(name)
+
+
+def predict_lanes(model: torch.nn.Module, dataset: LabelledFrames, device: torch.device,
+                  batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
+    """(predicted lanes, GT lanes, rows) of every frame of ``dataset``, both on the 1280x720 grid."""
+    deployed = Deployed(model).to(device).eval()
+    results = []
+    loader = DataLoader(dataset, batch_size=batch, shuffle=False)
+    with torch.no_grad():
+        for batch_data in loader:
+            values = deployed(batch_data["image"].to(device))
+            outputs = {name: v.float().cpu().numpy() for name, v in zip(deployed.output_names(), values, strict=True)}
+            for k, index in enumerate(batch_data["index"].tolist()):
+                record = dataset.records[index]
+                gt, rows = on_tusimple_grid(record["lanes"], record["h_samples"], dataset.frame_sizes[index])
+                lines = decode_outputs(model.spec, outputs, k)
+                # decode on the 720 grid: rows are continuous 720-grid rows, lanes_of adds the half pixel
+                pred = lanes_of(model.spec, lines, rows, (1280, 720))
+                results.append((pred, gt, rows))
+    model.train()
+    return results
+
+
+def tusimple_accuracy(results: list[tuple[list[list[int]], list[list[int]], list[float]]]) -> float:
+    """Mean official per-image accuracy."""
+    scores = [score_image(pred, gt, rows, 0.0).accuracy for pred, gt, rows in results]
+    return float(np.mean(scores)) if scores else float("nan")
+
+
+def _save(obj: Any, path: Path) -> None:
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    torch.save(obj, tmp)
+    os.replace(tmp, path)
+
+
+def _lr_at(step: int, total: int, base: float) -> float:
+    if step < WARMUP_STEPS:
+        return base * (step + 1) / WARMUP_STEPS
+    progress = (step - WARMUP_STEPS) / max(1, total - WARMUP_STEPS)
+    return base * 0.5 * (1.0 + math.cos(math.pi * min(1.0, progress)))
+
+
+Progress = Callable[[str], None]
+
+
+def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]:
+    """Train, export and describe a model in ``settings.out``; returns the ``training.json`` content."""
+    from tqdm import tqdm
+
+    torch.manual_seed(settings.seed)
+    torch.set_num_threads(os.cpu_count() or 1)
+    device = pick_device(settings.device)
+    spec = settings.spec
+    split_dir = settings.data / "train" if (settings.data / "train").is_dir() else settings.data
+    try:
+        label_file = split_labels(split_dir)
+    except ValueError as error:
+        raise TrainError(f"--data {settings.data}: {error}") from None
+    records = read_records(label_file)
+    if not records:
+        raise TrainError(f"--data {settings.data}: {label_file.name} has no frames")
+    groups = [str(Path(r["raw_file"]).parent) for r in records]
+    train_idx, val_idx = split_indices(len(records), groups, settings.val_fraction, settings.seed)
+    augment = AUGMENTS[settings.augment]
+    train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed)
+    val_set = LabelledFrames(split_dir, spec, val_idx, train=False) if val_idx else None
+
+    out = settings.out
+    out.mkdir(parents=True, exist_ok=True)
+    data_sha = file_sha256(label_file)
+    model = build_model(spec).to(device)
+    if settings.init is not None:
+        copied, skipped = load_init(model.backbone, settings.init)
+        if copied == 0:
+            raise TrainError(f"--init {settings.init}: no tensor matches the {spec.backbone} backbone")
+    optimizer = torch.optim.AdamW(model.parameters(), lr=settings.lr, weight_decay=settings.weight_decay)
+    steps_per_epoch = math.ceil(len(train_set) / settings.batch)
+    if settings.max_steps is not None:
+        steps_per_epoch = min(steps_per_epoch, settings.max_steps)
+    total_steps = steps_per_epoch * settings.epochs
+    history: list[dict[str, Any]] = []
+    start_epoch = 0
+    checkpoint_path = out / CHECKPOINT_FILE
+    if settings.resume and checkpoint_path.is_file():
+        checkpoint = torch.load(checkpoint_path, map_location=device, weights_only=False)
+        if checkpoint["data_sha256"] != data_sha or checkpoint["spec"] != asdict(spec):
+            raise TrainError(f"--resume: {checkpoint_path} was trained on other data or another model; "
+                             "use a new --out folder")
+        model.load_state_dict(checkpoint["model"])
+        optimizer.load_state_dict(checkpoint["optimizer"])
+        history = checkpoint["history"]
+        start_epoch = checkpoint["epoch"] + 1
+    write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
+
+    model.train()
+    for epoch in range(start_epoch, settings.epochs):
+        started = time.perf_counter()
+        train_set.epoch = epoch
+        generator = torch.Generator().manual_seed(settings.seed * 1000 + epoch)
+        loader = DataLoader(train_set, batch_size=settings.batch, shuffle=True, generator=generator, drop_last=True)
+        bar = tqdm(total=steps_per_epoch, desc=f"epoch {epoch + 1}/{settings.epochs}", disable=not show_progress,
+                   unit="batch", dynamic_ncols=True)
+        losses = []
+        for step, batch in enumerate(loader):
+            if step >= steps_per_epoch:
+                break
+            for group in optimizer.param_groups:
+                group["lr"] = _lr_at(epoch * steps_per_epoch + step, total_steps, settings.lr)
+            batch = {k: v.to(device) for k, v in batch.items()}
+            loss, terms = detector_loss(spec.family, model(batch["image"]), batch)
+            optimizer.zero_grad(set_to_none=True)
+            loss.backward()
+            optimizer.step()
+            losses.append(float(loss.detach()))
+            bar.set_postfix(loss=f"{np.mean(losses[-20:]):.3f}", **{k: f"{v:.3f}" for k, v in terms.items()})
+            bar.update()
+        bar.close()
+        val_accuracy = tusimple_accuracy(predict_lanes(model, val_set, device)) if val_set is not None else None
+        history.append({"epoch": epoch + 1, "loss": float(np.mean(losses)) if losses else None,
+                        "val_accuracy": val_accuracy, "seconds": round(time.perf_counter() - started, 2)})
+        if show_progress:
+            shown = "n/a" if val_accuracy is None else f"{100 * val_accuracy:.2f} %"
+            print(f"epoch {epoch + 1}: loss {history[-1]['loss']:.4f}  val accuracy {shown}", flush=True)
+        _save({"model": model.state_dict(), "optimizer": optimizer.state_dict(), "epoch": epoch,
+               "history": history, "data_sha256": data_sha, "spec": asdict(spec)}, checkpoint_path)
+
+    model = model.cpu().eval()
+    _save({k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}, out / WEIGHTS_FILE)
+    export_onnx(model, out / ONNX_FILE)
+    seconds = [h["seconds"] for h in history]
+    summary = {
+        "spec": asdict(spec),
+        "data": settings.data.name,
+        "data_sha256": data_sha,
+        "train_frames": len(train_set),
+        "val_frames": len(val_idx),
+        "epochs": settings.epochs,
+        "batch": settings.batch,
+        "lr": settings.lr,
+        "augment": settings.augment,
+        "seed": settings.seed,
+        "device": device.type,
+        "threads": torch.get_num_threads(),
+        "init": None if settings.init is None else settings.init.name,
+        "seconds": round(float(sum(seconds)), 1),
+        "seconds_per_epoch": round(float(np.median(seconds)), 1) if seconds else None,
+        "val_accuracy": history[-1]["val_accuracy"] if history else None,
+        "history": history,
+        "torch": torch.__version__,
+    }
+    write_atomic(out / TRAINING_FILE, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
+    return summary

@@ -1,0 +1,127 @@
+"""Several detectors side by side, in the paper's table layout.
+
+For each detector: Perturbed / Original / Gap of TuSimple Accuracy and F1 for each category and their average;
+a per-severity table (accuracy drop against the originals at each level) and a plot of the drop against severity,
+one line per detector. Each detector's own full report (``report.md`` ...) goes into a sub-folder.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+from .case import write_atomic
+from .report import ALL, CATEGORY_ORDER, LEVELS, Report, Row, _csv, _number, _pct, write_report
+
+COMPARE_MD, COMPARE_CSV, COMPARE_PNG = "compare.md", "compare.csv", "compare.png"
+
+
+@dataclass(frozen=True)
+class Detector:
+    """One detector's name (column label) and its report."""
+
+    name: str
+    report: Report
+
+
+def category_rows(report: Report) -> list[Row]:
+    """The category rows (in the paper's order) and last the row of all images."""
+    rows = {row.category: row for row in report.rows if row.type == ALL}
+    ordered = [rows[c] for c in CATEGORY_ORDER if c in rows]
+    ordered += [row for c, row in rows.items() if c not in CATEGORY_ORDER and c != ALL]
+    return ordered + ([rows[ALL]] if ALL in rows else [])
+
+
+def _heading(row: Row) -> str:
+    return "Average" if row.category == ALL else row.category
+
+
+def markdown(detectors: list[Detector], f1_variant: str) -> str:
+    first = category_rows(detectors[0].report)
+    heads = [_heading(row) for row in first]
+    lines = ["# Robustness of several detectors", "",
+             f"TuSimple metric, F1 variant `{f1_variant}`, values in %. P = Perturbed, O = Original (the clean "
+             "`00_original` cases), G = Gap = P - O.", ""]
+    for field, name in (("accuracy", "Accuracy"), ("f1", "F1")):
+        lines += [f"## {name}", "", "| Detector | | " + " | ".join(heads) + " |",
+                  "|---|---|" + "---:|" * len(heads)]
+        for detector in detectors:
+            rows = {_heading(row): row for row in category_rows(detector.report)}
+            for label, pick in (("P", "perturbed"), ("O", "original"), ("G", None)):
+                cells = []
+                for head in heads:
+                    row = rows.get(head)
+                    if row is None:
+                        cells.append("-")
+                    elif pick is None:
+                        cells.append(_pct(row.gap(field), signed=True))
+                    else:
+                        cells.append(_pct(getattr(getattr(row, pick), field, None)))
+                name_cell = detector.name if label == "P" else ""
+                lines.append(f"| {name_cell} | {label} | " + " | ".join(cells) + " |")
+        lines.append("")
+    lines += ["## Accuracy drop by severity (all categories)", "",
+              "| Detector | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
+              "|---|---:|" + "---:|" * len(LEVELS)]
+    for detector in detectors:
+        row = category_rows(detector.report)[-1]
+        cells = [_pct(getattr(row.original, "accuracy", None))]
+        cells += [_pct(row.gap("accuracy", level), signed=True) for level in LEVELS]
+        lines.append(f"| {detector.name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def comparison_csv(detectors: list[Detector]) -> str:
+    rows: list[list[str | int]] = [["detector", "category", "severity", "images", "accuracy", "f1",
+                                    "accuracy_gap", "f1_gap"]]
+    for detector in detectors:
+        for row in category_rows(detector.report):
+            for level in (0, *LEVELS):
+                stats = row.original if level == 0 else row.levels[level]
+                if stats is None:
+                    continue
+                gaps = (0.0, 0.0) if level == 0 else (row.gap("accuracy", level), row.gap("f1", level))
+                rows.append([detector.name, row.category, level, stats.images, _number(stats.accuracy),
+                             _number(stats.f1), _number(gaps[0]), _number(gaps[1])])
+    return _csv(rows)
+
+
+def comparison_plot(detectors: list[Detector]) -> bytes:
+    """PNG: accuracy drop (percentage points) against severity over all categories, one line per detector."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    for detector in detectors:
+        row = category_rows(detector.report)[-1]
+        points = [(level, -100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
+        if points:
+            ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", linewidth=1.8, label=detector.name)
+    ax.axhline(0.0, color="grey", linewidth=0.8)
+    ax.set_xticks(list(LEVELS))
+    ax.set_xlabel("severity level")
+    ax.set_ylabel("accuracy drop vs original (percentage points)")
+    ax.set_title("Accuracy drop by severity, per detector")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str) -> list[Path]:
+    """compare.md, compare.csv and compare.png in ``out_dir`` and each detector's report in ``out_dir/<name>/``."""
+    out_dir = Path(out_dir)
+    written = []
+    for detector in detectors:
+        written += write_report(detector.report, out_dir / detector.name)
+    files = {COMPARE_MD: markdown(detectors, f1_variant).encode("utf-8"),
+             COMPARE_CSV: comparison_csv(detectors).encode("utf-8"), COMPARE_PNG: comparison_plot(detectors)}
+    for name, data in files.items():
+        write_atomic(out_dir / name, data)
+    return [out_dir / name for name in files] + written
