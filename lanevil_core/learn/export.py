@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import torch
@@ -21,7 +22,10 @@ def export_onnx(model: torch.nn.Module, path: str | Path) -> Path:
     dummy = torch.zeros(1, 3, height, width)
     names = deployed.output_names()
     tmp = path.with_suffix(".onnx.tmp")
-    with torch.no_grad():
+    # The TorchScript exporter: about 1 s for these networks, byte-stable, and it needs no onnxscript; the
+    # torch.export-based one takes 5-6 s and prints progress. Its deprecation notice is expected here.
+    with torch.no_grad(), warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
         torch.onnx.export(deployed, (dummy,), str(tmp), input_names=["image"], output_names=names,
                           dynamic_axes={"image": {0: "batch"}, **{n: {0: "batch"} for n in names}},
                           opset_version=OPSET, dynamo=False)

@@ -1,0 +1,168 @@
+"""Learned detectors: target encodings decode back to the labels, a few training iterations on a tiny rendered
+dataset write a complete model folder whose ONNX export matches torch, resume and seeds reproduce, and the shipped
+models detect lanes on clean renders."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from lanevil_core.cli import main  # noqa: E402
+from lanevil_core.detect.lane_slots import (  # noqa: E402
+    assign_slots,
+    decode_lane_masks,
+    decode_row_anchors,
+    encode_lane_mask,
+    encode_row_anchors,
+    lane_lines,
+    mirror_slots,
+    on_tusimple_grid,
+)
+from lanevil_core.detect.learned import LearnedDetector, lanes_of, shipped_model_dir  # noqa: E402
+from lanevil_core.detect.model_spec import ModelSpec  # noqa: E402
+from lanevil_core.detect.split import detect_split  # noqa: E402
+from lanevil_core.labels import TUSIMPLE_H_SAMPLES  # noqa: E402
+from lanevil_core.metrics.tusimple import score_image  # noqa: E402
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+TINY_SPEC = {"width": 0.125, "input_size": (128, 72), "anchors": 14, "grid": 32, "hidden": 32}
+
+
+def straight_record(bottoms: tuple[int, ...] = (-300, 350, 930, 1580)) -> dict:
+    """Straight lanes converging to a vanishing point, on the 1280x720 grid, by their x at row 710."""
+    rows = list(TUSIMPLE_H_SAMPLES)
+    lanes = []
+    for bottom_x in bottoms:
+        xs = [640 + (bottom_x - 640) * (h - 340) / (710 - 340) if h >= 350 else -2 for h in rows]
+        lanes.append([int(x) if 0 <= x < 1280 else -2 for x in xs])
+    return {"lanes": lanes, "h_samples": rows}
+
+
+@pytest.mark.parametrize("family", ["ufld", "seg"])
+def test_known_targets_decode_to_the_same_tusimple_points(family):
+    record = straight_record()
+    spec = ModelSpec(family=family)
+    placed = assign_slots(lane_lines(record["lanes"], record["h_samples"], (1280, 720)), spec.slots)
+    assert [line is not None for line in placed] == [False, True, True, True, True, False]
+    if family == "ufld":
+        target = encode_row_anchors(placed, spec.anchor_rows, spec.grid)
+        lines = decode_row_anchors(np.eye(spec.grid + 1)[target], spec.anchor_rows)
+    else:
+        mask = encode_lane_mask(placed, spec.mask_size)
+        exist = np.array([line is not None for line in placed], float)
+        rows = np.linspace(spec.anchor_rows[0], spec.anchor_rows[-1], 2 * spec.anchors)
+        lines = decode_lane_masks(np.eye(spec.slots + 1)[mask].transpose(2, 0, 1), exist, rows)
+    decoded = lanes_of(spec, lines, record["h_samples"], (1280, 720))
+    score = score_image(decoded, record["lanes"], record["h_samples"], 0.0)
+    # Near the vanishing point the lanes overlap in the mask (one class per pixel), so seg loses a few top rows.
+    assert score.accuracy >= (0.97 if family == "ufld" else 0.94)
+    assert score.fp == 0.0 and score.fn == 0.0
+
+
+def test_slots_follow_the_camera_and_mirror():
+    record = straight_record((-900, -300, 350, 930))
+    lines = lane_lines(record["lanes"], record["h_samples"], (1280, 720))
+    placed = assign_slots(lines, 4)  # two each side: the farthest of three left lanes is dropped
+    bottoms = [None if line is None else round(line.bottom_x, 2) for line in placed]
+    assert bottoms[:3] == pytest.approx([-0.23, 0.27, 0.73], abs=0.03)
+    assert bottoms[3] is None
+    mirrored = mirror_slots(placed)
+    assert mirrored[0] is None
+    assert mirrored[3].bottom_x == pytest.approx(1 - placed[0].bottom_x)
+
+
+def test_labels_at_other_sizes_score_on_the_1280_grid():
+    lanes, rows = on_tusimple_grid([[10, -2, 319]], [40, 42, 179], (320, 180))
+    assert lanes == [[42, -2, 1278]]
+    assert rows == pytest.approx([161.5, 169.5, 717.5])
+
+
+@pytest.fixture(scope="module")
+def tiny_dataset(tmp_path_factory) -> Path:
+    cases = tmp_path_factory.mktemp("cases")
+    (cases / "straight.json").write_text((SCENES / "00_clean" / "00_straight_urban.json").read_text())
+    out = tmp_path_factory.mktemp("data")
+    assert main(["dataset", "--cases", str(cases), "--out", str(out), "--train-frames", "10", "--size", "256x144",
+                 "--workers", "1", "--quiet"]) == 0
+    return out
+
+
+def _train(data: Path, out: Path, family: str, *extra: str) -> int:
+    spec = TINY_SPEC
+    return main(["train", "--data", str(data), "--out", str(out), "--model", family, "--width", str(spec["width"]),
+                 "--size", "x".join(map(str, spec["input_size"])), "--epochs", "1", "--batch", "2",
+                 "--max-steps", "2", "--val", "0.5", "--quiet", *extra])
+
+
+@pytest.mark.parametrize("family", ["ufld", "seg"])
+def test_training_writes_a_model_folder_whose_onnx_matches_torch(tiny_dataset, tmp_path, family):
+    from lanevil_core.learn.models import Deployed, build_model
+
+    assert _train(tiny_dataset, tmp_path, family) == 0
+    for name in ("config.json", "model.onnx", "weights.pt", "training.json", "checkpoint.pt"):
+        assert (tmp_path / name).is_file(), name
+    summary = json.loads((tmp_path / "training.json").read_text())
+    assert summary["epochs"] == 1 and summary["train_frames"] + summary["val_frames"] == 10
+    assert len(summary["data_sha256"]) == 64 and 0.0 <= summary["val_accuracy"] <= 1.0
+
+    spec = ModelSpec.load(tmp_path)
+    model = build_model(spec)
+    state = torch.load(tmp_path / "checkpoint.pt", weights_only=False)["model"]
+    model.load_state_dict(state)
+    image = np.random.default_rng(0).random((2, 3, spec.input_size[1], spec.input_size[0]), dtype=np.float32)
+    with torch.no_grad():
+        expected = [t.numpy() for t in Deployed(model)(torch.from_numpy(image))]
+    detector = LearnedDetector(tmp_path)
+    session_out = detector._session.run(None, {"image": image})
+    for want, got in zip(expected, session_out, strict=True):
+        assert np.max(np.abs(want - got)) < 1e-4
+    rgb = (image[0].transpose(1, 2, 0) * 255).astype(np.uint8)
+    lanes = detector(rgb, list(range(20, 72, 4)))
+    assert all(len(lane) == 13 for lane in lanes)
+
+
+def test_same_seed_same_weights_and_resume_continues(tiny_dataset, tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert _train(tiny_dataset, a, "seg", "--seed", "3") == 0
+    assert _train(tiny_dataset, b, "seg", "--seed", "3") == 0
+    state_a = torch.load(a / "checkpoint.pt", weights_only=False)["model"]
+    state_b = torch.load(b / "checkpoint.pt", weights_only=False)["model"]
+    assert all(torch.equal(state_a[k], state_b[k]) for k in state_a)
+    spec = TINY_SPEC
+    assert main(["train", "--data", str(tiny_dataset), "--out", str(a), "--model", "seg", "--width",
+                 str(spec["width"]), "--size", "128x72", "--epochs", "2", "--batch", "2", "--max-steps", "2",
+                 "--val", "0.5", "--seed", "3", "--resume", "--quiet"]) == 0
+    history = json.loads((a / "training.json").read_text())["history"]
+    assert [h["epoch"] for h in history] == [1, 2]
+
+
+def test_train_and_detect_errors_exit_2(tmp_path, capsys):
+    assert main(["train", "--data", str(tmp_path / "missing"), "--out", str(tmp_path / "m")]) == 2
+    assert "--data" in capsys.readouterr().err
+    assert main(["train", "--data", str(tmp_path), "--out", str(tmp_path / "m"), "--quiet"]) == 2
+    assert "label" in capsys.readouterr().err
+    (tmp_path / "split").mkdir()
+    assert main(["detect", str(tmp_path / "split"), "--method", "ufld", "--weights", str(tmp_path / "nope"),
+                 "--out", str(tmp_path / "p.json")]) == 2
+    assert "not a model folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("family", ["ufld", "seg"])
+def test_shipped_model_detects_the_lanes_of_clean_renders(tmp_path, family):
+    if not (shipped_model_dir(family) / "model.onnx").is_file():
+        pytest.skip(f"no shipped {family} model")
+    cases = tmp_path / "cases" / "fence_shadow"
+    cases.mkdir(parents=True)
+    (cases / "00_original.json").write_text((SCENES / "30_shadow" / "fence_shadow" / "00_original.json").read_text())
+    out = tmp_path / "data"
+    assert main(["dataset", "--cases", str(tmp_path / "cases"), "--out", str(out), "--frames-per-case", "2",
+                 "--workers", "1", "--quiet"]) == 0
+    records = detect_split(out / "test", family)
+    gt = [json.loads(line) for line in (out / "test" / "test_label.json").read_text().splitlines()]
+    scores = [score_image(p["lanes"], g["lanes"], g["h_samples"], 0.0).accuracy for p, g in zip(records, gt)]
+    assert np.mean(scores) >= 0.85  # the shipped models score 95-96 % over all stock originals
