@@ -238,8 +238,13 @@ class CaseStore:
         self._notify("created", case_id, record)
         return record
 
-    def update(self, case_id: str, case: Case, expected_version: int | None = None) -> CaseRecord:
-        """Replace a case; with ``expected_version`` set, only if it is still the stored version."""
+    def update(self, case_id: str, case: Case, expected_version: int | None = None,
+               on_stored: Callable[[CaseRecord], None] | None = None) -> CaseRecord:
+        """Replace a case; with ``expected_version`` set, only if it is still the stored version.
+
+        ``on_stored(record)`` runs once the file is written and before any listener hears of it, so a writer that
+        listens too (an editor session) can take its new version first and not mistake its own write for
+        someone else's."""
         with self._lock:
             current = self.get(case_id)
             if expected_version is not None and expected_version != current.version:
@@ -248,6 +253,8 @@ class CaseStore:
                                 updated_at=max(time.time(), current.updated_at), origin=current.origin)
             self._write(record)
             self._records[case_id] = record
+            if on_stored is not None:
+                on_stored(record)
         self._notify("updated", case_id, record)
         return record
 

@@ -90,9 +90,10 @@ class CaseSession:
     def save(self, store: CaseStore) -> CaseRecord:
         """Write the case if the stored version is still the one it is based on; raises ``VersionConflict``."""
         with self._lock:
-            record = store.update(self.case_id, self._case, expected_version=self.version)
-            self._taken(record, keep_case=True)
-            return record
+            # take the new version inside the store's update, before its listeners (this session's editor among
+            # them) hear of it: our own write is then never mistaken for a newer version stored elsewhere
+            return store.update(self.case_id, self._case, expected_version=self.version,
+                                on_stored=lambda record: self._taken(record, keep_case=True))
 
     def reload(self, record: CaseRecord) -> None:
         """Take the stored ``record``, undoably (Undo brings the local edits back)."""

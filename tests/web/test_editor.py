@@ -16,6 +16,7 @@ import pytest
 
 from app.editor import EditError, Editor, launch_editor
 from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
+from app.editor.session import CaseSession
 from app.frames import FrameService
 from app.state import AppState
 from lanevil_core.benchmark_layout import illusion_folder
@@ -121,6 +122,42 @@ def test_conflicting_save_is_reported_and_the_edits_kept(editor: Editor, state: 
     assert state.store.get(SHADOW).case.title == "changed over REST"
     new_id = editor.save_as_new()
     assert state.store.get(new_id).case.illusions[0].severity == 5
+
+
+def test_a_save_is_never_reported_as_a_version_stored_elsewhere(editor: Editor, state: AppState,
+                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    open_shadow(editor)
+    errors: list[str] = []
+    report = editor._report
+
+    def recording_report(message: str, error: bool = False) -> None:
+        if error:
+            errors.append(message)
+        report(message, error)
+
+    monkeypatch.setattr(editor, "_report", recording_report)
+    editor.panel.severity.value = 5
+    editor.panel.save.value = True  # a click on Save
+    assert state.store.get(SHADOW).version == 2 and editor.session.version == 2
+    assert errors == [] and editor.session.remote_version is None
+    assert "saved version 2" in editor.panel.status.content
+    # a write made elsewhere while this session has unsaved edits is still reported
+    editor.panel.severity.value = 4
+    theirs = state.store.get(SHADOW).case.model_copy(update={"title": "changed over REST"})
+    state.store.update(SHADOW, theirs, expected_version=2)
+    assert editor.session.remote_version == 3
+    assert len(errors) == 1 and "Version 3 was stored elsewhere" in errors[0]
+
+
+def test_a_session_takes_its_new_version_before_store_listeners_hear_of_it(state: AppState) -> None:
+    session = CaseSession(state.store.get(SHADOW))
+    heard: list[tuple[int, bool, int | None]] = []
+    state.store.subscribe(lambda kind, case_id, record: heard.append(
+        (session.version, session.stored_change(record), session.remote_version)))
+    edited = session.case.model_copy(update={"title": "edited"})
+    session.apply(edited, "title")
+    assert session.save(state.store).version == 2
+    assert heard == [(2, False, None)] and not session.dirty
 
 
 def test_a_rest_change_shows_up_in_the_open_editor(editor: Editor, state: AppState) -> None:

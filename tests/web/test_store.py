@@ -85,6 +85,14 @@ def test_listeners_hear_every_change_until_unsubscribed(store: CaseStore) -> Non
     assert heard == [("created", "fence", 1), ("updated", "fence", 2), ("deleted", "fence", None)]
 
 
+def test_the_writer_hears_of_its_update_before_the_listeners(store: CaseStore) -> None:
+    order: list[str] = []
+    store.subscribe(lambda kind, case_id, record: order.append(f"listener {kind}"))
+    store.create(shadow_case(), case_id="fence")
+    record = store.update("fence", shadow_case(3), on_stored=lambda stored: order.append(f"writer {stored.version}"))
+    assert record.version == 2 and order == ["listener created", "writer 2", "listener updated"]
+
+
 def test_reload_from_disk_keeps_versions_and_cases(store: CaseStore) -> None:
     store.create(shadow_case(), case_id="fence")
     store.update("fence", shadow_case(5))
