@@ -1,9 +1,10 @@
 """Rendering for the web front ends: one service, content-addressed LRU caches, no duplicate work.
 
 Every image the API, the demo site, the editor and the study serve comes from ``FrameService``. A request is keyed
-by the SHA-256 of the canonical case JSON plus frame, size and overlay, so equal requests never render twice, and
-an edited case never gets a stale picture. Compiled scenes are cached too (scrubbing frames of one case compiles
-once). Concurrent requests for the same key wait for the one render in flight.
+by the SHA-256 of the canonical case JSON plus frame, size, overlay and detector, so equal requests never render
+twice, and an edited case never gets a stale picture. Compiled scenes are cached too (scrubbing frames of one case
+compiles once), and so are a detector's lanes on a frame (next to the frame, keyed by its key plus the detector's
+version). Concurrent requests for the same key wait for the one render in flight.
 """
 
 from __future__ import annotations
@@ -21,10 +22,12 @@ from pydantic.fields import FieldInfo
 from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
 from lanevil_core.compile import compile_scene, roadside_key
+from lanevil_core.detector_catalog import available_detector
 from lanevil_core.export import jpeg_bytes, png_bytes
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
-from lanevil_core.overlay import draw_lanes
+from lanevil_core.frame_detection import FrameDetection, detect_frame
+from lanevil_core.overlay import draw_detections, draw_lanes
 from lanevil_core.render import render_frame
 from lanevil_core.scene import CompiledScene
 
@@ -33,6 +36,7 @@ MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
 JPEG_QUALITY = 90
 SCENE_CACHE_ENTRIES = 8
 CULANE_CACHE_ENTRIES = 2048  # label texts are small (< 1 kB)
+DETECTION_CACHE_ENTRIES = 4096  # a frame's lanes: a few kB
 
 K = TypeVar("K", bound=Hashable)
 V = TypeVar("V")
@@ -156,11 +160,13 @@ class FrameService:
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
         self.images: LRUCache[str, EncodedImage] = LRUCache(cache_bytes // 2, lambda item: len(item.data))
         self.culane: LRUCache[str, str] = LRUCache(CULANE_CACHE_ENTRIES)
+        self.detections: LRUCache[str, FrameDetection] = LRUCache(DETECTION_CACHE_ENTRIES)
         self._inflight: dict[str, threading.Lock] = {}
         self._inflight_lock = threading.Lock()
         self.renders = 0  # frames actually rendered (not served from a cache)
         self.full_compiles = 0  # scenes compiled from scratch
         self.partial_compiles = 0  # scenes that reused a recent scene's road and roadside
+        self.detector_runs = 0  # detections actually run (not served from the cache)
 
     def _single_flight(self, key: str) -> threading.Lock:
         with self._inflight_lock:
@@ -188,23 +194,29 @@ class FrameService:
         return scene
 
     @staticmethod
-    def frame_key(case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False) -> str:
-        """Cache key of a rendered frame: case content hash, frame, size (default: the camera's), overlay."""
+    def frame_key(case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
+                  detector: str | None = None) -> str:
+        """Cache key of a rendered frame: case content hash, frame, size (default: the camera's), overlay, and the
+        version of the detector whose lanes are drawn (``detector_catalog.detector_version``), if any."""
         width, height = size or camera_size(case)
-        return f"{case_hash(case)}:{index}:{width}x{height}:{int(overlay)}"
+        key = f"{case_hash(case)}:{index}:{width}x{height}:{int(overlay)}"
+        return f"{key}:{available_detector(detector).version}" if detector else key
 
     def image_etag(self, case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
-                   fmt: ImageFormat = "png") -> str:
+                   fmt: ImageFormat = "png", detector: str | None = None) -> str:
         """The ETag ``image(...)`` will carry, known without rendering (so a 304 costs no render)."""
-        key = f"{self.frame_key(case, index, size, overlay)}:{fmt}"
+        key = f"{self.frame_key(case, index, size, overlay, detector)}:{fmt}"
         return hashlib.sha256(key.encode("ascii")).hexdigest()[:32]
 
     def frame(self, case: Case, index: int, size: tuple[int, int] | None = None,
-              overlay: bool = False) -> RenderedFrame:
-        """Frame ``index`` of ``case`` at ``size`` (default: the case camera's), lane overlay drawn if asked."""
+              overlay: bool = False, detector: str | None = None) -> RenderedFrame:
+        """Frame ``index`` of ``case`` at ``size`` (default: the case camera's), lane overlay drawn if asked, and
+        the lanes of ``detector`` (a ``detect.split.METHODS`` name) drawn in the detection colour if given.
+
+        Raises ``LaneFileError`` (message starting ``detector:``) for an unknown or unavailable detector."""
         if not 0 <= index < case.ego.frames:
             raise IndexError(f"frame {index} is outside 0..{case.ego.frames - 1}")
-        key = self.frame_key(case, index, size, overlay)
+        key = self.frame_key(case, index, size, overlay, detector)
         cached = self.frames.get(key)
         if cached is not None:
             return cached
@@ -212,12 +224,37 @@ class FrameService:
         with lock:
             cached = self.frames.get(key)
             if cached is None:
-                cached = self._render(case, index, size or camera_size(case), overlay, key)
+                cached = self._render(case, index, size or camera_size(case), overlay, detector, key)
                 self.frames.put(key, cached)
         self._release(key)
         return cached
 
-    def _render(self, case: Case, index: int, size: tuple[int, int], overlay: bool, key: str) -> RenderedFrame:
+    def detection(self, case: Case, index: int, size: tuple[int, int] | None = None,
+                  detector: str = "ufld") -> FrameDetection:
+        """``detector``'s lanes on the plain frame (no overlay) and their TuSimple score against its labels
+        (cached next to the frame). Raises ``LaneFileError`` for an unknown or unavailable detector."""
+        key = f"{self.frame_key(case, index, size, False, detector)}:lanes"
+        cached = self.detections.get(key)
+        if cached is not None:
+            return cached
+        plain = self.frame(case, index, size)
+        lock = self._single_flight(key)
+        with lock:
+            cached = self.detections.get(key)
+            if cached is None:
+                cached = detect_frame(detector, np.asarray(plain.rgb), plain.record)
+                self.detector_runs += 1
+                self.detections.put(key, cached)
+        self._release(key)
+        return cached
+
+    def _render(self, case: Case, index: int, size: tuple[int, int], overlay: bool, detector: str | None,
+                key: str) -> RenderedFrame:
+        if detector:  # detected lanes as bands on the plain frame, the labels' dots (if asked) on top of them
+            plain = self.frame(case, index, size)
+            found = self.detection(case, index, size, detector)
+            rgb = draw_detections(plain.rgb, found.lanes, found.h_samples)
+            return RenderedFrame(draw_lanes(rgb, plain.record) if overlay else rgb, plain.record, key)
         if overlay:  # the overlay is drawn on the plain frame, which is then cached too
             plain = self.frame(case, index, size, overlay=False)
             return RenderedFrame(draw_lanes(plain.rgb, plain.record), plain.record, key)
@@ -230,14 +267,14 @@ class FrameService:
         return RenderedFrame(rgb, record, key)
 
     def image(self, case: Case, index: int, size: tuple[int, int] | None = None, overlay: bool = False,
-              fmt: ImageFormat = "png") -> EncodedImage:
+              fmt: ImageFormat = "png", detector: str | None = None) -> EncodedImage:
         """Encoded bytes of ``frame(...)``, cached by the same key plus the format."""
-        key = f"{self.frame_key(case, index, size, overlay)}:{fmt}"
+        key = f"{self.frame_key(case, index, size, overlay, detector)}:{fmt}"
         cached = self.images.get(key)
         if cached is None:
-            rendered = self.frame(case, index, size, overlay)
-            cached = EncodedImage(encode(rendered.rgb, fmt), MEDIA_TYPES[fmt], self.image_etag(case, index, size,
-                                                                                                 overlay, fmt))
+            rendered = self.frame(case, index, size, overlay, detector)
+            etag = self.image_etag(case, index, size, overlay, fmt, detector)
+            cached = EncodedImage(encode(rendered.rgb, fmt), MEDIA_TYPES[fmt], etag)
             self.images.put(key, cached)
         return cached
 

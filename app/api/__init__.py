@@ -1,13 +1,13 @@
-"""The REST API under ``/api``: cases, frames, labels, exports, the illusion registry (see ``docs/api.md``)."""
+"""The REST API under ``/api``: cases, frames, detectors, labels, exports, the illusion registry (``docs/api.md``)."""
 
 from fastapi import APIRouter
 
-from . import cases, exports, illusions, images, labels
+from . import cases, detectors, exports, illusions, images, labels
 from .errors import ApiError, ErrorBody
 from .limits import BodyLimitMiddleware
 
 router = APIRouter()
-for _module in (cases, images, labels, exports, illusions):
+for _module in (cases, images, detectors, labels, exports, illusions):
     router.include_router(_module.router)
 
 __all__ = ["ApiError", "BodyLimitMiddleware", "ErrorBody", "router"]

@@ -2,7 +2,7 @@
 
 Images come from the shared ``FrameService`` (content-addressed caches), so the ETag is known before anything is
 rendered and a revalidation (``If-None-Match``) costs no render. Query overrides (severity, sun) render a variant
-of the case without saving it, for scrubbing sliders.
+of the case without saving it, for scrubbing sliders; ``detector=`` draws a detector's lanes on the frame.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from lanevil_core.case import Case
 from ..state import AppState
 from .cases import split_body, validate_case
 from .deps import RecordDep, StateDep
+from .detectors import checked_detector, detector_errors
 from .errors import ERROR_RESPONSES, ApiRoute, ErrorBody
 from .params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
 
@@ -35,12 +36,14 @@ def image_response(state: AppState, case: Case, frame: int, query: RenderQuery, 
                    if_none_match: str | None, cache_control: str) -> Response:
     """The encoded frame (or a 304), with ETag and Cache-Control."""
     size = image_size(query.width, query.height, case, state.settings)
+    detector = checked_detector(query.detector)
     case = query.apply(case)
-    etag = state.frames.image_etag(case, frame, size, query.overlay, fmt)
-    headers = {"ETag": f'"{etag}"', "Cache-Control": cache_control}
-    if etag_matches(if_none_match, etag):
-        return Response(status_code=304, headers=headers)
-    image = state.frames.image(case, frame, size, query.overlay, fmt)
+    with detector_errors():
+        etag = state.frames.image_etag(case, frame, size, query.overlay, fmt, detector)
+        headers = {"ETag": f'"{etag}"', "Cache-Control": cache_control}
+        if etag_matches(if_none_match, etag):
+            return Response(status_code=304, headers=headers)
+        image = state.frames.image(case, frame, size, query.overlay, fmt, detector)
     return Response(image.data, media_type=image.media_type, headers=headers)
 
 
@@ -49,7 +52,8 @@ def image_response(state: AppState, case: Case, frame: int, query: RenderQuery, 
 def get_frame(record: RecordDep, frame: int, fmt: ImageFormat, state: StateDep, query: RenderQueryDep,
               if_none_match: IfNoneMatch = None) -> Response:
     """Frame ``frame`` as PNG or JPEG at the case camera's size or ``width``x``height``, optionally with the lane
-    overlay and severity/sun overrides (not saved)."""
+    overlay (ground truth, one colour per lane), a detector's lanes (``detector=``, magenta) and severity/sun
+    overrides (not saved)."""
     check_frame(record.case, frame, status_code=404)
     return image_response(state, record.case, frame, query, fmt, if_none_match, FRAME_CACHE_CONTROL)
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated, Literal
 
 from fastapi import Depends, Query
@@ -86,7 +86,7 @@ def etag_matches(if_none_match: str | None, etag: str) -> bool:
 
 @dataclass(frozen=True)
 class RenderQuery:
-    """The query parameters of an image request."""
+    """The query parameters of an image request (a detections request: the same without overlay and detector)."""
 
     overlay: bool
     width: int | None
@@ -95,6 +95,7 @@ class RenderQuery:
     sun_azimuth: float | None
     sun_altitude: float | None
     sun_intensity: float | None
+    detector: str | None = None
 
     def apply(self, case: Case) -> Case:
         """``case`` with the overrides applied; an out-of-range override is a 422 naming its query parameter."""
@@ -109,8 +110,7 @@ class RenderQuery:
             raise ApiError(422, message, name) from None
 
 
-def render_query(
-    overlay: Annotated[bool, Query(description="draw the TuSimple lane labels on the image")] = False,
+def scrub_query(
     width: Annotated[int | None, Query(description="image width (with height; default: the case camera's)")] = None,
     height: Annotated[int | None, Query(description="image height (with width)")] = None,
     severity: Annotated[int | None, Query(ge=1, le=5, description="render every illusion at this level")] = None,
@@ -118,7 +118,20 @@ def render_query(
     sun_altitude: Annotated[float | None, Query(description="sun altitude override (degrees)")] = None,
     sun_intensity: Annotated[float | None, Query(description="sun intensity override")] = None,
 ) -> RenderQuery:
-    return RenderQuery(overlay, width, height, severity, sun_azimuth, sun_altitude, sun_intensity)
+    """Size and overrides: what picks the rendered frame."""
+    return RenderQuery(False, width, height, severity, sun_azimuth, sun_altitude, sun_intensity)
+
+
+ScrubQueryDep = Annotated[RenderQuery, Depends(scrub_query)]
+
+
+def render_query(
+    scrub: ScrubQueryDep,
+    overlay: Annotated[bool, Query(description="draw the TuSimple lane labels on the image")] = False,
+    detector: Annotated[str | None, Query(max_length=40, description="draw this detector's lanes (magenta): a "
+                                          "name of `GET /api/detectors`; empty = none")] = None,
+) -> RenderQuery:
+    return replace(scrub, overlay=overlay, detector=detector or None)
 
 
 RenderQueryDep = Annotated[RenderQuery, Depends(render_query)]
