@@ -21,6 +21,7 @@ import viser
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, CaseError, parse_case
 from lanevil_core.compile import roadside_key
+from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.illusions import REGISTRY, Illusion
 from lanevil_core.presets import preset_values
 from lanevil_core.road_layout import RoadNetwork
@@ -29,6 +30,7 @@ from lanevil_core.scene import CompiledScene
 from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
+from .detection import chosen_detector, detection_text, unavailable_text
 from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
@@ -113,6 +115,7 @@ class Editor:
         p = self.panel
         value = {"frame": lambda e: self.set_frame(int(e.target.value)),
                  "overlay": lambda e: self.set_overlay(bool(e.target.value)),
+                 "detector": lambda e: self.set_detector(str(e.target.value)),
                  "play": lambda e: self.set_playing(bool(e.target.value)),
                  "case_id": lambda e: self.open_case(str(e.target.value)),
                  "title": lambda e: self.set_title(str(e.target.value)),
@@ -328,6 +331,12 @@ class Editor:
             self.panel.overlay.value = on
         self._request_preview()
 
+    def set_detector(self, name: str) -> None:
+        """Show ``name``'s lanes and score on the preview (``none``: no detector)."""
+        with self._syncing_panel():
+            self.panel.detector.value = name
+        self._request_preview()
+
     def set_playing(self, on: bool) -> None:
         (self._playing.set if on else self._playing.clear)()
 
@@ -452,12 +461,27 @@ class Editor:
             p.status.content = self._status()
 
     def _request_preview(self) -> int:
-        return self.preview.request(self.case, self.frame, bool(self.panel.overlay.value))
+        detector = chosen_detector(str(self.panel.detector.value))
+        return self.preview.request(self.case, self.frame, bool(self.panel.overlay.value), detector=detector)
 
     def _render(self, request: PreviewRequest) -> tuple[np.ndarray, CompiledScene]:
         scene = self.state.frames.scene(request.case)
-        rendered = self.state.frames.frame(request.case, request.frame, request.size, request.overlay)
+        frames = self.state.frames
+        try:
+            rendered = frames.frame(request.case, request.frame, request.size, request.overlay, request.detector)
+        except LaneFileError:  # an unavailable detector: the frame without it; _publish says why
+            rendered = frames.frame(request.case, request.frame, request.size, request.overlay)
         return rendered.rgb, scene
+
+    def _detection_text(self, request: PreviewRequest) -> str:
+        """The score line of the preview's detector (from the frame service's cache: ``_render`` ran it)."""
+        if request.detector is None:
+            return ""
+        try:
+            found = self.state.frames.detection(request.case, request.frame, request.size, request.detector)
+        except LaneFileError as error:
+            return unavailable_text(request.detector, str(error))
+        return detection_text(found)
 
     def _publish(self, result: PreviewResult) -> None:
         """Push the preview image first (latency), then bring the 3D view up to the same state."""
@@ -468,6 +492,7 @@ class Editor:
         timing = f"rendered in {result.render_ms:.0f} ms" if result.render_ms >= 1.0 else "from the frame cache"
         self.panel.preview_info.content = (f"Frame {result.request.frame} · {result.rgb.shape[1]}×{result.rgb.shape[0]}"
                                            f" · {timing}")
+        self.panel.detection.content = self._detection_text(result.request)
         selected = self.selected if self.selected is not None and self.selected < len(case.illusions) else None
         road_key = roadside_key(case)
         # An illusion's meshes may depend on those placed before it (traffic keeps clear of earlier footprints).

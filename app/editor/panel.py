@@ -15,6 +15,7 @@ from lanevil_core.illusions import ILLUSION_TYPES
 from lanevil_core.presets import PRESET_NAMES
 from lanevil_core.typed import ROAD_TYPES, SCENE_KINDS
 
+from .detection import DETECTOR_CHOICES, NO_DETECTOR
 from .params import ParamInputs
 from .preview import PREVIEW_SIZE
 
@@ -58,8 +59,10 @@ class Panel:
     frame: viser.GuiSliderHandle
     play: viser.GuiCheckboxHandle
     overlay: viser.GuiCheckboxHandle
+    detector: viser.GuiDropdownHandle
     preview: viser.GuiImageHandle
     preview_info: viser.GuiMarkdownHandle
+    detection: viser.GuiMarkdownHandle
     export_case: viser.GuiButtonHandle
     export_frame: viser.GuiButtonHandle
     export_sequence: viser.GuiButtonHandle
@@ -75,10 +78,14 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
     preview = gui.add_image(np.full((PREVIEW_SIZE[1], PREVIEW_SIZE[0], 3), 200, np.uint8), label="Camera preview",
                             format="jpeg", jpeg_quality=90)
     preview_info = gui.add_markdown("")
+    detection = gui.add_markdown("")
     with gui.add_folder("Frame"):
         frame = gui.add_slider("Frame", 0, 99, 1, 0, hint="frame of the ego drive shown in the preview")
         play = gui.add_checkbox("Play", False, hint="step through the frames (loops)")
         overlay = gui.add_checkbox("Lane overlay", True, hint="draw the ground-truth lanes on the preview")
+        detector = gui.add_dropdown("Detector", list(DETECTOR_CHOICES), initial_value=NO_DETECTOR,
+                                    hint="run a lane detector on the preview: its lanes in magenta, its TuSimple "
+                                         "accuracy / FP / FN under the picture")
     with gui.add_folder("Case"):
         case_id = gui.add_dropdown("Open", case_ids or ["(no cases)"], hint="stored cases; choosing one opens it")
         title = gui.add_text("Title", "", hint="the case's title (saved with it)")
@@ -116,5 +123,6 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
                  selected=selected, severity=severity, delete=delete,
                  params=ParamInputs(gui, params_folder, lambda name, value: None),
                  sun_azimuth=sun_azimuth, sun_altitude=sun_altitude, sun_intensity=sun_intensity, weather=weather,
-                 frame=frame, play=play, overlay=overlay, preview=preview, preview_info=preview_info,
+                 frame=frame, play=play, overlay=overlay, detector=detector, preview=preview,
+                 preview_info=preview_info, detection=detection,
                  export_case=export_case, export_frame=export_frame, export_sequence=export_sequence)

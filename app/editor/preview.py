@@ -23,7 +23,7 @@ PREVIEW_SIZE = (640, 360)
 
 @dataclass(frozen=True)
 class PreviewRequest:
-    """What to show: a case at a frame, with or without the lane overlay."""
+    """What to show: a case at a frame, with or without the lane overlay and a detector's lanes."""
 
     case: Case
     frame: int
@@ -31,6 +31,7 @@ class PreviewRequest:
     size: tuple[int, int] = PREVIEW_SIZE
     seq: int = 0
     requested_at: float = field(default_factory=time.perf_counter)
+    detector: str | None = None
 
 
 @dataclass(frozen=True)
@@ -66,13 +67,14 @@ class PreviewWorker:
         self._thread = threading.Thread(target=self._run, name="lanevil-editor-preview", daemon=True)
         self._thread.start()
 
-    def request(self, case: Case, frame: int, overlay: bool, size: tuple[int, int] = PREVIEW_SIZE) -> int:
+    def request(self, case: Case, frame: int, overlay: bool, size: tuple[int, int] = PREVIEW_SIZE,
+                detector: str | None = None) -> int:
         """Ask for a preview of this state; returns its sequence number."""
         with self._cond:
             self._seq += 1
             if self._pending is not None:
                 self.dropped += 1
-            self._pending = PreviewRequest(case, frame, overlay, size, self._seq)
+            self._pending = PreviewRequest(case, frame, overlay, size, self._seq, detector=detector)
             self._cond.notify_all()
             return self._seq
 

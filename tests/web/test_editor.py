@@ -21,7 +21,9 @@ from app.frames import FrameService
 from app.state import AppState
 from lanevil_core.benchmark_layout import illusion_folder
 from lanevil_core.case import parse_case
+from lanevil_core import detector_catalog
 from lanevil_core.compile import compile_scene
+from lanevil_core.detect.split import METHODS
 from lanevil_core.illusions.shadow import roadside_t
 
 SHADOW = "fence_shadow-03_level3"
@@ -205,6 +207,35 @@ def test_frame_slider_and_overlay_toggle(editor: Editor) -> None:
     plain = settle(editor)
     assert not editor.last_result.request.overlay
     assert not np.array_equal(plain, moved)
+
+
+def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(editor: Editor, state: AppState, monkeypatch,
+                                                                 tmp_path) -> None:
+    assert list(editor.panel.detector.options) == ["none", *METHODS] and editor.panel.detector.value == "none"
+    plain = settle(editor)
+    assert editor.panel.detection.content == "" and editor.last_result.request.detector is None
+    shown: dict[str, np.ndarray] = {}
+    for name in ("hough", "ufld"):
+        editor.panel.detector.value = name
+        shown[name] = settle(editor)
+        request = editor.last_result.request
+        assert request.detector == name and request.overlay
+        found = state.frames.detection(request.case, request.frame, request.size, name)
+        text = editor.panel.detection.content
+        assert f"**{name}**" in text and f"accuracy **{found.accuracy:.2f}**" in text
+        assert f"FP {found.fp:.2f}" in text and f"FN {found.fn:.2f}" in text
+        assert 0.002 < np.any(shown[name] != plain, axis=2).mean() < 0.5  # magenta bands under the labels
+    assert not np.array_equal(shown["hough"], shown["ufld"])
+
+    monkeypatch.setattr(detector_catalog, "SHIPPED_MODELS", tmp_path)  # as without the ufld model
+    editor.panel.frame.value = 1
+    missing = settle(editor)
+    assert "not available" in editor.panel.detection.content and "⚠" not in editor.panel.status.content
+    overlaid = state.frames.frame(editor.case, 1, missing.shape[1::-1], overlay=True).rgb
+    np.testing.assert_array_equal(missing, overlaid)  # the preview without the detector, not an error
+    editor.panel.detector.value = "none"
+    settle(editor)
+    assert editor.panel.detection.content == "" and editor.last_result.request.detector is None
 
 
 def test_gizmo_move_and_parameter_inputs(editor: Editor) -> None:
