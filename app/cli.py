@@ -33,7 +33,7 @@ def _serve_arguments(parser: argparse.ArgumentParser) -> None:
 def _run_serve(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
-    from .server import serve
+    from .server import ListenError, serve
     from .settings import Settings
 
     given = {"host": args.host, "port": args.port, "editor_port": args.editor_port, "data_dir": args.data,
@@ -50,8 +50,8 @@ def _run_serve(args: argparse.Namespace) -> int:
         raise UsageError(f"--data {settings.data_dir}: not a folder")
     try:
         return serve(settings)
-    except OSError as error:
-        raise UsageError(f"cannot listen on {settings.host}: {error.strerror or error}") from None
+    except ListenError as error:
+        raise UsageError(str(error)) from None
 
 
 COMMANDS: dict[str, Command] = {

@@ -3,10 +3,16 @@
 ``JobManager.submit`` runs ``work(progress)`` on a small worker pool; ``progress(done, total)`` updates the job
 that ``GET /api/exports/{job_id}`` and the editor's notifications read. Finished zips live under
 ``<data>/exports/<job_id>.zip``.
+
+Jobs a client asks for are bounded: a submission with the ``key`` of a queued, running or finished job gets that
+job back instead of a new one, and one that would pass ``max_unfinished`` jobs in all or ``max_per_client`` for its
+client raises ``JobLimit`` (HTTP 429 with ``Retry-After``). Jobs the server starts itself (a study's renders) pass
+no client and are never refused, though they count towards the total.
 """
 
 from __future__ import annotations
 
+import math
 import re
 import shutil
 import tempfile
@@ -28,11 +34,23 @@ Progress = Callable[[int, int], None]
 JOB_ID_PATTERN = re.compile(r"^[0-9a-f]{32}$")
 EXPORTS_FOLDER = "exports"
 KEEP_FINISHED = 32  # finished jobs (and their zips) kept for polling and download; older ones are dropped
+MAX_UNFINISHED = 16  # queued or running jobs in all before clients are told to come back later
+MAX_PER_CLIENT = 4  # queued or running jobs of one client
+SECONDS_PER_STEP = 0.3  # a frame at 1280x720 before any job has finished (then measured)
+RETRY_AFTER_S = (1, 3600)
 SCRATCH_PREFIX = "lanevil-export-"
 
 
 class JobNotFound(LookupError):
     """No job with that id (404)."""
+
+
+class JobLimit(Exception):
+    """Too many unfinished jobs, in all or of one client (429); ``retry_after_s`` estimates when one is free."""
+
+    def __init__(self, message: str, retry_after_s: int) -> None:
+        super().__init__(message)
+        self.retry_after_s = retry_after_s
 
 
 class JobCancelled(Exception):
@@ -53,6 +71,9 @@ class Job:
     created_at: float = field(default_factory=time.time)
     finished_at: float | None = None
     meta: dict[str, Any] = field(default_factory=dict)  # what the job works on (e.g. case id and frames)
+    key: str | None = field(default=None, repr=False)  # equal keys: equal work, so the job is shared
+    client: str | None = field(default=None, repr=False)  # who asked for it (limits per client)
+    started_at: float | None = None
     finished: threading.Event = field(default_factory=threading.Event, repr=False)
     cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
 
@@ -65,10 +86,15 @@ class Job:
 class JobManager:
     """Runs jobs on ``workers`` threads and keeps their state (and result files under ``root/exports``)."""
 
-    def __init__(self, root: Path, workers: int = 1, keep_finished: int = KEEP_FINISHED) -> None:
+    def __init__(self, root: Path, workers: int = 1, keep_finished: int = KEEP_FINISHED,
+                 max_unfinished: int = MAX_UNFINISHED, max_per_client: int = MAX_PER_CLIENT) -> None:
         self.folder = Path(root) / EXPORTS_FOLDER
         self.folder.mkdir(parents=True, exist_ok=True)
         self.keep_finished = keep_finished
+        self.workers = workers
+        self.max_unfinished = max_unfinished
+        self.max_per_client = max_per_client
+        self._seconds_per_step = SECONDS_PER_STEP
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="lanevil-job")
         self._jobs: dict[str, Job] = {}
         self._lock = threading.Lock()
@@ -96,13 +122,48 @@ class JobManager:
                 job.result.unlink(missing_ok=True)
 
     def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path],
-               meta: dict[str, Any] | None = None) -> Job:
-        """Queue ``work(job, progress) -> result path``; return the job at once. ``meta`` is reported with it."""
-        job = Job(id=uuid.uuid4().hex, kind=kind, total=total, meta=dict(meta or {}))
+               meta: dict[str, Any] | None = None, key: str | None = None, client: str | None = None) -> Job:
+        """Queue ``work(job, progress) -> result path``; return the job at once. ``meta`` is reported with it.
+
+        With ``key``: a queued, running or finished (not failed or cancelled) job of the same key is returned
+        instead. With ``client``: ``JobLimit`` if the queue or this client's share of it is full."""
         with self._lock:
+            same = self._find(key)
+            if same is not None:
+                return same
+            if client is not None:
+                self._check_limits(client)
+            job = Job(id=uuid.uuid4().hex, kind=kind, total=total, meta=dict(meta or {}), key=key, client=client)
             self._jobs[job.id] = job
         self._pool.submit(self._run, job, work)
         return job
+
+    def _find(self, key: str | None) -> Job | None:
+        if key is None:
+            return None
+        return next((job for job in self._jobs.values()
+                     if job.key == key and job.status in ("queued", "running", "done")
+                     and not job.cancel_requested.is_set()), None)
+
+    def _check_limits(self, client: str) -> None:
+        unfinished = sorted((job for job in self._jobs.values() if not job.finished.is_set()),
+                            key=lambda job: job.created_at)
+        if len(unfinished) >= self.max_unfinished:
+            wait = self._retry_after(unfinished[:len(unfinished) - self.max_unfinished + 1])
+            raise JobLimit(f"the server has {len(unfinished)} jobs queued or running, the most it takes; "
+                           f"try again in {wait} s", wait)
+        own = [job for job in unfinished if job.client == client]
+        if len(own) >= self.max_per_client:
+            ahead = unfinished[:unfinished.index(own[0]) + 1]  # this client's oldest job and what runs before it
+            wait = self._retry_after(ahead)
+            raise JobLimit(f"you have {len(own)} jobs queued or running, the most one client may have; wait for "
+                           f"one to finish (about {wait} s) or cancel one", wait)
+
+    def _retry_after(self, ahead: list[Job]) -> int:
+        """Seconds until the jobs ``ahead`` are done, from the measured time per step (frame)."""
+        steps = sum(max(job.total - job.done, 0) for job in ahead)
+        seconds = math.ceil(steps * self._seconds_per_step / max(self.workers, 1))
+        return min(max(seconds, RETRY_AFTER_S[0]), RETRY_AFTER_S[1])
 
     def _run(self, job: Job, work: Callable[[Job, Progress], Path]) -> None:
         if job.cancel_requested.is_set():
@@ -111,6 +172,7 @@ class JobManager:
             job.finished.set()
             return
         job.status = "running"
+        job.started_at = time.time()
 
         def progress(done: int, total: int) -> None:
             job.done, job.total = done, total
@@ -121,6 +183,8 @@ class JobManager:
             job.result = work(job, progress)
             job.done = job.total
             job.status = "done"
+            if job.total:
+                self._seconds_per_step = (time.time() - job.started_at) / job.total
         except JobCancelled:
             job.status = "cancelled"
         except Exception as error:  # noqa: BLE001 - a failed job reports its error instead of killing the worker

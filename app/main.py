@@ -6,22 +6,26 @@ from fastapi import FastAPI, HTTPException, Request
 from fastapi.responses import RedirectResponse
 
 from .api import BodyLimitMiddleware
+from .api import openapi as api_openapi
 from .api import router as api_router
 from .api.errors import handle_exception
+from .docs import mount_docs
 from .jobs import JobNotFound
 from .settings import Settings
 from .site import mount_static
 from .state import AppState
 from .store import StoreError
 from .study import router as study_router
+from .study.api import SCHEMAS as STUDY_SCHEMAS
 
 
 def create_app(settings: Settings | None = None, state: AppState | None = None) -> FastAPI:
     """Build the app around ``state`` (default: opened from ``settings``, default: the environment)."""
     settings = settings or (state.settings if state else Settings())
     state = state or AppState.open(settings)
-    app = FastAPI(title="LanEvil Studio", version="0.1.0",
-                  description="Editable 3D lane-detection robustness cases: store, render, export, study.")
+    app = FastAPI(title="LanEvil Studio", version="0.1.0", docs_url=None, redoc_url=None,
+                  description="Editable 3D lane-detection robustness cases: store, render, export, study. Errors of "
+                              "`/api` answer `{\"detail\": \"<field>: <message>\", \"field\": \"<field>\"}`.")
     app.state.lanevil = state
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes,
                        max_upload_bytes=settings.max_upload_bytes)
@@ -29,6 +33,8 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
         app.add_exception_handler(error, handle_exception)
     app.include_router(api_router, prefix="/api")
     app.include_router(study_router)
+    mount_docs(app)  # /docs and /redoc with their scripts served here, not from a CDN
+    api_openapi.install(app, STUDY_SCHEMAS)
     mount_static(app)
     app.state.editor_port = None  # set by the server once the viser editor listens
     app.add_api_route("/editor", _editor_redirect, methods=["GET"], include_in_schema=False)

@@ -7,6 +7,7 @@ background thread. When uvicorn stops, the editor and the job pool are stopped t
 from __future__ import annotations
 
 import contextlib
+import errno
 import signal
 import socket
 import sys
@@ -47,6 +48,10 @@ class _Server(uvicorn.Server):
                 signal.signal(sig, handler)
 
 
+class ListenError(Exception):
+    """The API's address cannot be bound (a busy port, an address this machine does not have)."""
+
+
 def bind(host: str, port: int) -> socket.socket:
     """A listening TCP socket on ``host:port`` (port 0: any free port)."""
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
@@ -58,15 +63,26 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
+def listen(host: str, port: int) -> socket.socket:
+    """``bind``, or a ``ListenError`` that names the address and port and says what to do."""
+    try:
+        return bind(host, port)
+    except OSError as error:
+        reason = (error.strerror or str(error)).lower()
+        hint = " (another server runs there: stop it, or choose another port with --port; 0 = any free port)" \
+            if error.errno == errno.EADDRINUSE else ""
+        raise ListenError(f"cannot listen on {_http_host(host)}:{port}: {reason}{hint}") from None
+
+
 def _http_host(host: str) -> str:
     return f"[{host}]" if ":" in host else host
 
 
 def serve(settings: Settings) -> int:
     """Run the backend (and the editor, unless ``settings.editor`` is off) until Ctrl+C / SIGTERM."""
+    sock = listen(settings.host, settings.port)  # first: a busy port fails at once, before the store is opened
     state = AppState.open(settings)
     app = create_app(settings, state)
-    sock = bind(settings.host, settings.port)
     api_port = sock.getsockname()[1]
     editor = None
     if settings.editor:
@@ -74,6 +90,7 @@ def serve(settings: Settings) -> int:
 
         editor = launch_editor(state, host=settings.host, port=settings.editor_port)
         app.state.editor_port = editor.port
+        app.state.open_in_editor = editor.open_case
     urls = Urls(api=f"http://{_http_host(settings.host)}:{api_port}/",
                 editor=f"http://{_http_host(settings.host)}:{editor.port}/" if editor else None)
     print(f"LanEvil Studio: {len(state.store)} cases in {settings.data_dir}", file=sys.stderr)

@@ -23,5 +23,7 @@ class Settings(BaseSettings):
     max_upload_bytes: int = Field(20_000_000, ge=1024, description="largest uploaded image")
     max_width: int = Field(1920, description="largest rendered frame width")
     max_height: int = Field(1080, description="largest rendered frame height")
+    max_jobs: int = Field(16, ge=1, description="export jobs queued or running before clients get 429")
+    max_jobs_per_client: int = Field(4, ge=1, description="export jobs one client may have queued or running")
     frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
     editor: bool = Field(True, description="start the viser editor beside the API")

@@ -31,7 +31,8 @@ class AppState:
         if len(store) == 0 and Path(settings.scenes_dir).is_dir():
             store.seed_from(Path(settings.scenes_dir))
         return cls(settings=settings, store=store, frames=FrameService(settings.frame_cache_bytes),
-                   jobs=JobManager(data_dir))
+                   jobs=JobManager(data_dir, max_unfinished=settings.max_jobs,
+                                   max_per_client=settings.max_jobs_per_client))
 
 
 def get_state(request: Request) -> AppState:

@@ -1,9 +1,10 @@
 """One error format for the REST API: ``{"detail": "<field>: <message>", "field": "<field>"}``.
 
-``field`` is the dotted path of what was wrong: a query or header name (``width``, ``If-Match``), a path parameter
-(``case_id``), or a path inside the JSON body (``road.lanes_per_direction``, ``case.ego.frames``). Every 4xx of the
-API (validation, store, job and limit errors) uses this body; ``ApiRoute`` converts the exceptions raised while a
-request is handled, so malformed input never becomes a 500.
+``field`` is the dotted path of what was wrong: a query or header name (``width``, ``If-Match``, ``Content-Type``),
+a path parameter (``case_id``), ``body`` for a body that is not strict JSON (the message says line and column), or
+a path inside the JSON body (``road.lanes_per_direction``, ``case.ego.frames``). Every 4xx of the API (validation,
+store, job and limit errors) uses this body; ``ApiRoute`` reads JSON bodies strictly (``json_body``) and converts the
+exceptions raised while a request is handled, so malformed input never becomes a 500.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Coroutine, Sequence
 from typing import Any
 
-from fastapi import HTTPException, Request, Response
+from fastapi import HTTPException, Request, Response, params
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from fastapi.routing import APIRoute
@@ -19,8 +20,9 @@ from pydantic import BaseModel, ValidationError
 
 from lanevil_core.case import CaseError
 
-from ..jobs import JobNotFound
+from ..jobs import JobLimit, JobNotFound
 from ..store import CaseExists, CaseNotFound, InvalidId, StoreError, VersionConflict
+from .json_body import BodyError, check_json_type, parse_json
 
 # Where FastAPI says a bad value came from; dropped from the field path (the name alone is unambiguous).
 REQUEST_SOURCES = ("query", "path", "header", "cookie", "body")
@@ -90,6 +92,10 @@ def exception_response(error: Exception) -> JSONResponse | None:
         return error_response(status, f"{error.field}: {error}", error.field)
     if isinstance(error, JobNotFound):
         return error_response(404, f"job_id: {error}", "job_id")
+    if isinstance(error, JobLimit):
+        return error_response(429, str(error), None, {"Retry-After": str(error.retry_after_s)})
+    if isinstance(error, BodyError):
+        return error_response(error.status, f"{error.field}: {error}", error.field)
     if isinstance(error, CaseError):
         return error_response(422, str(error), "case")
     return None
@@ -103,14 +109,43 @@ async def handle_exception(request: Request, error: Exception) -> Response:
     return response
 
 
+class StrictJsonRequest(Request):
+    """A request whose ``json()`` is strict JSON (``json_body.parse_json``); FastAPI parses bodies through it."""
+
+    async def json(self) -> Any:
+        if not hasattr(self, "_strict_json"):
+            try:
+                self._strict_json = parse_json(await self.body())
+            except BodyError as error:  # FastAPI passes an HTTPException raised here on unchanged
+                raise ApiError(error.status, str(error), error.field) from None
+        return self._strict_json
+
+
+def takes_json_body(route: APIRoute) -> bool:
+    """Whether a route reads a JSON body (a body parameter that is not a form)."""
+    return route.body_field is not None and not isinstance(route.body_field.field_info, params.Form)
+
+
+async def check_json_request(request: Request) -> None:
+    """415 for a body that is not declared as JSON (a missing ``Content-Type`` is fine while the body is empty)."""
+    content_type = request.headers.get("content-type")
+    if content_type or await request.body():
+        check_json_type(content_type)
+
+
 class ApiRoute(APIRoute):
-    """A route whose client errors (including FastAPI's request validation) answer in the API's error format."""
+    """A route whose client errors (including FastAPI's request validation) answer in the API's error format, and
+    whose JSON body is read strictly (415 for another content type, 422 naming ``body`` for malformed JSON)."""
 
     def get_route_handler(self) -> Callable[[Request], Coroutine[Any, Any, Response]]:
         handler = super().get_route_handler()
+        json_body = takes_json_body(self)
 
         async def route_handler(request: Request) -> Response:
             try:
+                if json_body:
+                    request = StrictJsonRequest(request.scope, request.receive)
+                    await check_json_request(request)
                 return await handler(request)
             except Exception as error:
                 response = exception_response(error)
@@ -121,7 +156,16 @@ class ApiRoute(APIRoute):
         return route_handler
 
 
-# The error responses every API route documents (FastAPI's default 422 schema is replaced by ErrorBody).
+# The error responses API routes document (FastAPI's default 422 schema is replaced by ErrorBody).
 ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     422: {"model": ErrorBody, "description": "invalid input; `field` names it"},
+}
+# What every route that takes a JSON body may answer as well.
+BODY_RESPONSES: dict[int | str, dict[str, Any]] = {
+    413: {"model": ErrorBody, "description": "the body is over the server's limit (`field`: `body`)"},
+    415: {"model": ErrorBody, "description": "the body is not sent as JSON (`field`: `Content-Type`)"},
+}
+TOO_MANY: dict[int | str, dict[str, Any]] = {
+    429: {"model": ErrorBody, "description": "too many jobs queued: try again after `Retry-After` seconds",
+          "headers": {"Retry-After": {"description": "seconds to wait", "schema": {"type": "integer"}}}},
 }

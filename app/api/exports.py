@@ -4,6 +4,9 @@
 becomes a background job (202 + ``Location``), as does ``POST /api/exports``. Jobs are polled at
 ``GET /api/exports/{job_id}``, cancelled with ``DELETE``, and their zip fetched from ``/download`` once ``status``
 is ``done`` (409 before).
+
+An export of the same case content and frames as a queued, running or finished job answers that job; a full queue
+or a client with ``JobManager.max_per_client`` unfinished jobs gets 429 with ``Retry-After``.
 """
 
 from __future__ import annotations
@@ -18,11 +21,12 @@ from pydantic import BaseModel, Field
 
 from lanevil_core.benchmark_layout import case_folder
 
+from ..frames import case_hash
 from ..jobs import Job, export_zip
 from ..state import AppState
 from ..store import CaseRecord
 from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
 from .params import frame_range
 
 router = APIRouter(tags=["exports"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -30,8 +34,12 @@ router = APIRouter(tags=["exports"], route_class=ApiRoute, responses=ERROR_RESPO
 SYNC_EXPORT_FRAMES = 10  # more frames than this (~0.2 s each at 1280x720) go to a background job
 ZIP = "application/zip"
 JOB_ACCEPTED: dict[int | str, dict[str, Any]] = {
-    202: {"description": "export queued as a job: poll the Location (GET /api/exports/{job_id})"},
+    202: {"description": "export queued as a job (or the job of an identical export): poll the Location "
+                        "(GET /api/exports/{job_id})",
+          "headers": {"Location": {"description": "the job's URL", "schema": {"type": "string"}}}},
+    **TOO_MANY,
 }
+NO_CASE: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no case with that id"}}
 
 
 class ExportRequest(BaseModel):
@@ -57,18 +65,20 @@ def job_body(job: Job, request: Request) -> dict[str, Any]:
 
 
 def submit_export(state: AppState, record: CaseRecord, frames: range, request: Request) -> JSONResponse:
-    """Queue an export job of ``frames``; answer 202 with the job and its URL."""
+    """Queue an export job of ``frames`` (or find the job of the same export); answer 202 with the job and its URL."""
     case, folder = record.case, export_folder(record)
     meta = {"case_id": record.id, "case_version": record.version, "frames": f"{frames.start}:{frames.stop}",
             "folder": folder.as_posix()}
+    key = f"export:{folder.as_posix()}:{case_hash(case)}:{frames.start}:{frames.stop}"
+    client = request.client.host if request.client else "unknown"
     job = state.jobs.submit("export", len(frames), lambda job, progress: export_zip(
-        case, folder, frames, state.jobs.result_path(job.id), progress), meta)
+        case, folder, frames, state.jobs.result_path(job.id), progress), meta, key=key, client=client)
     body = job_body(job, request)
     return JSONResponse(body, status_code=202, headers={"Location": body["links"]["self"]})
 
 
 @router.get("/cases/{case_id}/export.zip", summary="Export frames and labels as a zip",
-            response_class=Response, responses={200: {"content": {ZIP: {}}}, **JOB_ACCEPTED})
+            response_class=Response, responses={200: {"content": {ZIP: {}}}, **JOB_ACCEPTED, **NO_CASE})
 def export_case_zip(
     record: RecordDep,
     state: StateDep,
@@ -89,7 +99,7 @@ def export_case_zip(
                     headers={"Content-Disposition": f'attachment; filename="{zip_name(record)}"'})
 
 
-@router.post("/exports", status_code=202, summary="Start an export job", responses=JOB_ACCEPTED)
+@router.post("/exports", status_code=202, summary="Start an export job", responses={**JOB_ACCEPTED, **NO_CASE})
 def create_export(body: ExportRequest, state: StateDep, request: Request) -> JSONResponse:
     """Queue an export of ``frames`` of a stored case; poll the returned job."""
     record = state.store.get(body.case_id)

@@ -16,7 +16,7 @@ from fastapi import APIRouter, Query, Response
 from lanevil_core.labels import CULANE_SIZE, TUSIMPLE_SIZE
 
 from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, ApiRoute
+from .errors import ERROR_RESPONSES, ApiRoute, ErrorBody
 from .params import frame_range
 
 router = APIRouter(tags=["labels"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -26,6 +26,7 @@ JSON_LINES = "application/x-ndjson"
 LABEL_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"content": {JSON_LINES: {}, "application/json": {}},
           "description": "tusimple: one JSON record per line; culane: {format, size, lines: {frame: text}}"},
+    404: {"model": ErrorBody, "description": "no case with that id"},
 }
 
 

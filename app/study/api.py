@@ -21,7 +21,8 @@ from fastapi.responses import FileResponse, JSONResponse, Response
 from pydantic import ValidationError
 from starlette.datastructures import UploadFile
 
-from ..api.errors import ApiError, ApiRoute, first_error
+from ..api.errors import ApiError, ApiRoute, ErrorBody, first_error
+from ..api.json_body import BodyError, check_json_type, is_json_type, parse_json
 from ..state import AppState, get_state
 from .auth import AdminDep
 from .create import SpecError, create_study, items_folder
@@ -48,10 +49,44 @@ from .spec import ConsentIn, RatingIn, StudySpec
 from .stats import exclusions, summarize
 from .tables import raw_ratings_csv, summary_csv
 
-router = APIRouter(prefix="/api/study", tags=["study"], route_class=ApiRoute)
 StateDep = Annotated[AppState, Depends(get_state)]
 MAX_UPLOAD_FILES = 1000
 FORM_TYPES = ("multipart/form-data", "application/x-www-form-urlencoded")
+
+
+def _error(description: str) -> dict[str, Any]:
+    return {"model": ErrorBody, "description": description}
+
+
+ORGANISER: dict[int | str, dict[str, Any]] = {
+    401: _error("missing or wrong organiser token (`Authorization: Bearer <token>`)"),
+    403: _error("no organiser token is configured on the server (LANEVIL_ADMIN_TOKEN)"),
+}
+NO_STUDY: dict[int | str, dict[str, Any]] = {404: _error("no such study (or participant, or item): `field` says which")}
+NOT_READY: dict[int | str, dict[str, Any]] = {409: _error("the study is not ready yet (still rendering, or failed)")}
+router = APIRouter(prefix="/api/study", tags=["study"], route_class=ApiRoute,
+                   responses={422: _error("invalid input; `field` names it")})
+
+# ``POST /studies`` reads its body itself (a multipart form or JSON), so its request body is described here.
+_SPEC_SCHEMA = StudySpec.model_json_schema(ref_template="#/components/schemas/{model}")
+SCHEMAS: dict[str, dict[str, Any]] = {"StudySpec": {k: v for k, v in _SPEC_SCHEMA.items() if k != "$defs"},
+                                      **_SPEC_SCHEMA.get("$defs", {})}
+SPEC_EXAMPLE = {"title": "How natural do these road scenes look?", "viewing_seconds": 3, "width": 1280,
+                "height": 720, "generated": {"cases": ["clean-00_straight_urban"], "frames": [0, 40]},
+                "items": [{"case_id": "clean-01_bend_suburban", "role": "training"},
+                          {"case_id": "clean-01_bend_suburban", "frame": 20, "role": "gold", "garble": True,
+                           "expect": [1, 2]},
+                          {"case_id": "clean-00_straight_urban", "frame": 60, "role": "trap", "answer": 2}]}
+CREATE_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {
+    "multipart/form-data": {
+        "schema": {"type": "object", "required": ["spec"], "properties": {
+            "spec": {"type": "string", "description": "the study spec as JSON (schema: StudySpec)",
+                     "default": json.dumps(SPEC_EXAMPLE, indent=2)},
+            "files": {"type": "array", "items": {"type": "string", "format": "binary"},
+                      "description": "real images (PNG or JPEG); an item names one by its file name (`upload`)"}}},
+        "encoding": {"files": {"contentType": "image/png, image/jpeg"}}},
+    "application/json": {"schema": {"$ref": "#/components/schemas/StudySpec"}, "example": SPEC_EXAMPLE},
+}}}
 
 
 def get_db(state: StateDep) -> Iterator[sqlite3.Connection]:
@@ -83,7 +118,10 @@ def answers() -> Iterator[None]:
 
 # --- organiser ---------------------------------------------------------------------------------------------------
 
-@router.post("/studies", status_code=201, summary="Create a study (organiser)")
+@router.post("/studies", status_code=201, summary="Create a study (organiser)", openapi_extra=CREATE_BODY,
+             responses={202: {"description": "the study, still rendering, and its render job"}, **ORGANISER,
+                        413: _error("an upload over `max_upload_bytes` (`field`: `files.<n>`), or the request over "
+                                    "the server's body limit")})
 async def post_study(request: Request, state: StateDep, _: AdminDep) -> JSONResponse:
     """Multipart form: ``spec`` (JSON, see ``StudySpec``) and any number of ``files`` (PNG/JPEG real images).
     A JSON body is accepted too (the spec alone, for studies of generated frames only).
@@ -103,13 +141,18 @@ async def post_study(request: Request, state: StateDep, _: AdminDep) -> JSONResp
 
 async def _read_create_request(request: Request, state: AppState) -> tuple[StudySpec, dict[str, CheckedUpload]]:
     content_type = request.headers.get("content-type", "")
-    if content_type.startswith("application/json"):
+    if is_json_type(content_type):
         body = await request.body()
         if len(body) > state.settings.max_body_bytes:
             raise http_error(413, "spec", f"the spec is over {state.settings.max_body_bytes} bytes")
-        return _parse_spec(body.decode("utf-8", errors="replace")), {}
+        return _parse_spec(body), {}
     if not content_type.startswith(FORM_TYPES):
-        raise http_error(415, "content-type", "send multipart/form-data (spec + files) or application/json")
+        try:
+            check_json_type(content_type)
+        except BodyError as error:
+            raise http_error(415, error.field, "send multipart/form-data (a 'spec' field and 'files') or "
+                                               f"application/json (the spec alone), not {content_type or 'nothing'}"
+                             ) from None
     form = await request.form(max_files=MAX_UPLOAD_FILES)
     raw_spec = form.get("spec")
     if not isinstance(raw_spec, str):
@@ -125,7 +168,7 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
             raise http_error(422, field, f"two uploads are named {name!r}; give each file its own name")
         data = await upload.read(state.settings.max_upload_bytes + 1)
         if len(data) > state.settings.max_upload_bytes:
-            raise http_error(413, field, f"the file is over {state.settings.max_upload_bytes} bytes")
+            raise http_error(413, field, f"{name} is over {state.settings.max_upload_bytes} bytes")
         try:
             uploads[name] = check_upload(data)
         except UploadError as error:
@@ -133,11 +176,11 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
     return spec, uploads
 
 
-def _parse_spec(text: str) -> StudySpec:
+def _parse_spec(text: str | bytes) -> StudySpec:
     try:
-        return StudySpec.model_validate(json.loads(text))
-    except json.JSONDecodeError as error:
-        raise http_error(422, "spec", f"the spec is not valid JSON ({error})") from None
+        return StudySpec.model_validate(parse_json(text, field="spec"))
+    except BodyError as error:
+        raise http_error(error.status, error.field, str(error)) from None
     except ValidationError as error:
         raise http_error(422, *first_error(error.errors(), prefix="spec")) from None
 
@@ -152,12 +195,12 @@ def _study_detail(db: sqlite3.Connection, study: Study) -> dict[str, Any]:
     }
 
 
-@router.get("/studies", summary="List studies (organiser)")
+@router.get("/studies", summary="List studies (organiser)", responses=ORGANISER)
 def get_studies(db: DbDep, _: AdminDep) -> list[dict[str, Any]]:
     return [study.to_dict() | {"participants": len(study_participants(db, study.id))} for study in list_studies(db)]
 
 
-@router.get("/studies/{study_id}", summary="A study with its items (organiser)")
+@router.get("/studies/{study_id}", summary="A study with its items (organiser)", responses={**ORGANISER, **NO_STUDY})
 def get_study_detail(study_id: str, db: DbDep, state: StateDep, _: AdminDep) -> dict[str, Any]:
     with answers():
         study = get_study(db, study_id)
@@ -182,13 +225,15 @@ def _results(db: sqlite3.Connection, study_id: str) -> tuple[Study, dict[str, An
     return study, summarize(items, study_participants(db, study_id), study_ratings(db, study_id))
 
 
-@router.get("/studies/{study_id}/results", summary="MOS with 95% CI and rater screening (organiser)")
+@router.get("/studies/{study_id}/results", summary="MOS with 95% CI and rater screening (organiser)",
+            responses={**ORGANISER, **NO_STUDY})
 def get_results(study_id: str, db: DbDep, _: AdminDep) -> dict[str, Any]:
     study, summary = _results(db, study_id)
     return {"study": study.to_dict()} | summary
 
 
-@router.get("/studies/{study_id}/ratings.csv", summary="Raw ratings as CSV (organiser)")
+@router.get("/studies/{study_id}/ratings.csv", summary="Raw ratings as CSV (organiser)", response_class=Response,
+            responses={200: {"content": {"text/csv": {}}}, **ORGANISER, **NO_STUDY})
 def get_ratings_csv(study_id: str, db: DbDep, _: AdminDep) -> Response:
     with answers():
         study = get_study(db, study_id)
@@ -198,7 +243,8 @@ def get_ratings_csv(study_id: str, db: DbDep, _: AdminDep) -> Response:
     return _csv_response(text, f"study-{study.id}-ratings.csv")
 
 
-@router.get("/studies/{study_id}/summary.csv", summary="MOS summary as CSV (organiser)")
+@router.get("/studies/{study_id}/summary.csv", summary="MOS summary as CSV (organiser)", response_class=Response,
+            responses={200: {"content": {"text/csv": {}}}, **ORGANISER, **NO_STUDY})
 def get_summary_csv(study_id: str, db: DbDep, _: AdminDep) -> Response:
     study, summary = _results(db, study_id)
     return _csv_response(summary_csv(summary["groups"]), f"study-{study.id}-summary.csv")
@@ -211,7 +257,7 @@ def _csv_response(text: str, filename: str) -> Response:
 
 # --- participants --------------------------------------------------------------------------------------------------
 
-@router.get("/studies/{study_id}/public", summary="What a participant sees before consenting")
+@router.get("/studies/{study_id}/public", summary="What a participant sees before consenting", responses=NO_STUDY)
 def get_public(study_id: str, db: DbDep) -> dict[str, Any]:
     with answers():
         study = get_study(db, study_id)
@@ -239,7 +285,8 @@ def _plan(db: sqlite3.Connection, study: Study, participant_id: str) -> dict[str
                        "image_url": image_url(study.id, item_id)} for item_id in order]}
 
 
-@router.post("/studies/{study_id}/participants", status_code=201, summary="Consent and join a study")
+@router.post("/studies/{study_id}/participants", status_code=201, summary="Consent and join a study",
+             responses={**NO_STUDY, **NOT_READY})
 def post_participant(study_id: str, consent: ConsentIn, db: DbDep) -> dict[str, Any]:
     """Creates the participant (a random id) only when ``consent`` is true; returns the item order."""
     with answers():
@@ -251,14 +298,16 @@ def post_participant(study_id: str, consent: ConsentIn, db: DbDep) -> dict[str, 
         return _plan(db, study, participant.id)
 
 
-@router.get("/studies/{study_id}/participants/{participant_id}", summary="A participant's order and progress")
+@router.get("/studies/{study_id}/participants/{participant_id}", summary="A participant's order and progress",
+            responses=NO_STUDY)
 def get_participant_plan(study_id: str, participant_id: str, db: DbDep) -> dict[str, Any]:
     with answers():
         return _plan(db, get_study(db, study_id), participant_id)
 
 
 @router.post("/studies/{study_id}/participants/{participant_id}/ratings", status_code=201,
-             summary="Rate one item (once; a second rating of the same item is refused with 409)")
+             summary="Rate one item (once; a second rating of the same item is refused with 409)",
+             responses={**NO_STUDY, 409: _error("this participant rated the item already (`field`: `item_id`)")})
 def post_rating(study_id: str, participant_id: str, rating: RatingIn, db: DbDep) -> dict[str, Any]:
     with answers():
         study = get_study(db, study_id)
@@ -272,7 +321,8 @@ def post_rating(study_id: str, participant_id: str, rating: RatingIn, db: DbDep)
     return {"id": stored.id, "item_id": item.id, "rating": stored.rating}
 
 
-@router.post("/studies/{study_id}/participants/{participant_id}/complete", summary="Finish the session")
+@router.post("/studies/{study_id}/participants/{participant_id}/complete", summary="Finish the session",
+             responses={**NO_STUDY, 409: _error("items are still unrated (`field`: `ratings`)")})
 def post_complete(study_id: str, participant_id: str, db: DbDep) -> dict[str, Any]:
     """409 while any item is unrated; otherwise marks the participant complete (idempotent)."""
     with answers():
@@ -286,7 +336,9 @@ def post_complete(study_id: str, participant_id: str, db: DbDep) -> dict[str, An
     return {"participant_id": participant.id, "completed": True}
 
 
-@router.get("/studies/{study_id}/items/{item_id}/image", summary="An item's image, as stored at creation")
+@router.get("/studies/{study_id}/items/{item_id}/image", summary="An item's image, as stored at creation",
+            response_class=FileResponse,
+            responses={200: {"content": {"image/png": {}, "image/jpeg": {}}}, **NO_STUDY, **NOT_READY})
 def get_item_image(study_id: str, item_id: int, db: DbDep, state: StateDep) -> FileResponse:
     with answers():
         study = get_study(db, study_id)

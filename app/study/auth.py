@@ -5,14 +5,19 @@ from __future__ import annotations
 import hmac
 from typing import Annotated
 
-from fastapi import Depends, Header
+from fastapi import Depends
+from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..api.errors import ApiError
 from ..state import AppState, get_state
 
+# Declared as a security scheme, so /docs has an "Authorize" button; missing or malformed headers are ours to refuse.
+bearer = HTTPBearer(auto_error=False, scheme_name="OrganiserToken",
+                    description="the organiser token, LANEVIL_ADMIN_TOKEN of the server")
+
 
 def require_admin(state: Annotated[AppState, Depends(get_state)],
-                  authorization: Annotated[str | None, Header()] = None) -> None:
+                  credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)] = None) -> None:
     """Pass when ``Authorization: Bearer <token>`` matches the configured token (constant-time compare).
 
     403 when no token is configured (admin routes are then closed), 401 for a missing or wrong token."""
@@ -21,8 +26,8 @@ def require_admin(state: Annotated[AppState, Depends(get_state)],
         raise ApiError(403, "no organiser token is configured: set LANEVIL_ADMIN_TOKEN (e.g. "
                             "`LANEVIL_ADMIN_TOKEN=$(openssl rand -hex 16) lanevil serve`) and send it as "
                             "`Authorization: Bearer <token>`", "authorization")
-    scheme, _, given = (authorization or "").partition(" ")
-    if scheme.lower() != "bearer" or not hmac.compare_digest(given.strip().encode(), token.encode()):
+    given = credentials.credentials.strip() if credentials else ""
+    if not given or not hmac.compare_digest(given.encode(), token.encode()):
         raise ApiError(401, "send the organiser token as `Authorization: Bearer <token>`", "authorization",
                        headers={"WWW-Authenticate": "Bearer"})
 

@@ -7,6 +7,7 @@ All functions are pure over ``(H, W, 3) uint8`` RGB arrays (pixel origin top-lef
 from __future__ import annotations
 
 import io
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,7 @@ from .spec import ACR_LABELS
 UPLOAD_FORMATS: dict[str, tuple[str, str]] = {"PNG": ("image/png", ".png"), "JPEG": ("image/jpeg", ".jpg")}
 GARBLE_TILES = 8  # tiles per side of the scrambled grid
 BANNER_GREY = (32, 32, 32)
+OBJECT_REPR = re.compile(r"\s*<[^<>]* at 0x[0-9a-fA-F]+>")
 
 
 class UploadError(ValueError):
@@ -43,12 +45,21 @@ def check_upload(data: bytes) -> CheckedUpload:
                 raise UploadError(f"is a {image_format or 'unknown'} file; upload PNG or JPEG images")
             image.load()  # verify() misses truncated data; a full decode does not
             size = image.size
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
-        if isinstance(error, UploadError):
-            raise
-        raise UploadError(f"does not decode as a PNG or JPEG image ({error})") from None
+    except UploadError:
+        raise
+    except UnidentifiedImageError:
+        raise UploadError("is not an image file; upload PNG or JPEG images") from None
+    except Image.DecompressionBombError:
+        raise UploadError(f"has more than {Image.MAX_IMAGE_PIXELS} pixels; upload a smaller image") from None
+    except (OSError, SyntaxError, ValueError) as error:
+        raise UploadError(f"does not decode as a PNG or JPEG image ({_reason(error)})") from None
     media_type, suffix = UPLOAD_FORMATS[image_format]
     return CheckedUpload(data, image_format, media_type, suffix, size)
+
+
+def _reason(error: Exception) -> str:
+    """Pillow's message without object reprs (``<_io.BytesIO object at 0x…>``), which mean nothing to a user."""
+    return OBJECT_REPR.sub("", str(error)).strip(" :()") or type(error).__name__
 
 
 def decode_rgb(data: bytes) -> np.ndarray:

@@ -282,7 +282,7 @@ def test_multipart_uploads_have_their_own_limit(settings, state) -> None:
     with TestClient(create_app(small, state)) as client:
         files = {"files": ("big.bin", b"\0" * 4096, "application/octet-stream")}
         response = client.post("/api/cases", files=files)
-        assert response.status_code == 422  # not a JSON case: refused by validation, not by the size limit
+        assert response.status_code == 415  # not a JSON case: refused for its content type, not by the size limit
         over = b"\0" * (UPLOADS_PER_REQUEST * 2048 + 1)
         response = client.post("/api/cases", content=over, headers={"content-type": "multipart/form-data; boundary=x"})
         assert response.status_code == 413 and response.json()["field"] == "body"

@@ -113,3 +113,33 @@ def test_post_exports_rejects_bad_requests(client, body: dict, status: int, fiel
 def test_unknown_jobs_are_404(client, job_id: str) -> None:
     assert client.get(f"/api/exports/{job_id}").status_code == 404
     assert client.get(f"/api/exports/{job_id}/download").status_code == 404
+
+
+def test_identical_export_requests_share_one_job(client, state) -> None:
+    body = {"case_id": SHADOW_ID, "frames": "0:50"}
+    first = client.post("/api/exports", json=body)
+    again = client.post("/api/exports", json=body)
+    direct = client.get(f"/api/cases/{SHADOW_ID}/export.zip?frames=0:50")
+    assert first.status_code == again.status_code == direct.status_code == 202
+    assert first.json()["id"] == again.json()["id"] == direct.json()["id"]
+    other = client.post("/api/exports", json={"case_id": SHADOW_ID, "frames": "0:49"})
+    assert other.json()["id"] != first.json()["id"]
+    for job_id in (first.json()["id"], other.json()["id"]):
+        client.delete(f"/api/exports/{job_id}")
+
+
+def test_a_client_past_its_share_of_the_queue_gets_429_with_retry_after(client, state, monkeypatch) -> None:
+    monkeypatch.setattr(state.jobs, "max_per_client", 2)
+    ids = [client.post("/api/exports", json={"case_id": SHADOW_ID, "frames": f"0:{stop}"}).json()["id"]
+           for stop in (90, 91)]
+    refused = client.post("/api/exports", json={"case_id": SHADOW_ID, "frames": "0:92"})
+    assert refused.status_code == 429 and int(refused.headers["retry-after"]) >= 1
+    assert refused.json()["field"] is None and "2 jobs queued or running" in refused.json()["detail"]
+    assert client.get(f"/api/cases/{SHADOW_ID}/export.zip?frames=0:93").status_code == 429
+    monkeypatch.setattr(state.jobs, "max_unfinished", 2)
+    monkeypatch.setattr(state.jobs, "max_per_client", 10)
+    full = client.post("/api/exports", json={"case_id": SHADOW_ID, "frames": "0:94"})
+    assert full.status_code == 429 and "retry-after" in full.headers
+    assert "the most it takes" in full.json()["detail"]
+    for job_id in ids:
+        client.delete(f"/api/exports/{job_id}")

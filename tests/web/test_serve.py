@@ -62,3 +62,20 @@ def test_serve_runs_backend_and_editor_and_stops_cleanly(settings: Settings, sto
         process.send_signal(stop_signal)
         code = process.wait(timeout=30)
     assert code == 0
+
+
+def test_a_busy_port_is_named_and_exits_2(settings: Settings, capsys: pytest.CaptureFixture[str]) -> None:
+    from app.cli import main
+    from app.server import bind
+
+    busy = bind("127.0.0.1", 0)
+    port = busy.getsockname()[1]
+    try:
+        status = main(["serve", "--port", str(port), "--no-editor", "--data", str(settings.data_dir),
+                       "--scenes", str(settings.scenes_dir)])
+    finally:
+        busy.close()
+    err = capsys.readouterr().err.strip()
+    assert status == 2 and len(err.splitlines()) == 1
+    assert f"cannot listen on 127.0.0.1:{port}: address already in use" in err and "--port" in err
+    assert not settings.data_dir.exists()  # refused before the store was opened

@@ -1,0 +1,167 @@
+"""Errors name the real field and the real problem: malformed, non-JSON, non-finite and deeply nested bodies, study
+uploads, and an OpenAPI description that documents the error body and statuses the API really answers."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from app.api.json_body import MAX_DEPTH, line_column
+
+ADMIN = {"Authorization": "Bearer test-admin"}
+JSON = {"content-type": "application/json"}
+SHADOW_ID = "fence_shadow-03_level3"
+
+
+def post_case(client, payload: bytes, headers: dict[str, str] | None = None):
+    return client.post("/api/cases", content=payload, headers=JSON if headers is None else headers)
+
+
+def test_line_column_is_one_based() -> None:
+    assert line_column("ab\ncd", 0) == (1, 1)
+    assert line_column("ab\ncd", 4) == (2, 2)
+
+
+def test_malformed_json_names_body_with_line_and_column(client) -> None:
+    response = post_case(client, b'{"title": "x",\n "road": }')
+    assert response.status_code == 422
+    assert response.json() == {"detail": "body: invalid JSON at line 2 column 10: Expecting value", "field": "body"}
+
+
+@pytest.mark.parametrize(("method", "url", "body"), [
+    ("POST", "/api/cases", b'{"title": "x"}'),
+    ("PUT", f"/api/cases/{SHADOW_ID}", b'{"title": "x"}'),
+    ("PATCH", f"/api/cases/{SHADOW_ID}", b'{"title": "x"}'),
+    ("POST", "/api/render", b'{"title": "x"}'),
+    ("POST", "/api/exports", b'{"case_id": "fence_shadow-03_level3"}'),
+])
+@pytest.mark.parametrize("content_type", ["text/plain", "application/x-www-form-urlencoded", "application/xml", None])
+def test_a_body_not_sent_as_json_is_415(client, method: str, url: str, body: bytes, content_type: str | None) -> None:
+    headers = {"content-type": content_type} if content_type else {}
+    response = client.request(method, url, content=body, headers=headers)
+    assert response.status_code == 415, response.text
+    assert response.json()["field"] == "Content-Type" and "application/json" in response.json()["detail"]
+
+
+def test_json_content_types_with_parameters_and_merge_patch_are_read(client) -> None:
+    response = post_case(client, b'{"title": "charset"}', {"content-type": "application/json; charset=utf-8"})
+    assert response.status_code == 201
+    patch = client.patch(f"/api/cases/{response.json()['id']}", content=b'{"title": "patched"}',
+                         headers={"content-type": "application/merge-patch+json"})
+    assert patch.status_code == 200 and patch.json()["case"]["title"] == "patched"
+
+
+@pytest.mark.parametrize("constant", ["NaN", "Infinity", "-Infinity"])
+def test_nan_and_infinity_are_refused(client, constant: str) -> None:
+    payload = f'{{"title": "x",\n  "sun": {{"altitude": {constant}}}}}'.encode()
+    response = post_case(client, payload)
+    assert response.status_code == 422 and response.json()["field"] == "body"
+    assert response.json()["detail"].startswith(f"body: {constant} at line 2 column 23 is not a JSON number")
+
+
+def test_nan_inside_a_string_is_text(client) -> None:
+    response = post_case(client, b'{"title": "NaN [[[ Infinity {{{"}')
+    assert response.status_code == 201 and response.json()["case"]["title"] == "NaN [[[ Infinity {{{"
+
+
+@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 5_000, 200_000])
+def test_deeply_nested_json_names_body(client, depth: int) -> None:
+    payload = b'{"title": ' + b"[" * depth + b"]" * depth + b"}"
+    response = post_case(client, payload)
+    assert response.status_code == 422
+    assert response.json()["field"] == "body" and f"nested deeper than {MAX_DEPTH} levels" in response.json()["detail"]
+
+
+def test_a_body_that_is_not_utf8_names_body(client) -> None:
+    response = post_case(client, b'{"title": "\xff"}')
+    assert response.status_code == 422 and response.json()["field"] == "body"
+
+
+def test_participant_routes_refuse_non_json_too(client) -> None:
+    response = client.post("/api/study/studies/000000000000/participants", content=b"consent=true",
+                           headers={"content-type": "application/x-www-form-urlencoded"})
+    assert response.status_code == 415 and response.json()["field"] == "Content-Type"
+
+
+# ------------------------------------------------------------------------------------------ study creation
+
+
+def test_study_spec_errors_name_spec_with_line_and_column(client) -> None:
+    response = client.post("/api/study/studies", headers=ADMIN, data={"spec": '{"title": "x",\n "width": NaN}'})
+    assert response.status_code == 422 and response.json()["field"] == "spec"
+    assert "NaN at line 2 column 11" in response.json()["detail"]
+    response = client.post("/api/study/studies", headers=ADMIN, data={"spec": '{"title": }'})
+    assert response.json() == {"detail": "spec: invalid JSON at line 1 column 11: Expecting value", "field": "spec"}
+
+
+def test_study_creation_with_another_content_type_is_415(client) -> None:
+    response = client.post("/api/study/studies", headers={**ADMIN, "content-type": "text/plain"}, content=b"{}")
+    assert response.status_code == 415 and response.json()["field"] == "Content-Type"
+
+
+def truncated_png() -> bytes:
+    pixels = np.random.default_rng(0).integers(0, 256, (90, 160, 3), dtype=np.uint8)
+    buffer = io.BytesIO()
+    Image.fromarray(pixels, "RGB").save(buffer, format="PNG")
+    return buffer.getvalue()[: len(buffer.getvalue()) // 2]
+
+
+@pytest.mark.parametrize(("data", "says"), [
+    (b"not an image at all", "is not an image file"),
+    (truncated_png(), "does not decode as a PNG or JPEG image"),
+])
+def test_upload_errors_never_show_object_reprs(client, data: bytes, says: str) -> None:
+    spec = {"title": "x", "generated": {"cases": ["clean-00_straight_urban"]}}
+    response = client.post("/api/study/studies", headers=ADMIN, data={"spec": json.dumps(spec)},
+                           files=[("files", ("photo.png", data, "image/png"))])
+    assert response.status_code == 422 and response.json()["field"] == "files.0"
+    detail = response.json()["detail"]
+    assert detail.startswith(f"files.0: photo.png {says}")
+    assert "object at 0x" not in detail and "BytesIO" not in detail
+
+
+# ------------------------------------------------------------------------------------------ the OpenAPI description
+
+
+def operations(schema: dict):
+    for path, item in schema["paths"].items():
+        for method, operation in item.items():
+            yield path, method, operation
+
+
+def test_openapi_documents_the_error_body_and_statuses(client) -> None:
+    schema = client.get("/openapi.json").json()
+    assert "HTTPValidationError" not in schema["components"]["schemas"]
+    assert set(schema["components"]["schemas"]["ErrorBody"]["properties"]) == {"detail", "field"}
+    for path, method, operation in operations(schema):
+        responses = operation["responses"]
+        for status, response in responses.items():
+            if status.startswith("4"):
+                ref = response["content"]["application/json"]["schema"]["$ref"]
+                assert ref == "#/components/schemas/ErrorBody", (path, method, status)
+        if "requestBody" in operation:
+            assert {"413", "415", "422"} <= set(responses), (path, method)
+    paths = schema["paths"]
+    assert "404" in paths["/api/cases/{case_id}"]["get"]["responses"]
+    assert "409" in paths["/api/cases/{case_id}"]["put"]["responses"]
+    assert "404" in paths["/api/cases/{case_id}/labels"]["get"]["responses"]
+    exports = paths["/api/exports"]["post"]["responses"]
+    assert "429" in exports and "Retry-After" in exports["429"]["headers"]
+    assert "429" in paths["/api/cases/{case_id}/export.zip"]["get"]["responses"]
+
+
+def test_openapi_describes_study_creation(client) -> None:
+    schema = client.get("/openapi.json").json()
+    create = schema["paths"]["/api/study/studies"]["post"]
+    content = create["requestBody"]["content"]
+    form = content["multipart/form-data"]["schema"]
+    assert form["required"] == ["spec"] and form["properties"]["files"]["items"]["format"] == "binary"
+    assert json.loads(form["properties"]["spec"]["default"])["title"]
+    assert content["application/json"]["schema"] == {"$ref": "#/components/schemas/StudySpec"}
+    assert {"StudySpec", "ItemSpec", "GeneratedSet"} <= set(schema["components"]["schemas"])
+    assert {"201", "202", "401", "403", "413", "415", "422"} <= set(create["responses"])
+    assert create["security"] == [{"OrganiserToken": []}]
