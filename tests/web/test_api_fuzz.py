@@ -1,4 +1,6 @@
-"""Property-based fuzzing of the REST API from its own OpenAPI schema: whatever the input, never a 5xx.
+"""Property-based fuzzing of the REST API from its own OpenAPI schema: whatever the input, never a 5xx, and every
+answer is one the schema describes (status code, content type, headers and body schema), so a client generated
+from ``/openapi.json`` understands it.
 
 Bounded to run in about a minute: few examples per operation, frames rendered at most 160x96, labels and direct
 exports capped at a couple of frames (each is a full-size render), study routes left to their own tests.
@@ -12,7 +14,13 @@ import pytest
 import schemathesis
 from hypothesis import HealthCheck, Phase, given
 from hypothesis import settings as hypothesis_settings
-from schemathesis.checks import not_a_server_error
+from schemathesis.checks import (
+    content_type_conformance,
+    not_a_server_error,
+    response_headers_conformance,
+    response_schema_conformance,
+    status_code_conformance,
+)
 
 import app.api.exports as exports
 import app.api.labels as labels
@@ -22,10 +30,12 @@ from app.state import AppState
 
 EXAMPLES_PER_OPERATION = 12
 API_PATHS = re.compile(r"^/api/(?!study)")
+CHECKS = [not_a_server_error, status_code_conformance, content_type_conformance, response_headers_conformance,
+          response_schema_conformance]
 
 
 @pytest.mark.slow
-def test_api_never_answers_5xx(settings: Settings, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_api_never_answers_5xx_and_answers_what_its_schema_says(settings: Settings, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(labels, "MAX_LABEL_FRAMES", 2)
     monkeypatch.setattr(exports, "SYNC_EXPORT_FRAMES", 1)
     small = settings.model_copy(update={"max_width": 160, "max_height": 96})
@@ -47,6 +57,6 @@ def check_operation(operation) -> None:
     @hypothesis_settings(max_examples=EXAMPLES_PER_OPERATION, deadline=None, database=None,
                          phases=[Phase.explicit, Phase.generate], suppress_health_check=list(HealthCheck))
     def no_server_error(case) -> None:
-        case.call_and_validate(checks=[not_a_server_error])
+        case.call_and_validate(checks=CHECKS)
 
     no_server_error()
