@@ -2,19 +2,19 @@
 
 from __future__ import annotations
 
-from fastapi import FastAPI, HTTPException, Request
+from fastapi import FastAPI, HTTPException, Request, Response
 from fastapi.responses import RedirectResponse
 
 from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
-from .api.errors import handle_exception
+from .api.errors import error_response, handle_exception
 from .docs import mount_docs
 from .jobs import JobNotFound
 from .settings import Settings
 from .site import mount_static
 from .state import AppState
-from .store import StoreError
+from .store import InvalidId, StoreError
 from .study import router as study_router
 from .study.api import SCHEMAS as STUDY_SCHEMAS
 
@@ -37,15 +37,24 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     api_openapi.install(app, STUDY_SCHEMAS)
     mount_static(app)
     app.state.editor_port = None  # set by the server once the viser editor listens
+    app.state.open_in_editor = None  # the editor's open_case(case_id), set with editor_port
     app.add_api_route("/editor", _editor_redirect, methods=["GET"], include_in_schema=False)
     return app
 
 
-def _editor_redirect(request: Request) -> RedirectResponse:
-    """``/editor`` -> the viser editor on the same host name, so users need only the backend's address."""
+def _editor_redirect(request: Request, case: str | None = None) -> Response:
+    """``/editor`` -> the viser editor on the same host name, so users need only the backend's address.
+    ``/editor?case=ID`` first opens stored case ``ID`` there (every editor tab shows the same case)."""
     port = request.app.state.editor_port
     if port is None:
         raise HTTPException(503, detail="the editor is not running (start it with `lanevil serve`)")
+    if case is not None:
+        try:
+            request.app.state.lanevil.store.get(case)
+        except StoreError as error:
+            return error_response(422 if isinstance(error, InvalidId) else 404, f"case: {error}", "case")
+        if request.app.state.open_in_editor is not None:
+            request.app.state.open_in_editor(case)
     host = request.url.hostname or "127.0.0.1"
     host = f"[{host}]" if ":" in host else host
     return RedirectResponse(f"{request.url.scheme}://{host}:{port}/", status_code=307)

@@ -19,12 +19,18 @@ def chosen_detector(value: str) -> str | None:
     return None if value == NO_DETECTOR else value
 
 
+def rate_text(value: float) -> str:
+    """A TuSimple rate for reading: two decimals without trailing zeros (``0``, ``0.2``, ``0.25``)."""
+    return f"{value:.2f}".rstrip("0").rstrip(".")
+
+
 def detection_text(found: FrameDetection) -> str:
-    """Markdown: the detector's verdict on the frame and its score."""
+    """Markdown, two lines: the detector's verdict on the frame, then its score."""
     fooled = found.fp > 0 or found.fn > 0
-    verdict = "**fooled**" if fooled else "not fooled"
-    return (f"**{found.detector}** (magenta) {verdict} · accuracy **{found.accuracy:.2f}** · FP {found.fp:.2f} · "
-            f"FN {found.fn:.2f} · {len(found.lanes)} lanes found, {len(found.gt_lanes)} labelled")
+    verdict = "✗ **fooled**" if fooled else "✓ not fooled"
+    return (f"**{found.detector}** (magenta): {verdict} · {len(found.lanes)} lanes found, "
+            f"{len(found.gt_lanes)} labelled  \n"
+            f"accuracy **{100 * found.accuracy:.1f}%** · FP {rate_text(found.fp)} · FN {rate_text(found.fn)}")
 
 
 def unavailable_text(detector: str, reason: str) -> str:

@@ -1,7 +1,7 @@
 /**
- * The REST API as the demo site uses it: JSON reads, frame URLs, readable error messages.
+ * The REST API as the demo site uses it: JSON reads, frame and detection URLs, readable error messages.
  *
- * Every frame URL is built in one place (`frameUrl`) with its query parameters in a fixed order, so one slider
+ * Every frame URL is built in one place (`frameQuery`) with its query parameters in a fixed order, so one slider
  * state always maps to one URL and the browser's HTTP cache can answer repeated states.
  */
 
@@ -57,18 +57,41 @@ export async function caseDocument(id, { signal } = {}) {
   return (await getJson(`/api/cases/${encodeURIComponent(id)}`, { signal })).case;
 }
 
+/** The lane detectors: a list of {name, kind, available, reason, model}. */
+export async function detectors() {
+  return (await getJson("/api/detectors")).data;
+}
+
 /**
- * The URL of frame `frame` of case `id`: JPEG at `FRAME_SIZE`, overlay on or off, optional severity and sun
- * overrides (left out when `undefined`, so an untouched control shares the case's own cached render).
+ * Query of a frame at `FRAME_SIZE`: the overlay (when given) and detector (when set), then the optional severity
+ * and sun overrides (left out when `undefined`, so an untouched control shares the case's own cached render).
  */
-export function frameUrl(id, { frame = 0, overlay = false, severity, sunAzimuth, sunAltitude } = {}) {
-  const query = new URLSearchParams({
-    width: String(FRAME_SIZE.width),
-    height: String(FRAME_SIZE.height),
-    overlay: overlay ? "true" : "false",
-  });
+function frameQuery({ overlay, detector, severity, sunAzimuth, sunAltitude }) {
+  const query = new URLSearchParams({ width: String(FRAME_SIZE.width), height: String(FRAME_SIZE.height) });
+  if (overlay !== undefined) query.set("overlay", overlay ? "true" : "false");
+  if (detector) query.set("detector", detector);
   if (severity !== undefined) query.set("severity", String(severity));
   if (sunAzimuth !== undefined) query.set("sun_azimuth", String(sunAzimuth));
   if (sunAltitude !== undefined) query.set("sun_altitude", String(sunAltitude));
+  return query;
+}
+
+/**
+ * The URL of frame `frame` of case `id`: JPEG at `FRAME_SIZE`, overlay on or off, a detector's lanes (magenta)
+ * when `detector` is set, optional severity and sun overrides.
+ */
+export function frameUrl(id, { frame = 0, overlay = false, detector = "", severity, sunAzimuth, sunAltitude } = {}) {
+  const query = frameQuery({ overlay, detector, severity, sunAzimuth, sunAltitude });
   return `/api/cases/${encodeURIComponent(id)}/frames/${frame}.jpg?${query}`;
+}
+
+/** The URL of `detector`'s lanes and TuSimple score on the frame `frameUrl` shows with the same settings. */
+export function detectionsUrl(id, { frame = 0, detector, severity, sunAzimuth, sunAltitude }) {
+  const query = frameQuery({ detector, severity, sunAzimuth, sunAltitude });
+  return `/api/cases/${encodeURIComponent(id)}/frames/${frame}/detections?${query}`;
+}
+
+/** The editor's address, opening case `id` there. */
+export function editorUrl(id) {
+  return `/editor?case=${encodeURIComponent(id)}`;
 }

@@ -4,10 +4,13 @@
  * A card does nothing until `activate()` (called when it scrolls near the viewport). It then looks up the type's
  * cases in the store: `<type>-00_original` for the left frame and a level case (`<type>-03_level3` preferred)
  * re-rendered at the slider's severity for the right one. Types the store lacks get a "not in this library" card.
+ * With a detector chosen (page toolbar), both frames show its lanes in magenta and their captions its TuSimple
+ * accuracy on that frame; "Open the editor" opens the card's perturbed case (else its original) in the editor.
  */
 
-import { caseDocument, casesOfType, frameUrl } from "./api.js";
+import { caseDocument, casesOfType, detectionsUrl, editorUrl, frameUrl } from "./api.js";
 import { LatestImage } from "./latest-image.js";
+import { LatestScore } from "./latest-score.js";
 
 const PREFERRED_LEVEL = 3;
 const LEVELS = 5;
@@ -57,7 +60,7 @@ export class IllusionCard {
   /**
    * @param {HTMLTemplateElement} template the card markup
    * @param {{name: string, description: string, severity: object[]}} info the type's registry entry
-   * @param {{overlay: boolean}} display page-wide display options
+   * @param {{overlay: boolean, detector: string}} display page-wide display options ("" = no detector)
    */
   constructor(template, info, display) {
     this.info = info;
@@ -101,7 +104,7 @@ export class IllusionCard {
     for (const [role, caption] of FRAME_ROLES) {
       const figure = frameTemplate.content.firstElementChild.cloneNode(true);
       figure.dataset.role = role;
-      figure.querySelector("figcaption").textContent = caption;
+      figure.querySelector(".frame__label").textContent = caption;
       pair.append(figure);
     }
     this.frames = {};
@@ -113,7 +116,8 @@ export class IllusionCard {
         onError: (error) => this.setFrameError(figure, error),
       });
       figure.querySelector(".frame__retry").addEventListener("click", () => loader.retry());
-      this.frames[role] = { figure, img, loader };
+      const score = new LatestScore(figure.querySelector(".frame__score"));
+      this.frames[role] = { figure, img, loader, score };
     }
     el.querySelector(".card__reset").addEventListener("click", () => this.reset());
     this.showValues();
@@ -139,6 +143,7 @@ export class IllusionCard {
     for (const [role, id] of Object.entries(this.ids)) {
       this.frames[role].figure.querySelector(".frame__missing").hidden = id !== null;
     }
+    this.linkEditor(this.ids.perturbed ?? this.ids.original);
     if (!this.ids.original && !this.ids.perturbed) {
       this.setState("missing");
       const note = this.el.querySelector(".card__missing");
@@ -174,6 +179,15 @@ export class IllusionCard {
     }
   }
 
+  /** Point "Open the editor" at case `id` (the editor opens it for every tab). */
+  linkEditor(id) {
+    const link = this.el.querySelector(".card__edit");
+    if (!id) return;
+    link.href = editorUrl(id);
+    link.title = `Open ${id} in the editor`;
+    link.dataset.case = id;
+  }
+
   setState(state) {
     this.el.dataset.state = state;
   }
@@ -206,7 +220,7 @@ export class IllusionCard {
     this.refresh();
   }
 
-  /** Page-wide options changed (the lane overlay). */
+  /** Page-wide options changed (the lane overlay, the detector). */
   displayChanged() {
     if (this.el.dataset.state === "ready") this.refresh({ immediate: true });
   }
@@ -231,7 +245,14 @@ export class IllusionCard {
     const sun = this.sunTouched
       ? { sunAzimuth: Number(this.inputs.azimuth.value), sunAltitude: Number(this.inputs.altitude.value) }
       : {};
-    return { severity: Number(this.inputs.severity.value), overlay: this.display.overlay, ...sun };
+    return { severity: Number(this.inputs.severity.value), overlay: this.display.overlay,
+      detector: this.display.detector, ...sun };
+  }
+
+  /** " · sun 120° / 20°" once the user moved a sun slider, else "". */
+  sunCaption() {
+    if (!this.sunTouched) return "";
+    return ` · sun ${this.inputs.azimuth.value}° / ${this.inputs.altitude.value}°`;
   }
 
   showValues() {
@@ -248,24 +269,27 @@ export class IllusionCard {
     altitude.setAttribute("aria-valuetext", auto ? "set by the illusion" : `${altitude.value} degrees above the horizon`);
     const row = this.info.severity?.[Number(severity.value) - 1];
     this.el.querySelector(".card__level").textContent = row ? `Level ${severity.value}: ${levelSummary(row)}` : "";
-    this.el.querySelector('figure[data-role="perturbed"] figcaption').textContent =
-      `Perturbed · level ${severity.value}`;
+    const sun = this.sunCaption();
+    this.frames.original.figure.querySelector(".frame__label").textContent = `Original${sun}`;
+    this.frames.perturbed.figure.querySelector(".frame__label").textContent =
+      `Perturbed · level ${severity.value}${sun}`;
   }
 
-  /** Ask both frames for the pictures of the current settings. */
+  /** Ask both frames for the pictures (and the detector's scores) of the current settings. */
   refresh({ immediate = false } = {}) {
-    const { severity, overlay, sunAzimuth, sunAltitude } = this.settings();
+    const { severity, overlay, detector, sunAzimuth, sunAltitude } = this.settings();
     const sun = sunAzimuth === undefined ? "" : `, sun at ${sunAzimuth}° azimuth and ${sunAltitude}° altitude`;
-    const lanes = overlay ? ", ground-truth lanes drawn" : "";
-    if (this.ids.original) {
-      const url = frameUrl(this.ids.original, { overlay, sunAzimuth, sunAltitude });
-      this.frames.original.loader.request(url, `${this.title}: original frame without the illusion${sun}${lanes}`,
-        { immediate });
-    }
-    if (this.ids.perturbed) {
-      const url = frameUrl(this.ids.perturbed, { overlay, severity, sunAzimuth, sunAltitude });
-      this.frames.perturbed.loader.request(url, `${this.title} at severity ${severity} of ${LEVELS}${sun}${lanes}`,
-        { immediate });
+    const lanes = (overlay ? ", ground-truth lanes drawn" : "") + (detector ? `, ${detector} lanes in magenta` : "");
+    const views = {
+      original: [{ sunAzimuth, sunAltitude }, `${this.title}: original frame without the illusion`],
+      perturbed: [{ severity, sunAzimuth, sunAltitude }, `${this.title} at severity ${severity} of ${LEVELS}`],
+    };
+    for (const [role, [overrides, alt]] of Object.entries(views)) {
+      const id = this.ids[role];
+      if (!id) continue;
+      const { loader, score } = this.frames[role];
+      loader.request(frameUrl(id, { overlay, detector, ...overrides }), `${alt}${sun}${lanes}`, { immediate });
+      score.request(detector ? detectionsUrl(id, { detector, ...overrides }) : null, detector, { immediate });
     }
   }
 }

@@ -5,10 +5,36 @@
  * first paint needs one small JSON request.
  */
 
-import { illusions } from "./api.js";
+import { detectors, illusions } from "./api.js";
 import { IllusionCard } from "./card.js";
 
 const LAZY_MARGIN = "300px 0px";
+const DEFAULT_DETECTOR = "ufld";
+
+/** Fill the detector select from `/api/detectors` (unavailable ones listed but disabled); returns its value. */
+async function fillDetectors(select) {
+  let list;
+  try {
+    list = await detectors();
+  } catch (error) {
+    select.replaceChildren(new Option("none", ""));
+    select.title = `Could not list the detectors: ${error.message}`;
+    return "";
+  }
+  const options = [new Option("none", "")];
+  for (const entry of list) {
+    const accuracy = entry.model?.val_accuracy;
+    const option = new Option(`${entry.name} (${entry.available ? entry.kind : "not installed"})`, entry.name);
+    option.disabled = !entry.available;
+    option.title = !entry.available ? entry.reason ?? ""
+      : typeof accuracy === "number" ? `validation accuracy ${(100 * accuracy).toFixed(1)}%` : "";
+    options.push(option);
+  }
+  select.replaceChildren(...options);
+  const usable = list.filter((entry) => entry.available).map((entry) => entry.name);
+  select.value = usable.includes(DEFAULT_DETECTOR) ? DEFAULT_DETECTOR : usable[0] ?? "";
+  return select.value;
+}
 
 /** The section of `category`, created at the end of the gallery if the page has none for it. */
 function sectionOf(gallery, category) {
@@ -53,11 +79,13 @@ async function main() {
   const gallery = document.getElementById("gallery");
   const template = document.getElementById("card-template");
   const overlayToggle = document.getElementById("overlay-toggle");
+  const detectorSelect = document.getElementById("detector-select");
   const status = document.getElementById("page-status");
-  const display = { overlay: overlayToggle.checked };
+  const display = { overlay: overlayToggle.checked, detector: detectorSelect.value };
+  const detectorsRead = fillDetectors(detectorSelect);
   let registry;
   try {
-    registry = await illusions();
+    [registry, display.detector] = await Promise.all([illusions(), detectorsRead]);
   } catch (error) {
     showPageError(`Could not load the illusion registry from /api/illusions: ${error.message}`);
     return;
@@ -72,6 +100,10 @@ async function main() {
   status.textContent = `${cards.length} illusion types`;
   overlayToggle.addEventListener("change", () => {
     display.overlay = overlayToggle.checked;
+    cards.forEach((card) => card.displayChanged());
+  });
+  detectorSelect.addEventListener("change", () => {
+    display.detector = detectorSelect.value;
     cards.forEach((card) => card.displayChanged());
   });
   document.body.dataset.ready = "true";

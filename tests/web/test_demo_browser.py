@@ -1,12 +1,15 @@
 """The demo website in headless Chromium against a live server on the small test store (only ``fence_shadow``).
 
-Checks that sliders re-render the frames (debounced, ending on the latest value), the overlay toggle, error and
-"not in this library" states, keyboard use, and layouts at desktop and phone widths (screenshots saved).
+Checks that sliders re-render the frames (debounced, ending on the latest value), the overlay toggle, the detector
+select (magenta lanes and an accuracy caption under each frame), the card's editor link, error and "not in this
+library" states, keyboard use, and layouts at desktop and phone widths (screenshots saved).
 """
 
 from __future__ import annotations
 
 import json
+import re
+import time
 
 import pytest
 
@@ -67,8 +70,11 @@ def load_every_card(page) -> None:
 
 
 def test_sliders_and_overlay_rerender_the_frames(page, live_server) -> None:
+    page.route("**/api/detectors", lambda route: route.fulfill(  # no detector: the frames as rendered
+        status=200, content_type="application/json", body=json.dumps({"data": [], "count": 0})))
     original, perturbed = open_card(page, live_server)
     assert "severity=3" in perturbed["url"] and "overlay=false" in perturbed["url"]
+    assert "detector" not in perturbed["url"]
     assert perturbed["width"] == 480
     level3 = page.evaluate(PIXEL_HASH, PERTURBED)
 
@@ -80,7 +86,7 @@ def test_sliders_and_overlay_rerender_the_frames(page, live_server) -> None:
     level5 = wait_new(page, PERTURBED, perturbed["url"])
     assert "severity=5" in level5["url"] and level5["src"] != perturbed["src"]
     assert page.evaluate(PIXEL_HASH, PERTURBED) != level3
-    assert page.locator(f'{CARD} figure[data-role="perturbed"] figcaption').inner_text() == "Perturbed · level 5"
+    assert page.locator(f'{CARD} figure[data-role="perturbed"] .frame__label').inner_text() == "Perturbed · level 5"
     assert shown(page, ORIGINAL)["url"] == original["url"]  # severity leaves the original alone
 
     azimuth_value = page.locator(f'{CARD} output[data-output="azimuth"]')
@@ -94,9 +100,13 @@ def test_sliders_and_overlay_rerender_the_frames(page, live_server) -> None:
     assert page.evaluate(PIXEL_HASH, ORIGINAL) != before
     sunny = wait_new(page, PERTURBED, level5["url"])
     assert "sun_azimuth=120" in sunny["url"] and "severity=5" in sunny["url"]
+    altitude = page.locator(f"{CARD} input[data-control=altitude]").input_value()
+    captions = page.locator(f"{CARD} .frame__label").all_inner_texts()
+    assert captions == [f"Original · sun 120° / {altitude}°", f"Perturbed · level 5 · sun 120° / {altitude}°"]
 
     before = page.evaluate(PIXEL_HASH, PERTURBED)
     page.locator(f"{CARD} input[data-control=altitude]").fill("20")
+    assert page.locator(f'{CARD} figure[data-role="perturbed"] .frame__label').inner_text().endswith("120° / 20°")
     low_sun = wait_new(page, PERTURBED, sunny["url"])
     assert "sun_altitude=20" in low_sun["url"]
     assert page.evaluate(PIXEL_HASH, PERTURBED) != before
@@ -125,7 +135,10 @@ def test_a_slider_drag_ends_on_the_latest_value_with_few_requests(page, live_ser
     assert "severity=1" in final["url"]
     page.wait_for_timeout(400)
     assert shown(page, PERTURBED)["url"] == final["url"]
-    assert len(requested) == 1, requested
+    images = [url for url in requested if ".jpg?" in url]
+    scores = [url for url in requested if "/detections?" in url]
+    assert len(images) == 1 and len(scores) == 1, requested  # the picture and its detector's score
+    assert "severity=1" in scores[0] and "detector=ufld" in scores[0]
 
 
 def test_reset_returns_to_the_first_render(page, live_server) -> None:
@@ -211,3 +224,74 @@ def test_listing_and_registry_errors_are_shown(page, live_server) -> None:
     banner = page.locator("#page-error")
     banner.wait_for(state="visible", timeout=TIMEOUT_MS)
     assert "registry exploded" in banner.inner_text()
+
+
+SCORE = f'{CARD} figure[data-role="{{}}"] .frame__score'
+# True once the score line of `sel` shows an answer for a URL holding `part` (not a placeholder).
+SCORED = """([sel, part]) => {
+  const line = document.querySelector(sel);
+  return line && !line.hidden && (line.dataset.src || "").includes(part)
+    && ["fooled", "holds"].includes(line.dataset.verdict);
+}"""
+
+
+def wait_scored(page, role: str, part: str) -> str:
+    page.wait_for_function(SCORED, arg=[SCORE.format(role), part], timeout=TIMEOUT_MS)
+    return page.locator(SCORE.format(role)).inner_text()
+
+
+def test_detector_lanes_and_accuracy_captions(page, live_server, screenshot_dir) -> None:
+    original, perturbed = open_card(page, live_server)
+    select = page.locator("#detector-select")
+    assert select.input_value() == "ufld"  # the default
+    assert "detector=ufld" in original["url"] and "detector=ufld" in perturbed["url"]
+    for role in ("original", "perturbed"):
+        text = wait_scored(page, role, "detector=ufld")
+        assert re.fullmatch(r"ufld · accuracy\s\d{1,3}\.\d% · FP\s-?\d(\.\d\d?)? · FN\s\d(\.\d\d?)?", text), text
+    detections = page.evaluate(f"""() => fetch(document.querySelector('{SCORE.format("perturbed")}').dataset.src)
+      .then((r) => r.json())""")
+    assert f"\xa0{100 * detections['accuracy']:.1f}%" in page.locator(SCORE.format("perturbed")).inner_text()
+    page.locator(CARD).screenshot(path=str(screenshot_dir / "demo-card-detector.png"))
+
+    before = page.evaluate(PIXEL_HASH, PERTURBED)
+    select.select_option("hough")
+    hough = wait_new(page, PERTURBED, perturbed["url"])
+    assert "detector=hough" in hough["url"] and page.evaluate(PIXEL_HASH, PERTURBED) != before
+    assert wait_scored(page, "perturbed", "detector=hough").startswith("hough · accuracy\xa0")
+
+    page.locator(f"{CARD} input[data-control=azimuth]").fill("150")  # a slider moves the score with the frame
+    assert wait_scored(page, "original", "sun_azimuth=150").startswith("hough · accuracy\xa0")
+    assert "sun 150°" in page.locator(f'{CARD} figure[data-role="original"] .frame__label').inner_text()
+
+    select.select_option("")
+    plain = wait_new(page, PERTURBED, hough["url"])
+    assert "detector" not in plain["url"]
+    assert page.locator(f"{CARD} .frame__score:visible").count() == 0
+
+
+def test_unavailable_detectors_are_listed_disabled(page, live_server) -> None:
+    body = {"data": [{"name": "ufld", "kind": "learned", "available": False, "reason": "no ufld model",
+                      "model": None},
+                     {"name": "hough", "kind": "classical", "available": True, "reason": None, "model": None}],
+            "count": 2}
+    page.route("**/api/detectors", lambda route: route.fulfill(status=200, content_type="application/json",
+                                                              body=json.dumps(body)))
+    _, perturbed = open_card(page, live_server)
+    assert page.locator("#detector-select").input_value() == "hough"  # the default is not installed
+    assert page.locator("#detector-select option[value=ufld]").is_disabled()
+    assert "detector=hough" in perturbed["url"]
+
+
+def test_editor_link_opens_the_cards_case(page, live_server) -> None:
+    opened: list[str] = []
+    live_server.app.state.editor_port = 1  # a port nothing listens on: only the redirect is followed here
+    live_server.app.state.open_in_editor = opened.append
+    open_card(page, live_server)
+    link = page.locator(f"{CARD} .card__edit")
+    assert link.get_attribute("href") == "/editor?case=fence_shadow-03_level3"
+    with page.expect_request("**/editor?case=*"):
+        link.click(no_wait_after=True)
+    deadline = time.monotonic() + 10
+    while not opened and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert opened == ["fence_shadow-03_level3"]

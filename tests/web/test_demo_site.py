@@ -123,3 +123,16 @@ def test_frame_url_the_page_builds_renders_a_jpeg(client) -> None:
     assert response.status_code == 200
     assert response.headers["content-type"] == "image/jpeg"
     assert response.content[:2] == b"\xff\xd8"
+
+
+def test_detector_select_and_score_line(client, page: PageParser) -> None:
+    """The toolbar's detector select (filled from /api/detectors) and the score line under each frame."""
+    assert page.find("select", id="detector-select") and page.find("label", for_="detector-select")
+    assert any("hidden" in a for a in page.find("span", class_="frame__score"))
+    assert "/static/js/latest-score.js" in static_references(page)
+    names = [entry["name"] for entry in client.get("/api/detectors").json()["data"]]
+    assert "ufld" in names  # the page's default
+    response = client.get("/api/cases/fence_shadow-03_level3/frames/0/detections",
+                          params={"width": 160, "height": 90, "detector": "hough", "severity": 5, "sun_azimuth": 90,
+                                  "sun_altitude": 30})
+    assert response.status_code == 200 and 0.0 <= response.json()["accuracy"] <= 1.0

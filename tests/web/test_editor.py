@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from app.editor import EditError, Editor, launch_editor
+from app.editor.detection import rate_text
 from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
 from app.editor.session import CaseSession
 from app.frames import FrameService
@@ -222,8 +223,9 @@ def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(editor: Editor, 
         assert request.detector == name and request.overlay
         found = state.frames.detection(request.case, request.frame, request.size, name)
         text = editor.panel.detection.content
-        assert f"**{name}**" in text and f"accuracy **{found.accuracy:.2f}**" in text
-        assert f"FP {found.fp:.2f}" in text and f"FN {found.fn:.2f}" in text
+        assert f"**{name}**" in text and f"accuracy **{100 * found.accuracy:.1f}%**" in text
+        assert f"FP {rate_text(found.fp)} · FN {rate_text(found.fn)}" in text
+        assert ("fooled**" in text) == (found.fp > 0 or found.fn > 0)
         assert 0.002 < np.any(shown[name] != plain, axis=2).mean() < 0.5  # magenta bands under the labels
     assert not np.array_equal(shown["hough"], shown["ufld"])
 

@@ -81,3 +81,41 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, stat
     stored = state.store.get(case_id).case.illusions[-1]
     assert stored.type == "vehicle" and stored.severity == 5 and stored.s == placed.s
     page.close()
+
+
+def pick(page, current: str, option: str) -> None:
+    """Choose ``option`` in the viser dropdown that now shows ``current``."""
+    combos = page.locator("input[role=combobox]")
+    index = combos.evaluate_all(f"(inputs) => inputs.findIndex((i) => i.value === {current!r})")
+    assert index >= 0, f"no dropdown shows {current!r}"
+    combos.nth(index).click()
+    page.get_by_role("option", name=option, exact=True).click()
+
+
+def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: Editor,
+                                                               screenshot_dir: Path) -> None:
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(SHOT_MS)
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    preview = page.locator("img[src^='blob:']").first
+    preview.wait_for(timeout=WAIT_S * 1000)
+    assert editor.preview.wait_idle(WAIT_S)
+    time.sleep(2)
+    before = preview.screenshot(timeout=SHOT_MS)
+    seen = [before]
+    for current, name in (("none", "hough"), ("hough", "ufld")):
+        pick(page, current, name)
+        wait_for(lambda: editor.panel.detector.value == name, f"the Detector dropdown at {name}")
+        assert editor.preview.wait_idle(WAIT_S)
+        score = page.get_by_text(f"{name} (magenta):").first
+        score.wait_for(timeout=WAIT_S * 1000)
+        time.sleep(2)
+        shot = preview.screenshot(timeout=SHOT_MS)
+        assert shot not in seen, f"the preview did not change with the {name} detector"
+        seen.append(shot)
+        assert "accuracy" in score.locator("xpath=..").inner_text()
+    page.mouse.move(400, 450)  # off the panel: no hover hint over the dropdowns
+    time.sleep(1)
+    page.screenshot(path=str(screenshot_dir / "editor_4_detector.png"), timeout=SHOT_MS)
+    page.close()
