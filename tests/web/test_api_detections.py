@@ -65,8 +65,8 @@ def test_detections_are_scored_against_the_labels_and_cached(client, state, dete
     assert state.frames.detector_runs == runs  # served from the frame service's cache
 
 
-def test_ground_truth_as_detection_scores_perfectly(client, state) -> None:
-    """The score uses the labels of the same frame: the learned model on this clean-looking frame is near them."""
+def test_detections_are_scored_against_the_frames_own_labels(client, state) -> None:
+    """GT lanes and rows are the frame's TuSimple labels at its size; the learned model finds most of them."""
     body = client.get(f"{FRAME}/0/detections?detector=ufld&{SIZE}").json()
     labels = state.frames.frame(state.store.get(SHADOW_ID).case, 0, (320, 180)).record
     assert body["gt_lanes"] == labels["lanes"] and body["h_samples"] == labels["h_samples"]
