@@ -12,15 +12,14 @@ from __future__ import annotations
 import importlib.util
 import json
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal
 
+from .detect.learned import SHIPPED_MODELS
 from .detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE
 from .detect.split import DETECTORS, LEARNED_METHODS, METHODS
 from .metrics.formats import LaneFileError
 
 DetectorKind = Literal["learned", "classical"]
-SHIPPED_MODELS = Path(__file__).resolve().parent / "detect" / "models"
 # training.json keys shown as a learned model's summary
 SUMMARY_KEYS = ("val_accuracy", "epochs", "train_frames", "val_frames", "data", "augment")
 

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -77,3 +81,11 @@ def test_detections_are_drawn_in_their_own_colour() -> None:
     assert colours and all(c[1] < 60 and c[0] > 100 and c[2] > 100 for c in colours)  # magenta (antialiased)
     labelled = draw_lanes(drawn, {"lanes": lanes, "h_samples": rows})
     assert tuple(labelled[50, 40]) == LANE_COLORS[0]  # a label's dot sits on top of the band
+
+
+def test_detection_modules_import_no_web_framework() -> None:
+    code = ("import sys, lanevil_core.detector_catalog, lanevil_core.frame_detection; "
+            "print(','.join(m for m in ('fastapi', 'viser', 'uvicorn', 'starlette', 'torch') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=Path(__file__).resolve().parents[2])
+    assert out.stdout.strip() == ""
