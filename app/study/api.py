@@ -257,16 +257,30 @@ def _csv_response(text: str, filename: str) -> Response:
 
 # --- participants --------------------------------------------------------------------------------------------------
 
+def _counts(db: sqlite3.Connection, study_id: str) -> dict[str, int]:
+    items = study_items(db, study_id)
+    return {"training_items": sum(item.role == "training" for item in items),
+            "rated_items": sum(item.scored for item in items)}
+
+
+@router.get("/open", summary="Studies open to participants (for the /study page)")
+def get_open_studies(db: DbDep) -> list[dict[str, Any]]:
+    """Every study that is ready, newest first: what the ``/study`` page lists for people who want to take part."""
+    ready = [study for study in reversed(list_studies(db)) if study.status == "ready"]
+    return [{"id": study.id, "title": study.title, "question": study.question, "viewing_ms": study.viewing_ms,
+             "participant_url": f"/study/{study.id}", **_counts(db, study.id)} for study in ready]
+
+
 @router.get("/studies/{study_id}/public", summary="What a participant sees before consenting", responses=NO_STUDY)
-def get_public(study_id: str, db: DbDep) -> dict[str, Any]:
+def get_public(study_id: str, db: DbDep, state: StateDep) -> dict[str, Any]:
+    """Also ``preparing`` (``{"done", "total"}`` images) while the study's images are still being rendered."""
     with answers():
         study = get_study(db, study_id)
-    items = study_items(db, study_id)
+    job = _job(state, study.job_id) if study.status == "rendering" else None
     return {"id": study.id, "title": study.title, "question": study.question, "consent_text": study.consent_text,
             "instructions": study.instructions, "viewing_ms": study.viewing_ms, "width": study.width,
-            "height": study.height, "status": study.status,
-            "training_items": sum(item.role == "training" for item in items),
-            "rated_items": sum(item.scored for item in items)}
+            "height": study.height, "status": study.status, **_counts(db, study_id),
+            "preparing": {"done": job["done"], "total": job["total"]} if job else None}
 
 
 def _ready(study: Study) -> None:

@@ -1,6 +1,7 @@
-"""The study's HTML pages: ``/study/<study_id>`` for participants, ``/study/admin`` for the organiser.
+"""The study's HTML pages: ``/study`` (what the study is, the open studies, the way to the organiser's page),
+``/study/<study_id>`` for participants, ``/study/admin`` for the organiser (results, and creating studies).
 
-Both are static files from ``static/study/`` (plain HTML, CSS and JavaScript, served at ``/static/study/``) that
+All are static files from ``static/study/`` (plain HTML, CSS and JavaScript, served at ``/static/study/``) that
 talk to ``/api/study``. The participant page is answered with 404 for an unknown study id.
 """
 
@@ -27,6 +28,11 @@ def _page(name: str) -> FileResponse:
     if not path.is_file():
         raise HTTPException(404, detail=f"the study pages are not installed (static/study/{name})")
     return FileResponse(path, media_type="text/html", headers={"Cache-Control": "no-cache"})
+
+
+@router.get("")
+def landing_page() -> FileResponse:
+    return _page("index.html")
 
 
 @router.get("/admin")

@@ -38,7 +38,7 @@ async function listStudies() {
       const row = body.insertRow();
       cell(row, study.title);
       cell(row, study.id);
-      cell(row, study.status);
+      cell(row, statusText(study, detail));
       cell(row, String(detail.items.length), true);
       cell(row, String(study.participants), true);
       const link = document.createElement("a");
@@ -50,11 +50,20 @@ async function listStudies() {
       button.addEventListener("click", () => showResults(study.id));
       cell(row, "").append(button);
     }
-    $("studies").hidden = false;
+    $("studies").hidden = studies.length === 0;
+    $("no-studies").hidden = studies.length > 0;
+    $("create").hidden = false;
+    document.dispatchEvent(new CustomEvent("organiser-ready"));
     if (location.hash.length > 1) showResults(location.hash.slice(1));
   } catch (error) {
     $("admin-error").textContent = error.message;
   }
+}
+
+function statusText(study, detail) {
+  if (study.status === "rendering" && detail.job) return `rendering ${detail.job.done}/${detail.job.total}`;
+  if (study.status === "failed") return `failed: ${study.error || "see the server log"}`;
+  return study.status;
 }
 
 function itemLabel(item) {
@@ -132,4 +141,5 @@ document.addEventListener("DOMContentLoaded", () => {
     listStudies();
   });
   if ($("token").value) listStudies();
+  document.addEventListener("study-created", listStudies);
 });

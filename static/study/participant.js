@@ -6,6 +6,7 @@ const STUDY_ID = decodeURIComponent(location.pathname.split("/").filter(Boolean)
 const API = `/api/study/studies/${STUDY_ID}`;
 const STORAGE_KEY = `lanevil-study:${STUDY_ID}`;
 const POST_RETRIES = 4;
+const PREPARING_POLL_MS = 2000;
 
 const state = {study: null, plan: null, index: 0, rated: new Set(), scaleShownAt: 0, accepting: false};
 
@@ -70,8 +71,31 @@ async function start() {
     if (plan.status === 200) return resume(plan.data);
     localStorage.removeItem(STORAGE_KEY);
   }
-  if (state.study.status !== "ready") return fail("This study is not open yet. Please try again later.");
+  if (state.study.status === "rendering") return waitUntilReady();
+  if (state.study.status !== "ready") {
+    $("unavailable-text").textContent = "Its images could not be prepared, so it cannot start. Please tell the " +
+      "person who sent you the link.";
+    return show("unavailable");
+  }
   show("consent");
+}
+
+// A study whose images are still rendering: show how far it is and open it once it is ready.
+async function waitUntilReady() {
+  show("preparing");
+  for (;;) {
+    const preparing = state.study.preparing;
+    if (preparing && preparing.total) {
+      $("preparing-fill").style.width = `${(100 * preparing.done) / preparing.total}%`;
+      $("preparing-text").textContent = `${preparing.done} of ${preparing.total} images ready.`;
+    } else {
+      $("preparing-text").textContent = "Waiting for the images…";
+    }
+    await new Promise((resolve) => setTimeout(resolve, PREPARING_POLL_MS));
+    const answer = await request("GET", `${API}/public`).catch(() => null);
+    if (answer && answer.status === 200) state.study = answer.data;
+    if (state.study.status !== "rendering") return start();
+  }
 }
 
 function resume(plan) {

@@ -289,3 +289,31 @@ def test_new_study_is_listed(client) -> None:
     listing = client.get("/api/study/studies", headers=ADMIN).json()
     assert [entry["id"] for entry in listing] == [study["id"]] and listing[0]["participants"] == 0
     assert time.time() - listing[0]["created_at"] < 600
+
+
+def test_the_study_landing_page_is_served(client) -> None:
+    response = client.get("/study")
+    assert response.status_code == 200 and response.headers["content-type"].startswith("text/html")
+    assert "Open studies" in response.text and 'href="/study/admin"' in response.text
+    assert client.get("/static/study/index.js").status_code == 200
+    assert client.get("/static/study/create.js").status_code == 200
+
+
+def test_open_studies_lists_ready_studies_for_everyone(client, state) -> None:
+    assert client.get("/api/study/open").json() == []
+    ready = client.post("/api/study/studies", headers=ADMIN,
+                        json={"title": "Open one", **SIZE, "generated": {"cases": ["clean-00_straight_urban"]}}).json()
+    spec = {"title": "Still rendering", **SIZE, "generated": {"cases": ["clean-00_straight_urban",
+                                                                       "fence_shadow-05_level5"],
+                                                             "frames": [0, 10, 20, 30, 40]}}
+    rendering = create(client, spec).json()
+    assert rendering["status"] == "rendering"
+    public = client.get(f"/api/study/studies/{rendering['id']}/public").json()
+    assert public["status"] == "rendering" and public["preparing"]["total"] == 10
+    listed = client.get("/api/study/open").json()  # no token needed
+    assert [entry["id"] for entry in listed] == [ready["id"]]
+    assert listed[0] == {"id": ready["id"], "title": "Open one", "question": ready["question"], "viewing_ms": 3000,
+                         "participant_url": f"/study/{ready['id']}", "training_items": 0, "rated_items": 1}
+    assert state.jobs.get(rendering["job"]["id"]).finished.wait(120)
+    assert client.get(f"/api/study/studies/{rendering['id']}/public").json()["preparing"] is None
+    assert len(client.get("/api/study/open").json()) == 2
