@@ -8,7 +8,6 @@ malformed (a rating outside 1-5 included).
 
 from __future__ import annotations
 
-import json
 import secrets
 import sqlite3
 from collections.abc import Iterator
@@ -80,11 +79,11 @@ SPEC_EXAMPLE = {"title": "How natural do these road scenes look?", "viewing_seco
 CREATE_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {
     "multipart/form-data": {
         "schema": {"type": "object", "required": ["spec"], "properties": {
-            "spec": {"type": "string", "description": "the study spec as JSON (schema: StudySpec)",
-                     "default": json.dumps(SPEC_EXAMPLE, indent=2)},
-            "files": {"type": "array", "items": {"type": "string", "format": "binary"},
+            "spec": {"$ref": "#/components/schemas/StudySpec", "description": "the study spec, sent as JSON text",
+                     "example": SPEC_EXAMPLE},
+            "files": {"type": "array", "items": {"type": "string", "format": "binary"}, "default": [],
                       "description": "real images (PNG or JPEG); an item names one by its file name (`upload`)"}}},
-        "encoding": {"files": {"contentType": "image/png, image/jpeg"}}},
+        "encoding": {"spec": {"contentType": "application/json"}, "files": {"contentType": "image/png, image/jpeg"}}},
     "application/json": {"schema": {"$ref": "#/components/schemas/StudySpec"}, "example": SPEC_EXAMPLE},
 }}}
 
@@ -119,7 +118,11 @@ def answers() -> Iterator[None]:
 # --- organiser ---------------------------------------------------------------------------------------------------
 
 @router.post("/studies", status_code=201, summary="Create a study (organiser)", openapi_extra=CREATE_BODY,
-             responses={202: {"description": "the study, still rendering, and its render job"}, **ORGANISER,
+             responses={201: {"description": "the study, ready: `id`, `status`, `participant_url`, `items` (each "
+                                             "with its `image_url`) and `job`: null",
+                              "content": {"application/json": {"schema": {"type": "object"}}}},
+                        202: {"description": "the study, still `rendering`, and its render `job`",
+                              "content": {"application/json": {"schema": {"type": "object"}}}}, **ORGANISER,
                         413: _error("an upload over `max_upload_bytes` (`field`: `files.<n>`), or the request over "
                                     "the server's body limit")})
 async def post_study(request: Request, state: StateDep, _: AdminDep) -> JSONResponse:
@@ -155,11 +158,17 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
                              ) from None
     form = await request.form(max_files=MAX_UPLOAD_FILES)
     raw_spec = form.get("spec")
-    if not isinstance(raw_spec, str):
-        raise http_error(422, "spec", "the form needs a text field 'spec' holding the study spec as JSON")
+    if isinstance(raw_spec, UploadFile):  # a JSON part, as /docs and generated clients send it
+        raw_spec = await raw_spec.read(state.settings.max_body_bytes + 1)
+        if len(raw_spec) > state.settings.max_body_bytes:
+            raise http_error(413, "spec", f"the spec is over {state.settings.max_body_bytes} bytes")
+    if not isinstance(raw_spec, str | bytes):
+        raise http_error(422, "spec", "the form needs a field 'spec' holding the study spec as JSON")
     spec = _parse_spec(raw_spec)
     uploads: dict[str, CheckedUpload] = {}
     for index, upload in enumerate(form.getlist("files")):
+        if upload == "":  # an empty file input, as browsers send it, is no upload
+            continue
         if not isinstance(upload, UploadFile):
             raise http_error(422, f"files.{index}", "each 'files' part must be a file")
         name = upload.filename or f"upload-{index}"
@@ -167,6 +176,8 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
         if name in uploads:
             raise http_error(422, field, f"two uploads are named {name!r}; give each file its own name")
         data = await upload.read(state.settings.max_upload_bytes + 1)
+        if not data:  # an empty file part is no upload either
+            continue
         if len(data) > state.settings.max_upload_bytes:
             raise http_error(413, field, f"{name} is over {state.settings.max_upload_bytes} bytes")
         try:

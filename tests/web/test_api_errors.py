@@ -160,7 +160,9 @@ def test_openapi_describes_study_creation(client) -> None:
     content = create["requestBody"]["content"]
     form = content["multipart/form-data"]["schema"]
     assert form["required"] == ["spec"] and form["properties"]["files"]["items"]["format"] == "binary"
-    assert json.loads(form["properties"]["spec"]["default"])["title"]
+    assert form["properties"]["spec"]["$ref"] == "#/components/schemas/StudySpec"
+    assert form["properties"]["spec"]["example"]["title"]
+    assert content["multipart/form-data"]["encoding"]["spec"]["contentType"] == "application/json"
     assert content["application/json"]["schema"] == {"$ref": "#/components/schemas/StudySpec"}
     assert {"StudySpec", "ItemSpec", "GeneratedSet"} <= set(schema["components"]["schemas"])
     assert {"201", "202", "401", "403", "413", "415", "422"} <= set(create["responses"])

@@ -317,3 +317,14 @@ def test_open_studies_lists_ready_studies_for_everyone(client, state) -> None:
     assert state.jobs.get(rendering["job"]["id"]).finished.wait(120)
     assert client.get(f"/api/study/studies/{rendering['id']}/public").json()["preparing"] is None
     assert len(client.get("/api/study/open").json()) == 2
+
+
+def test_spec_may_come_as_a_json_part_and_empty_file_parts_are_skipped(client) -> None:
+    """What /docs (Swagger UI) and generated clients send: the spec as an application/json part, an empty file."""
+    spec = {"title": "From a client", **SIZE, "generated": {"cases": ["clean-00_straight_urban"]}}
+    parts = [("spec", ("blob", json.dumps(spec).encode(), "application/json")),
+             ("files", ("", b"", "application/octet-stream")),
+             ("files", ("real.png", image_bytes(3), "image/png"))]
+    response = client.post("/api/study/studies", files=parts, headers=ADMIN)
+    assert response.status_code == 201, response.text
+    assert [item["upload_name"] for item in response.json()["items"]] == [None, "real.png"]
