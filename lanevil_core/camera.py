@@ -95,16 +95,51 @@ def intrinsics_for(camera: Camera, size: tuple[int, int] | None = None) -> Intri
     return Intrinsics.from_fov(width, height, camera.fov)
 
 
-def ego_camera(case: Case, network: RoadNetwork, frame: int, size: tuple[int, int] | None = None) -> PinholeCamera:
-    """The ego camera of frame ``frame``: the vehicle sits on its lane centre, aligned with the road."""
+@dataclass(frozen=True)
+class VehiclePose:
+    """The ego vehicle on the road: world position of its origin (m) and heading (radians, counter-clockwise
+    from world +X). Height and pitch follow the road under it."""
+
+    x: float
+    y: float
+    yaw: float
+
+
+def scripted_vehicle_transform(case: Case, network: RoadNetwork, frame: int) -> FloatArray:
+    """(4, 4) ``T_world_vehicle`` of frame ``frame`` of the case's scripted drive: on its lane centre, aligned with
+    the road. Vehicle frame: +X forward (along the grade), +Y left (horizontal), +Z up."""
+    s_road = case.ego_s(frame)
+    t_road = network.lane_center_t(case.ego.lane)
+    p_world, forward, left = network.main.line.frame(s_road)
+    return _transform(p_world + left * t_road, forward, left)
+
+
+def vehicle_transform(network: RoadNetwork, pose: VehiclePose) -> FloatArray:
+    """(4, 4) ``T_world_vehicle`` of a vehicle at ``pose`` standing on the main road's surface: its height is the
+    road's at its station, its pitch the road's slope along its heading (no roll)."""
     line = network.main.line
-    s_ego = case.ego_s(frame)
-    t_ego = network.lane_center_t(case.ego.lane)
-    p_world_vehicle, forward, left = line.frame(s_ego)
-    p_world_vehicle = p_world_vehicle + left * t_ego
-    up = np.cross(forward, left)
-    cam = case.camera
-    p_world_camera = p_world_vehicle + cam.x * forward + cam.y * left + cam.z * up
+    s_road, _ = line.station(np.array([pose.x, pose.y]))
+    z = float(line.z_at(s_road))
+    slope = float(line.grade_at(s_road)) * float(np.cos(pose.yaw - line.heading_at(s_road)))
+    forward = np.array([np.cos(pose.yaw), np.sin(pose.yaw), slope]) / np.sqrt(1.0 + slope**2)
+    left = np.array([-np.sin(pose.yaw), np.cos(pose.yaw), 0.0])
+    return _transform(np.array([pose.x, pose.y, z]), forward, left)
+
+
+def _transform(p_world: FloatArray, forward: FloatArray, left: FloatArray) -> FloatArray:
+    T_world_vehicle = np.eye(4)
+    T_world_vehicle[:3, 0], T_world_vehicle[:3, 1] = forward, left
+    T_world_vehicle[:3, 2], T_world_vehicle[:3, 3] = np.cross(forward, left), p_world
+    return T_world_vehicle
+
+
+def mounted_camera(cam: Camera, T_world_vehicle: FloatArray, size: tuple[int, int] | None = None) -> PinholeCamera:
+    """The case camera mounted on a vehicle at ``T_world_vehicle`` (4, 4), optionally at another image size."""
+    forward, left, up = (T_world_vehicle[:3, i] for i in range(3))
+    p_world_camera = T_world_vehicle[:3, 3] + cam.x * forward + cam.y * left + cam.z * up
+    if cam.yaw:  # turn the mount about the vehicle's up axis
+        yaw = np.radians(cam.yaw)
+        forward, left = np.cos(yaw) * forward + np.sin(yaw) * left, np.cos(yaw) * left - np.sin(yaw) * forward
     pitch = np.radians(cam.pitch)
     z_axis = np.cos(pitch) * forward - np.sin(pitch) * up  # optical axis, pitched down for pitch > 0
     y_axis = -(np.cos(pitch) * up + np.sin(pitch) * forward)  # image down
@@ -113,3 +148,14 @@ def ego_camera(case: Case, network: RoadNetwork, frame: int, size: tuple[int, in
     T_world_camera[:3, 0], T_world_camera[:3, 1], T_world_camera[:3, 2] = x_axis, y_axis, z_axis
     T_world_camera[:3, 3] = p_world_camera
     return PinholeCamera(intrinsics_for(cam, size), T_world_camera)
+
+
+def ego_camera(case: Case, network: RoadNetwork, frame: int, size: tuple[int, int] | None = None) -> PinholeCamera:
+    """The ego camera of frame ``frame``: the vehicle sits on its lane centre, aligned with the road."""
+    return mounted_camera(case.camera, scripted_vehicle_transform(case, network, frame), size)
+
+
+def pose_camera(case: Case, network: RoadNetwork, pose: VehiclePose,
+                size: tuple[int, int] | None = None) -> PinholeCamera:
+    """The ego camera of a vehicle at an arbitrary ``pose`` (closed-loop driving)."""
+    return mounted_camera(case.camera, vehicle_transform(network, pose), size)

@@ -107,6 +107,26 @@ class ReferenceLine:
         """Grade dz/ds at ``s_road``."""
         return self._interp(self.grade, np.asarray(s_road, np.float64))
 
+    def z_at(self, s_road: FloatArray | float) -> FloatArray:
+        """Elevation (m) of the reference line at ``s_road``."""
+        return self._interp(self.z, np.asarray(s_road, np.float64))
+
+    def station(self, p_world: FloatArray) -> tuple[float, float]:
+        """Road-frame (s, t) of a world point (its x, y; (2,) or (3,)): the foot of the perpendicular on the line.
+
+        The nearest sample is refined along its tangent (exact on lines, within micrometres on arcs), clamped to
+        the line's ends.
+        """
+        xy = np.asarray(p_world, np.float64)[:2]
+        nearest = int(np.argmin(np.sum((self.xy - xy) ** 2, axis=1)))
+        heading = self.heading[nearest]
+        along = float(np.dot(xy - self.xy[nearest], [np.cos(heading), np.sin(heading)]))
+        s_road = float(np.clip(self.s[nearest] + along, 0.0, self.length))
+        x, y = self._interp(self.xy[:, 0], s_road), self._interp(self.xy[:, 1], s_road)
+        heading = self._interp(self.heading, s_road)
+        t_road = float(np.dot(xy - [x, y], [-np.sin(heading), np.cos(heading)]))
+        return s_road, t_road
+
 
 def _curvature_heading(pieces: list[Piece], s: FloatArray, heading0: float) -> tuple[FloatArray, FloatArray]:
     curvature = np.zeros_like(s)

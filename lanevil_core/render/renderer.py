@@ -113,6 +113,11 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
 
 def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None) -> Frame:
     """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV)."""
+    return render_view(scene, ego_camera(scene.case, scene.network, frame, size))
+
+
+def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:
+    """Render ``scene`` from any camera (e.g. ``camera.pose_camera`` of a vehicle driven in closed loop)."""
     timings: dict[str, float] = {}
     clock = time.perf_counter()
 
@@ -123,7 +128,6 @@ def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None 
         clock = now
 
     packed = pack_scene(scene)
-    camera = ego_camera(scene.case, scene.network, frame, size)
     k = camera.intrinsics
     env = scene.env
     lap("setup")
