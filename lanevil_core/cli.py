@@ -137,17 +137,33 @@ def _run_render(args: argparse.Namespace) -> int:
 def _export_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", type=Path, help="case file (JSON)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
-    parser.add_argument("--frames", default=":", help="START:STOP frame range (default: all)")
+    parser.add_argument("--frames", default=None, help="START:STOP frame range (default: all)")
     parser.add_argument("--format", type=parse_formats, default=frozenset({"tusimple"}), dest="formats",
                         help="label formats, comma-separated: tusimple,culane (default tusimple)")
     parser.add_argument("--glb", action="store_true", help="also write the 3D scene as scene.glb")
+    parser.add_argument("--opendrive", action="store_true",
+                        help="write the road as OpenDRIVE 1.6 (road.xodr); frames only with --frames")
+    parser.add_argument("--openscenario", action="store_true",
+                        help="write the drive as OpenSCENARIO 1.0 (scenario.xosc, with road.xodr); frames only with "
+                             "--frames")
+
+
+def _run_interchange(case: Case, args: argparse.Namespace) -> None:
+    from .interchange import write_interchange
+
+    for path in write_interchange(case, args.out, opendrive=args.opendrive, openscenario=args.openscenario):
+        print(path)
 
 
 def _run_export(args: argparse.Namespace) -> int:
     from .export import export_case
 
     case = load_case(args.case)
-    frames = frame_range(args.frames, case.ego.frames)
+    if args.opendrive or args.openscenario:
+        _run_interchange(case, args)
+        if args.frames is None and not args.glb:
+            return 0
+    frames = frame_range(args.frames if args.frames is not None else ":", case.ego.frames)
 
     def progress(done: int, total: int) -> None:
         print(f"\rframe {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)

@@ -1,0 +1,32 @@
+"""Scenario interchange: a case's road as OpenDRIVE (``road.xodr``) and its drive as OpenSCENARIO
+(``scenario.xosc``), for CARLA and other simulators. Both writers need the ``scenariogeneration`` package, imported
+only when they run. See docs/interchange.md."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..case import Case
+
+XODR_FILE = "road.xodr"
+XOSC_FILE = "scenario.xosc"
+
+
+def write_interchange(case: Case, out_dir: str | Path, opendrive: bool = True,
+                      openscenario: bool = False) -> list[Path]:
+    """Write ``road.xodr`` (with ``opendrive`` or ``openscenario``: the scenario refers to it) and, with
+    ``openscenario``, ``scenario.xosc`` into ``out_dir``; returns the paths written."""
+    from ..compile import compile_scene
+    from .opendrive import write_opendrive
+    from .openscenario import write_openscenario
+
+    scene = compile_scene(case)
+    written = []
+    if opendrive or openscenario:
+        written.append(write_opendrive(case, out_dir, scene))
+    if openscenario:
+        written.append(write_openscenario(case, out_dir, scene))
+    return written
+
+
+__all__ = ["XODR_FILE", "XOSC_FILE", "write_interchange"]
