@@ -6,16 +6,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..case import Case
+from ..case import Case, case_json, write_atomic
 
 XODR_FILE = "road.xodr"
 XOSC_FILE = "scenario.xosc"
+CASE_FILE = "case.json"
 
 
 def write_interchange(case: Case, out_dir: str | Path, opendrive: bool = True,
                       openscenario: bool = False) -> list[Path]:
     """Write ``road.xodr`` (with ``opendrive`` or ``openscenario``: the scenario refers to it) and, with
-    ``openscenario``, ``scenario.xosc`` into ``out_dir``; returns the paths written."""
+    ``openscenario``, ``scenario.xosc`` into ``out_dir``, plus the case itself (``case.json``, whose weather numbers
+    ``scripts/carla_run.py`` applies); returns the interchange files written."""
     from ..compile import compile_scene
     from .opendrive import write_opendrive
     from .openscenario import write_openscenario
@@ -26,7 +28,8 @@ def write_interchange(case: Case, out_dir: str | Path, opendrive: bool = True,
         written.append(write_opendrive(case, out_dir, scene))
     if openscenario:
         written.append(write_openscenario(case, out_dir, scene))
+    write_atomic(Path(out_dir) / CASE_FILE, case_json(case).encode("utf-8"))
     return written
 
 
-__all__ = ["XODR_FILE", "XOSC_FILE", "write_interchange"]
+__all__ = ["CASE_FILE", "XODR_FILE", "XOSC_FILE", "write_interchange"]

@@ -152,7 +152,13 @@ def test_export_command_writes_only_the_interchange_files(tmp_path, make_case):
     save_case(make_case(road={"type": "bend"}), path)
     out = tmp_path / "out"
     assert cli.main(["export", str(path), "--out", str(out), "--opendrive"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["road.xodr"]
+    assert sorted(p.name for p in out.iterdir()) == ["case.json", "road.xodr"]
+
+
+def test_carla_script_explains_what_is_missing(tmp_path):
+    script = Path(__file__).resolve().parents[2] / "scripts" / "carla_run.py"
+    result = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True)
+    assert result.returncode == 2 and "road.xodr is missing" in result.stderr
 
 
 def test_core_imports_no_interchange_package():
