@@ -27,6 +27,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any, Literal
 
 from lanevil_core.case import Case
+from lanevil_core.drive.loop import DriveSettings
 from lanevil_core.export import export_case
 
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
@@ -39,6 +40,7 @@ MAX_PER_CLIENT = 4  # queued or running jobs of one client
 SECONDS_PER_STEP = 0.3  # a frame at 1280x720 before any job has finished (then measured)
 RETRY_AFTER_S = (1, 3600)
 SCRATCH_PREFIX = "lanevil-export-"
+DRIVE_PREFIX = "lanevil-drive-"  # a drive job's output folder: lanevil-drive-<job id>/
 
 
 class JobNotFound(LookupError):
@@ -104,7 +106,7 @@ class JobManager:
         """Delete what an earlier process left in the exports folder: its jobs lived in its memory, so nobody can
         poll or download them any more."""
         for path in self.folder.iterdir():
-            if path.is_dir() and path.name.startswith(SCRATCH_PREFIX):
+            if path.is_dir() and path.name.startswith((SCRATCH_PREFIX, DRIVE_PREFIX)):
                 shutil.rmtree(path, ignore_errors=True)
             elif path.is_file() and (path.suffix == ".zip" or path.name.endswith(".partial")):
                 path.unlink(missing_ok=True)
@@ -119,7 +121,10 @@ class JobManager:
                 del self._jobs[job.id]
         for job in dropped:
             if job.result is not None and job.result.parent == self.folder:
-                job.result.unlink(missing_ok=True)
+                if job.result.is_dir():
+                    shutil.rmtree(job.result, ignore_errors=True)
+                else:
+                    job.result.unlink(missing_ok=True)
 
     def submit(self, kind: str, total: int, work: Callable[[Job, Progress], Path],
                meta: dict[str, Any] | None = None, key: str | None = None, client: str | None = None) -> Job:
@@ -207,6 +212,12 @@ class JobManager:
             raise JobNotFound(f"no job with id {job_id!r}")
         return self.folder / f"{job_id}.zip"
 
+    def drive_folder(self, job_id: str) -> Path:
+        """Where a drive job writes its files (the id is checked, so the path stays in the exports folder)."""
+        if not JOB_ID_PATTERN.fullmatch(job_id):
+            raise JobNotFound(f"no job with id {job_id!r}")
+        return self.folder / f"{DRIVE_PREFIX}{job_id}"
+
     def cancel(self, job_id: str) -> Job:
         """Ask a job to stop: a queued job never starts, a running one stops at its next progress report."""
         job = self.get(job_id)
@@ -244,3 +255,18 @@ def export_zip(case: Case, folder: PurePosixPath, frames: Iterable[int], target:
         zip_folder(Path(scratch), target, folder)
     return target
 
+
+def drive_job(jobs: JobManager, case: Case, settings: DriveSettings, meta: dict[str, Any] | None = None,
+              key: str | None = None, client: str | None = None) -> Job:
+    """Queue a closed-loop drive of ``case``; the job's result is its folder of files (``lanevil_core.drive``).
+    ``key`` and ``client`` as in ``JobManager.submit`` (the same drive shared, a client's share bounded)."""
+    from lanevil_core.drive.outputs import drive_to_folder
+
+    steps = max(1, round(settings.duration(case) * case.ego.fps))
+
+    def work(job: Job, progress: Progress) -> Path:
+        folder = jobs.drive_folder(job.id)
+        drive_to_folder(case, settings, folder, video=True, progress=progress)
+        return folder
+
+    return jobs.submit("drive", steps, work, meta, key=key, client=client)

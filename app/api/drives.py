@@ -1,0 +1,120 @@
+"""Closed-loop drives as background jobs: ``POST /api/drives`` starts one, ``GET /api/drives/{job_id}`` polls it
+(with the summary once done), ``DELETE`` cancels it, ``GET /api/drives/{job_id}/files/{name}`` serves its files
+(``trace.csv``, ``summary.json``, ``trace.png``, ``path.png``, ``drive.mp4`` or ``drive.gif``).
+
+The drive itself is ``lanevil_core.drive`` (docs/drive.md): the renderer in the loop, a detector, a lane estimate,
+a lateral controller and a kinematic bicycle model.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Literal
+
+from fastapi import APIRouter, Request
+from fastapi.responses import FileResponse, JSONResponse
+from pydantic import BaseModel, Field
+
+from lanevil_core.drive.detectors import DRIVE_DETECTORS, GROUND_TRUTH
+from lanevil_core.drive.loop import DriveSettings
+from lanevil_core.drive.outputs import PATH_PLOT_FILE, SUMMARY_FILE, TRACE_FILE, TRACE_PLOT_FILE
+
+from ..frames import case_hash
+from ..jobs import Job, drive_job
+from .deps import StateDep
+from .detectors import checked_detector
+from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from .params import image_size
+
+router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPONSES)
+
+MEDIA_TYPES = {TRACE_FILE: "text/csv", SUMMARY_FILE: "application/json", TRACE_PLOT_FILE: "image/png",
+               PATH_PLOT_FILE: "image/png", "drive.mp4": "video/mp4", "drive.gif": "image/gif"}
+JOB_NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no such drive job"}}
+
+
+class DriveRequest(BaseModel):
+    """Body of ``POST /api/drives``."""
+
+    case_id: str = Field(description="id of a stored case", max_length=200)
+    detector: str = Field(GROUND_TRUTH, description=f"one of {', '.join(DRIVE_DETECTORS)} (gt = the projected "
+                                                    "ground truth, the reference)")
+    controller: Literal["pure_pursuit", "stanley"] = Field("pure_pursuit", description="lateral controller")
+    seconds: float | None = Field(None, gt=0, le=60, description="how long to drive; default the case's drive")
+    width: int = Field(640, description="camera width, pixels (64 to the server's largest)")
+    height: int = Field(360, description="camera height, pixels (64 to the server's largest)")
+
+
+def _files(job: Job) -> list[str]:
+    if job.status != "done" or job.result is None:
+        return []
+    return sorted(path.name for path in job.result.iterdir() if path.name in MEDIA_TYPES)
+
+
+def drive_body(job: Job, request: Request) -> dict[str, Any]:
+    """A drive job's state, its links, and once done its summary and file URLs."""
+    body: dict[str, Any] = {**job.to_dict(), "links": {"self": str(request.url_for("get_drive", job_id=job.id))}}
+    files = _files(job)
+    if files:
+        body["files"] = {name: str(request.url_for("drive_file", job_id=job.id, name=name)) for name in files}
+        body["summary"] = json.loads((job.result / SUMMARY_FILE).read_text(encoding="utf-8"))
+    return body
+
+
+def _drive_job(state: StateDep, job_id: str) -> Job:
+    job = state.jobs.get(job_id)
+    if job.kind != "drive":
+        raise ApiError(404, f"no drive job with id {job_id!r}", "job_id")
+    return job
+
+
+@router.post("/drives", status_code=202, summary="Start a closed-loop drive",
+             responses={202: {"description": "drive queued: poll the Location (GET /api/drives/{job_id})"}})
+def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONResponse:
+    """Drive a stored case with a detector in the loop; poll the returned job for its summary and files."""
+    record = state.store.get(body.case_id)
+    if body.detector not in DRIVE_DETECTORS:
+        raise ApiError(422, f"choose from {', '.join(DRIVE_DETECTORS)}", "detector")
+    if body.detector != GROUND_TRUTH:
+        checked_detector(body.detector)
+    size = image_size(body.width, body.height, record.case, state.settings)
+    settings = DriveSettings(detector=body.detector, controller=body.controller, seconds=body.seconds, size=size)
+    meta = {"case_id": record.id, "case_version": record.version, "detector": body.detector,
+            "controller": body.controller}
+    key = (f"drive:{case_hash(record.case)}:{body.detector}:{body.controller}:{body.seconds}:"
+           f"{body.width}x{body.height}")
+    client = request.client.host if request.client else "unknown"
+    job = drive_job(state.jobs, record.case, settings, meta, key=key, client=client)
+    payload = drive_body(job, request)
+    return JSONResponse(payload, status_code=202, headers={"Location": payload["links"]["self"]})
+
+
+@router.get("/drives/{job_id}", summary="State of a drive job", responses=JOB_NOT_FOUND)
+def get_drive(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
+    """``status``, ``done``/``total`` steps; once ``done`` also ``summary`` (the ASR criterion, max deviation,
+    departures) and ``files``."""
+    return drive_body(_drive_job(state, job_id), request)
+
+
+@router.delete("/drives/{job_id}", summary="Cancel a drive job", responses=JOB_NOT_FOUND)
+def cancel_drive(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
+    """Stop a queued or running drive (it ends as ``cancelled`` after its current step)."""
+    _drive_job(state, job_id)
+    return drive_body(state.jobs.cancel(job_id), request)
+
+
+@router.get("/drives/{job_id}/files/{name}", summary="A file of a finished drive", response_class=FileResponse,
+            responses={200: {"content": {media: {} for media in sorted(set(MEDIA_TYPES.values()))}},
+                       404: {"model": ErrorBody}, 409: {"model": ErrorBody, "description": "not done (yet)"}})
+def drive_file(job_id: str, name: str, state: StateDep) -> FileResponse:
+    """One of the drive's files: ``trace.csv``, ``summary.json``, ``trace.png``, ``path.png``, ``drive.mp4``."""
+    job = _drive_job(state, job_id)
+    if name not in MEDIA_TYPES:
+        raise ApiError(404, f"no file {name!r}: choose from {', '.join(MEDIA_TYPES)}", "name")
+    if job.status != "done" or job.result is None:
+        reason = f"failed: {job.error}" if job.status == "failed" else f"is {job.status} ({job.done}/{job.total})"
+        raise ApiError(409, f"drive {job_id} {reason}", "job_id")
+    path = job.result / name
+    if not path.is_file():
+        raise ApiError(404, f"drive {job_id} has no {name}", "name")
+    return FileResponse(path, media_type=MEDIA_TYPES[name], filename=name)
