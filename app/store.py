@@ -22,6 +22,7 @@ from typing import Any, Literal
 
 from lanevil_core.benchmark_layout import case_illusion_type
 from lanevil_core.case import Case, CaseError, case_json, load_case, parse_case, write_atomic
+from lanevil_core.files import remove_stale_temps
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.stock import CATEGORY_FOLDERS as STOCK_FOLDERS
 
@@ -147,6 +148,7 @@ class CaseStore:
         self.root = Path(root)
         self.folder = self.root / CASES_FOLDER
         self.folder.mkdir(parents=True, exist_ok=True)
+        remove_stale_temps(self.folder)  # what a killed write of an earlier process left
         self._lock = threading.RLock()
         self._records: dict[str, CaseRecord] = {}
         self._listeners: list[Listener] = []

@@ -4,7 +4,9 @@ Subcommands live in ``COMMANDS`` (name -> ``Command``). Another module adds its 
 ``COMMANDS`` dict of the same shape in a file named ``lanevil_core/cli_<anything>.py``; those files are found and
 merged at start-up, so a new subcommand needs no edit here.
 
-User errors (a bad case file, a bad flag value) end with exit status 2 and one line on stderr, never a traceback.
+User errors (a bad case file, a bad flag value, an output path that is a folder) end with exit status 2 and one
+line on stderr, never a traceback. Before a command runs, the temporary files that a killed earlier run left in its
+output folders (``--out``, ``--labels``) are removed (``files.remove_stale_temps``).
 """
 
 from __future__ import annotations
@@ -22,12 +24,16 @@ from typing import NoReturn
 import numpy as np
 
 from .case import Case, CaseError, load_case, write_atomic
+from .files import remove_stale_temps
 from .frame_range import parse_frame_range
 
 PROG = "lanevil"
 EXTENSION_PREFIX = "cli_"
 SCENES_DIR = Path("scenes")
 CLEAN_DIR = SCENES_DIR / "00_clean"
+IMAGE_FORMATS = {".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg"}  # --out suffix -> encoding
+JPEG_QUALITY = 95
+OUTPUT_ARGUMENTS = ("out", "labels")  # path arguments whose folders get their leftover temporary files removed
 
 
 class UsageError(Exception):
@@ -88,6 +94,36 @@ def check_frame(case: Case, frame: int) -> None:
         raise UsageError(f"--frame {frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} frames)")
 
 
+def output_file(path: Path, flag: str, example: str) -> Path:
+    """``path`` if a file can be written there; a ``UsageError`` naming ``flag`` and the path for a folder."""
+    if path.is_dir():
+        raise UsageError(f"{flag} {path}: is a folder; give a file name, e.g. {path / example}")
+    return path
+
+
+def image_path(path: Path, flag: str = "--out") -> Path:
+    """An output image path whose suffix names a format we write (``IMAGE_FORMATS``)."""
+    output_file(path, flag, "frame.png")
+    if path.suffix.lower() not in IMAGE_FORMATS:
+        raise UsageError(f"{flag} {path}: the suffix picks the format; use one of {', '.join(IMAGE_FORMATS)}")
+    return path
+
+
+def encode_image(rgb: np.ndarray, path: Path) -> bytes:
+    """(H, W, 3) uint8 pixels encoded as ``path``'s suffix says (PNG or JPEG)."""
+    from .export import jpeg_bytes, png_bytes
+
+    return png_bytes(rgb) if IMAGE_FORMATS[path.suffix.lower()] == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
+
+
+def remove_leftovers(args: argparse.Namespace) -> None:
+    """Remove what killed writes left in the folders this command writes to (files of running processes stay)."""
+    for name in OUTPUT_ARGUMENTS:
+        value = getattr(args, name, None)
+        if isinstance(value, Path):
+            remove_stale_temps(value if value.is_dir() else value.parent, recursive=value.is_dir())
+
+
 def stock_scenes(root: Path = SCENES_DIR) -> list[Path]:
     """Every case file under ``root`` (``**/*.json``), sorted."""
     return sorted(root.glob("**/*.json"))
@@ -98,7 +134,7 @@ def stock_scenes(root: Path = SCENES_DIR) -> list[Path]:
 def _render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", type=Path, help="case file (JSON)")
     parser.add_argument("--frame", type=int, default=0, help="frame index (default 0)")
-    parser.add_argument("--out", type=Path, required=True, help="output image (PNG)")
+    parser.add_argument("--out", type=Path, required=True, help="output image: .png, or .jpg for JPEG")
     parser.add_argument("--size", type=parse_size, default=None, help="WIDTHxHEIGHT (default: the case camera's)")
     parser.add_argument("--overlay", action="store_true", help="draw the lane labels on the image")
     parser.add_argument("--labels", type=Path, default=None, help="also write the frame's TuSimple record (JSON)")
@@ -119,12 +155,13 @@ def render_image(case: Case, frame_index: int, size: tuple[int, int] | None, ove
 
 
 def _run_render(args: argparse.Namespace) -> int:
-    from .export import png_bytes
-
+    image_path(args.out)
+    if args.labels is not None:
+        output_file(args.labels, "--labels", "labels.json")
     case = load_case(args.case)
     check_frame(case, args.frame)
     rgb, record = render_image(case, args.frame, args.size, args.overlay)
-    write_atomic(args.out, png_bytes(rgb))
+    write_atomic(args.out, encode_image(rgb, args.out))
     if args.labels is not None:
         record["raw_file"] = args.out.name
         write_atomic(args.labels, (json.dumps(record) + "\n").encode("utf-8"))
@@ -158,6 +195,8 @@ def _run_interchange(case: Case, args: argparse.Namespace) -> None:
 def _run_export(args: argparse.Namespace) -> int:
     from .export import export_case
 
+    if args.out.exists() and not args.out.is_dir():
+        raise UsageError(f"--out {args.out}: is a file; give a folder to export into")
     case = load_case(args.case)
     if args.opendrive or args.openscenario:
         _run_interchange(case, args)
@@ -236,7 +275,7 @@ def _run_bench(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Command] = {
-    "render": Command("render one frame to a PNG", _render_arguments, _run_render),
+    "render": Command("render one frame to a PNG or JPEG", _render_arguments, _run_render),
     "export": Command("export frames with TuSimple/CULane labels (and the 3D scene)", _export_arguments, _run_export),
     "preview": Command("render frame 0 of every stock case (and a labelled copy)", _preview_arguments, _run_preview),
     "bench": Command("time the renderer on the stock cases", _bench_arguments, _run_bench),
@@ -268,9 +307,13 @@ def main(argv: Sequence[str] | None = None, extra_commands: dict[str, Command] |
     commands = {**all_commands(), **(extra_commands or {})}
     try:
         args = build_parser(commands).parse_args(argv)
+        remove_leftovers(args)
         return commands[args.command].run(args)
     except (UsageError, CaseError) as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
+        return 2
+    except (IsADirectoryError, NotADirectoryError) as error:  # an output path that names or crosses a folder
+        print(f"{PROG}: error: {error.filename or ''}: {error.strerror or error}", file=sys.stderr)
         return 2
     except OSError as error:  # an unwritable output path, a full disk
         print(f"{PROG}: error: {error.filename or ''}: {error.strerror or error}", file=sys.stderr)

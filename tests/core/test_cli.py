@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
 import sys
 import types
 from functools import partial
@@ -11,7 +13,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from lanevil_core import bench, cli
+from lanevil_core import bench, cli, files
 from lanevil_core.case import save_case
 
 
@@ -78,6 +80,73 @@ def test_user_errors_exit_2_with_one_line(case_file, tmp_path, capsys, argv, nee
     assert cli.main(argv) == 2
     line = _error_line(capsys)
     assert line.startswith("lanevil: error: ") and needle in line
+
+
+@pytest.mark.parametrize(("name", "image_format"), [("f.jpg", "JPEG"), ("f.JPEG", "JPEG"), ("f.png", "PNG")])
+def test_render_writes_the_format_the_suffix_names(case_file, tmp_path, name, image_format):
+    out = tmp_path / name
+    assert cli.main(["render", str(case_file), "--out", str(out), "--size", "160x90"]) == 0
+    with Image.open(out) as image:
+        assert image.format == image_format and image.size == (160, 90)
+
+
+@pytest.mark.parametrize(("argv", "needle"), [
+    (["render", "{case}", "--out", "{tmp}/x.bmp"], "--out {tmp}/x.bmp: the suffix picks the format; use one of "
+                                                   ".png, .jpg, .jpeg"),
+    (["render", "{case}", "--out", "{tmp}/frame"], "--out {tmp}/frame: the suffix picks the format"),
+    (["render", "{case}", "--out", "{tmp}"], "--out {tmp}: is a folder; give a file name, e.g. {tmp}/frame.png"),
+    (["render", "{case}", "--out", "{tmp}/ok.png", "--labels", "{tmp}"], "--labels {tmp}: is a folder"),
+    (["export", "{case}", "--out", "{case}"], "--out {case}: is a file; give a folder"),
+])
+def test_output_paths_are_checked_before_rendering(case_file, tmp_path, capsys, argv, needle):
+    argv = [arg.format(case=case_file, tmp=tmp_path) for arg in argv]
+    assert cli.main(argv) == 2
+    line = _error_line(capsys)
+    assert line.startswith(f"lanevil: error: {needle.format(case=case_file, tmp=tmp_path)}")
+    assert ".tmp" not in line
+
+
+def test_an_output_below_a_file_exits_2_naming_the_users_path(case_file, tmp_path, capsys):
+    out = case_file / "frame.png"  # the case file is not a folder
+    assert cli.main(["render", str(case_file), "--out", str(out), "--size", "64x64"]) == 2
+    line = _error_line(capsys)
+    assert line.startswith(f"lanevil: error: {out}: ") and ".tmp" not in line
+
+
+def test_leftovers_of_a_killed_write_are_removed_at_start(case_file, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead_pid = int(dead.stdout)
+    stale = out / f".frame.png.{dead_pid}.abcd1234.tmp"
+    live = out / f".frame.png.{os.getpid()}.efgh5678.tmp"  # a write of a running process: kept
+    other = out / ".notes.tmp"
+    for path in (stale, live, other):
+        path.write_bytes(b"partial")
+    assert cli.main(["render", str(case_file), "--out", str(out / "frame.png"), "--size", "64x64"]) == 0
+    assert sorted(path.name for path in out.iterdir()) == sorted(["frame.png", live.name, other.name])
+
+
+def test_write_atomic_leaves_nothing_and_names_the_target(tmp_path):
+    target = tmp_path / "a" / "b.bin"
+    files.write_atomic(target, b"data")
+    assert target.read_bytes() == b"data" and [path.name for path in target.parent.iterdir()] == ["b.bin"]
+    with pytest.raises(IsADirectoryError) as error:
+        files.write_atomic(tmp_path / "a", b"data")
+    assert error.value.filename == str(tmp_path / "a")
+    assert [path.name for path in target.parent.iterdir()] == ["b.bin"]
+
+
+def test_stale_temps_are_found_below_a_folder_but_not_in_hidden_ones(tmp_path):
+    nested, hidden = tmp_path / "x" / "y", tmp_path / ".git"
+    nested.mkdir(parents=True)
+    hidden.mkdir()
+    names = [nested / ".f.png.999999999.abc.tmp", hidden / ".f.png.999999999.abc.tmp"]
+    for path in names:
+        path.write_bytes(b"")
+    assert files.remove_stale_temps(tmp_path) == []  # not recursive by default
+    assert files.remove_stale_temps(tmp_path, recursive=True) == [names[0]]
+    assert names[1].exists()
 
 
 def test_not_json_is_a_user_error(tmp_path, capsys):

@@ -141,3 +141,12 @@ def test_id_helpers() -> None:
     assert slugify("  Héllo, World ") == "h-llo-world"
     assert stock_id(PurePosixPath("00_clean/00_straight_urban.json")) == "clean-00_straight_urban"
     assert stock_id(PurePosixPath("30_shadow/fence_shadow/03_level3.json")) == "fence_shadow-03_level3"
+
+
+def test_a_new_store_removes_what_a_killed_write_left(tmp_path: Path) -> None:
+    folder = tmp_path / "data" / "cases"
+    folder.mkdir(parents=True)
+    stale = folder / ".fence.json.999999999.x1y2z3.tmp"
+    stale.write_text("{half a case")
+    store = CaseStore(tmp_path / "data")
+    assert not stale.exists() and len(store) == 0
