@@ -31,6 +31,7 @@ from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
 from .detection import chosen_detector, detection_text, unavailable_text
+from .drive_panel import DrivePanel
 from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
@@ -71,6 +72,8 @@ class Editor:
         self._stopped = threading.Event()
         self.view = SceneView(server.scene)
         self.panel: Panel = build_panel(server.gui, self._case_ids())
+        self.drive = DrivePanel(server.gui, state, lambda: (self._current().case_id, self.case),
+                                lambda: chosen_detector(str(self.panel.detector.value)))
         self.panel.params.on_change = self._guarded(self.set_field)
         self.preview = PreviewWorker(self._render, self._publish, self._preview_failed)
         self._wire()
@@ -92,6 +95,7 @@ class Editor:
         """Stop the preview worker, the player and the viser server."""
         self._stopped.set()
         self._playing.clear()
+        self.drive.stop()
         self._unsubscribe()
         self.preview.stop()
         self.server.stop()

@@ -1,0 +1,42 @@
+"""The editor's Drive folder: a drive job of the open case with the preview's detector, played back in the panel."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from app.editor import Editor, launch_editor
+from app.state import AppState
+
+WAIT_S = 120.0
+
+
+@pytest.fixture
+def editor(state: AppState) -> Iterator[Editor]:
+    editor = launch_editor(state, host="127.0.0.1", port=0)
+    assert editor.preview.wait_idle(WAIT_S)
+    yield editor
+    editor.stop()
+
+
+def test_drive_button_runs_the_open_case_and_plays_it(editor: Editor) -> None:
+    editor.drive.seconds.value = 1.0
+    job = editor.drive.start()
+    assert job is not None and job.kind == "drive"
+    assert job.meta["detector"] == "gt"  # the preview shows no detector: the ground truth drives
+    assert job.finished.wait(WAIT_S) and job.status == "done", job.error
+    deadline = time.monotonic() + 10
+    while not editor.drive.frames and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert len(editor.drive.frames) == 10 and editor.drive.frames[0].shape == (360, 640, 3)
+    assert "no success" in editor.drive.status.content and not editor.drive.replay.disabled
+
+
+def test_drive_uses_the_preview_detector(editor: Editor) -> None:
+    editor.set_detector("hough")
+    editor.drive.seconds.value = 1.0
+    job = editor.drive.start()
+    assert job is not None and job.meta["detector"] == "hough"
+    assert job.finished.wait(WAIT_S) and job.status == "done", job.error
