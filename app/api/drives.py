@@ -23,7 +23,7 @@ from ..frames import case_hash
 from ..jobs import Job, drive_job
 from .deps import StateDep
 from .detectors import checked_detector
-from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
 from .params import image_size
 
 router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -69,7 +69,8 @@ def _drive_job(state: StateDep, job_id: str) -> Job:
 
 
 @router.post("/drives", status_code=202, summary="Start a closed-loop drive",
-             responses={202: {"description": "drive queued: poll the Location (GET /api/drives/{job_id})"}})
+             responses={202: {"description": "drive queued: poll the Location (GET /api/drives/{job_id})"},
+                        404: {"model": ErrorBody, "description": "no case with that id"}, **TOO_MANY})
 def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONResponse:
     """Drive a stored case with a detector in the loop; poll the returned job for its summary and files."""
     record = state.store.get(body.case_id)
