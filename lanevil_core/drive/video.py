@@ -56,7 +56,7 @@ def drive_frame(view: StepView) -> UInt8Array:
     for xs in view.lanes:
         _polyline(image, xs, view.h_samples, DETECTED_RGB, max(3, width // 120))
     for index, xs in enumerate(view.gt_lanes):
-        _polyline(image, xs, view.h_samples, lane_color(index), max(1, width // 640))
+        _polyline(image, xs, view.h_samples, lane_color(index), max(2, width // 400))
     _status(image, view)
     return image
 
