@@ -1,6 +1,6 @@
 """lanevil_core: editable 3D lane-detection robustness cases, a CPU renderer and exact lane ground truth."""
 
-from .camera import Intrinsics, PinholeCamera, ego_camera
+from .camera import Intrinsics, PinholeCamera, VehiclePose, ego_camera, pose_camera
 from .case import (
     Camera,
     Case,
@@ -22,7 +22,7 @@ from .export import export_case
 from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
 from .labels import culane_lines, tusimple_record
 from .overlay import draw_lanes
-from .render import Frame, render_frame
+from .render import Frame, render_frame, render_view
 from .road_layout import RoadNetwork, build_network
 from .scene import CompiledScene
 
@@ -44,6 +44,7 @@ __all__ = [
     "RoadNetwork",
     "Scene",
     "Sun",
+    "VehiclePose",
     "Weather",
     "build_network",
     "case_json",
@@ -55,7 +56,9 @@ __all__ = [
     "export_case",
     "load_case",
     "parse_case",
+    "pose_camera",
     "render_frame",
+    "render_view",
     "save_case",
     "tusimple_record",
 ]
