@@ -157,7 +157,7 @@ def test_carla_script_explains_what_is_missing(tmp_path):
     assert result.returncode == 2 and "road.xodr is missing" in result.stderr
 
 
-def test_core_imports_no_interchange_package():
+def test_core_imports_no_interchange_package_and_no_web_framework():
     code = ("import sys, lanevil_core, lanevil_core.cli, lanevil_core.drive, lanevil_core.interchange; "
-            "assert 'scenariogeneration' not in sys.modules")
+            "bad = [m for m in ('scenariogeneration', 'fastapi', 'viser') if m in sys.modules]; assert not bad, bad")
     subprocess.run([sys.executable, "-c", code], check=True)
