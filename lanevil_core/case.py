@@ -77,6 +77,11 @@ class Road(_Model):
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults)",
     )
+    paint: bool = Field(
+        True,
+        description="false removes every lane marking from the world (the paint-free control: the lane labels "
+        "stay, so a detector that still finds the lanes reads the road's layout, not its paint)",
+    )
 
     @model_validator(mode="after")
     def _fill_markings(self) -> Road:
@@ -128,6 +133,7 @@ class Camera(_Model):
     y: float = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
     z: float = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
     pitch: float = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
+    yaw: float = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
 
 
 class Ego(_Model):

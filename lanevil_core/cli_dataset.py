@@ -44,6 +44,9 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scheduler-timeout", type=float, default=10.0,
                         help="seconds to wait for the scheduler (default 10)")
     parser.add_argument("--seed", type=_count(0), default=0, help="seed of the train variations")
+    parser.add_argument("--no-paint", action="store_true",
+                        help="also render every original test case with its lane paint removed "
+                             "(<case>_nopaint folders, records with \"paint\": false): the paint-free control")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -63,7 +66,7 @@ def _run_dataset(args: argparse.Namespace) -> int:
     else:
         executor = functools.partial(run_local, workers=args.workers)
     settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
-                        train_frames=args.train_frames, seed=args.seed)
+                        train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint)
     try:
         summary = generate_dataset(args.cases, args.out, settings, executor, show_progress=not args.quiet)
     except (PlanError, SchedulerError) as error:

@@ -103,6 +103,12 @@ def _run_report(args: argparse.Namespace) -> int:
             detectors.append(Detector(name, build_report(score_tusimple_files(gt, pred), args.f1, title)))
     except LaneFileError as error:
         raise UsageError(str(error)) from None
+    for detector in detectors:
+        total = detector.report.rows[-1]
+        figures = [f"{label} {100 * stats.accuracy:.2f} %" for label, stats in
+                   (("original", total.original), ("perturbed", total.perturbed), ("paint-free", total.no_paint))
+                   if stats is not None]
+        print(f"{detector.name}: accuracy " + ", ".join(figures))
     if len(detectors) == 1:
         paths = write_report(detectors[0].report, args.out)
     else:

@@ -24,14 +24,19 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--epochs", type=_count(1), default=12, help="default 12")
     parser.add_argument("--batch", type=_count(1), default=16, help="default 16")
     parser.add_argument("--lr", type=float, default=2e-3, help="peak learning rate of AdamW (default 2e-3)")
-    parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste"), default="none",
-                        help="training augmentation / defence (default none)")
+    parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste", "aam"),
+                        default="none",
+                        help="training augmentation / defence: the paper's baselines or aam, Attention Area Mixing "
+                             "with hard examples rendered from training variations (default none)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
     parser.add_argument("--seed", type=_count(0), default=0, help="default 0")
     parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",
                         help="share of the train split's case folders held out for validation (default 0.1)")
     parser.add_argument("--init", type=Path, default=None,
                         help="state dict to initialise the backbone from (e.g. ImageNet ResNet weights)")
+    parser.add_argument("--threads", type=_count(0), default=0,
+                        help="CPU threads (default 0 = every core; use 1 when other work shares the cores: "
+                             "oversubscribed threads make training many times slower)")
     parser.add_argument("--resume", action="store_true", help="continue from MODEL_DIR/checkpoint.pt")
     parser.add_argument("--max-steps", type=_count(1), default=None, help="batches per epoch at most (smoke runs)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -56,7 +61,7 @@ def _run_train(args: argparse.Namespace) -> int:
         settings = TrainSettings(data=args.data, out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,
                                  lr=args.lr, augment=args.augment, device=args.device, seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
-                                 max_steps=args.max_steps)
+                                 max_steps=args.max_steps, threads=args.threads)
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:
         raise UsageError(str(error)) from None

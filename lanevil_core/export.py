@@ -154,9 +154,10 @@ def _dash_spans(s0: float, s1: float, pattern: int, on: float, period: float) ->
     return [(float(a), float(min(a + on, s1))) for a in starts]
 
 
-def paint_mesh(network: RoadNetwork, markings: list[Marking]) -> tuple[FloatArray, IntArray, Float32Array]:
+def paint_mesh(network: RoadNetwork, markings: list[Marking],
+               paint: bool = True) -> tuple[FloatArray, IntArray, Float32Array]:
     """Quads of every paint stripe just above the road: vertices (n, 3), faces (m, 3), colours (m, 3)."""
-    stripes = paint_stripes(network, markings).reshape(-1, STRIPE_COLUMNS)
+    stripes = paint_stripes(network, markings, paint).reshape(-1, STRIPE_COLUMNS)
     vertices, faces, colors = [], [], []
     count = 0
     for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary in stripes:
@@ -184,7 +185,7 @@ def scene_glb(scene: CompiledScene) -> bytes:
     road = road_surface(scene.network)
     gltf_scene.add_geometry(_flat_trimesh(road.vertices, road.faces, MATERIAL_ALBEDO[road.material]),
                             geom_name="road", node_name="road")
-    paint = paint_mesh(scene.network, scene.case.road.markings)
+    paint = paint_mesh(scene.network, scene.case.road.markings, scene.case.road.paint)
     if len(paint[1]):
         gltf_scene.add_geometry(_flat_trimesh(*paint), geom_name="paint", node_name="paint")
     for index, mesh in enumerate(scene.meshes):

@@ -115,7 +115,8 @@ def _painted(main: RoadPiece, index: int, s_road: FloatArray) -> BoolArray:
 
 
 def lane_boundaries_in_view(scene: CompiledScene, camera: PinholeCamera) -> list[BoundaryInView]:
-    """Every boundary of the main road, left to right, sampled from just behind the camera to ``RANGE_M`` ahead."""
+    """Every marked boundary of the main road, left to right, sampled from just behind the camera to ``RANGE_M``
+    ahead. A boundary whose marking is ``none`` has no paint and so no label."""
     main = scene.network.main
     s_camera, _ = camera_station(scene, camera)
     s0 = max(main.s_start, s_camera - BEHIND_M)
@@ -124,6 +125,8 @@ def lane_boundaries_in_view(scene: CompiledScene, camera: PinholeCamera) -> list
     markings = scene.case.road.markings
     views = []
     for index, t_road in enumerate(main.boundaries_t):
+        if markings[index].type == "none":
+            continue
         p_world = main.line.to_world(s_road, float(t_road))
         uv_image, depth = camera.project(p_world)
         uv_image[(depth <= NEAR_M) | ~_painted(main, index, s_road)] = np.nan

@@ -4,6 +4,10 @@ Images are grouped by the extra fields of the split's labels (``category``, ``ty
 marks the clean original cases, 1-5 the perturbed ones. Every figure of a group is the official per-image mean
 over its images (F1 from the group's mean FP and FN), so a category pools the images of its types. Gap =
 Perturbed - Original (negative = the detector lost accuracy under the illusion).
+
+Records with ``"paint": false`` (``lanevil dataset --no-paint``) are the originals rendered with their lane paint
+removed: they form the *paint-free control*, reported beside the originals and never mixed into them. A detector
+that reads the paint scores low there; one that scores high places lanes from the road's layout.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ class Row:
     original: Stats | None
     perturbed: Stats | None
     levels: dict[int, Stats | None]
+    no_paint: Stats | None = None
 
     def gap(self, field: str, level: int | None = None) -> float | None:
         """Perturbed (or one level) minus Original of ``field`` ('accuracy' or 'f1'); None if either is missing."""
@@ -74,12 +79,20 @@ def _severity(image: ScoredImage) -> int:
     return int(image.extra["severity"])
 
 
+def paint_free(image: ScoredImage) -> bool:
+    """An image of the paint-free control (its record says ``"paint": false``)."""
+    return image.extra.get("paint") is False
+
+
 def _row(category: str, type_name: str, images: list[ScoredImage], f1_variant: str) -> Row:
+    control = [image for image in images if paint_free(image)]
+    images = [image for image in images if not paint_free(image)]
     originals = [image for image in images if _severity(image) == 0]
     perturbed = [image for image in images if _severity(image) > 0]
     levels = {level: _stats([image for image in images if _severity(image) == level], f1_variant)
               for level in LEVELS}
-    return Row(category, type_name, _stats(originals, f1_variant), _stats(perturbed, f1_variant), levels)
+    return Row(category, type_name, _stats(originals, f1_variant), _stats(perturbed, f1_variant), levels,
+               _stats(control, f1_variant))
 
 
 def _labelled(image: ScoredImage) -> bool:
@@ -143,6 +156,18 @@ def markdown(report: Report) -> str:
             cells += [_pct(getattr(row.original, field, None)), _pct(getattr(row.perturbed, field, None)),
                       _pct(row.gap(field), signed=True)]
         lines.append("| " + " | ".join(cells) + " |")
+    total = report.rows[-1] if report.rows else None
+    if total is not None and total.no_paint is not None:
+        lines += ["", "## Paint-free control", "",
+                  "Accuracy on the originals rendered with every lane marking removed (labels unchanged). A detector "
+                  "that reads the paint scores low here; a high score means it places lanes from the road's layout.",
+                  "", "| Category | Type | Images | Acc Original | Acc no paint |", "|---|---|---:|---:|---:|"]
+        for row in report.rows:
+            if row.no_paint is None:
+                continue
+            category, type_name = _label(row)
+            lines.append(f"| {category} | {type_name} | {row.no_paint.images} | "
+                         f"{_pct(getattr(row.original, 'accuracy', None))} | {_pct(row.no_paint.accuracy)} |")
     for field, name in (("accuracy", "Accuracy"), ("f1", "F1")):
         lines += ["", f"## {name} by severity", "",
                   f"{name} of the originals (level 0) and of each level; in brackets the gap to the originals.", "",

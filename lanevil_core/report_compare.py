@@ -61,6 +61,17 @@ def markdown(detectors: list[Detector], f1_variant: str) -> str:
                 name_cell = detector.name if label == "P" else ""
                 lines.append(f"| {name_cell} | {label} | " + " | ".join(cells) + " |")
         lines.append("")
+    if any(category_rows(d.report)[-1].no_paint is not None for d in detectors):
+        lines += ["## Paint-free control", "",
+                  "Accuracy on the originals and on the same frames with every lane marking removed (labels "
+                  "unchanged): low without paint = the detector reads the paint.", "",
+                  "| Detector | Original | No paint |", "|---|---:|---:|"]
+        for detector in detectors:
+            row = category_rows(detector.report)[-1]
+            lines.append(f"| {detector.name} | {_pct(getattr(row.original, 'accuracy', None))} | "
+                         f"{_pct(getattr(row.no_paint, 'accuracy', None))} |")
+        lines.append("")
+    lines += defence_table(detectors)
     lines += ["## Accuracy drop by severity (all categories)", "",
               "| Detector | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
               "|---|---:|" + "---:|" * len(LEVELS)]
@@ -70,6 +81,35 @@ def markdown(detectors: list[Detector], f1_variant: str) -> str:
         cells += [_pct(row.gap("accuracy", level), signed=True) for level in LEVELS]
         lines.append(f"| {detector.name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def defence_table(detectors: list[Detector]) -> list[str]:
+    """Markdown lines: each detector's Perturbed accuracy per category and average, its gain over the first
+    detector (the vanilla model when comparing training defences), and its clean (Original) accuracy and change."""
+    if len(detectors) < 2:
+        return []
+    base = {_heading(row): row for row in category_rows(detectors[0].report)}
+    heads = list(base)
+    lines = ["## Defences", "",
+             f"Perturbed accuracy (%) per category and its gain over `{detectors[0].name}` in brackets; Clean = "
+             "accuracy on the originals (a defence should not cost more than 1 point there).", "",
+             "| Detector | " + " | ".join(heads) + " | Clean |", "|---|" + "---:|" * (len(heads) + 1)]
+    for detector in detectors:
+        rows = {_heading(row): row for row in category_rows(detector.report)}
+        cells = []
+        for head in heads:
+            mine = getattr(rows[head].perturbed, "accuracy", None) if head in rows else None
+            theirs = getattr(base[head].perturbed, "accuracy", None)
+            gain = None if mine is None or theirs is None else mine - theirs
+            cells.append(_pct(mine) if detector is detectors[0] or gain is None
+                         else f"{_pct(mine)} ({_pct(gain, signed=True)})")
+        clean = getattr(rows.get("Average") and rows["Average"].original, "accuracy", None)
+        base_clean = getattr(base["Average"].original, "accuracy", None) if "Average" in base else None
+        clean_cell = _pct(clean)
+        if detector is not detectors[0] and clean is not None and base_clean is not None:
+            clean_cell += f" ({_pct(clean - base_clean, signed=True)})"
+        lines.append(f"| {detector.name} | " + " | ".join(cells) + f" | {clean_cell} |")
+    return lines + [""]
 
 
 def comparison_csv(detectors: list[Detector]) -> str:

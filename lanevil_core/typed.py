@@ -31,11 +31,12 @@ LineType = Literal[
     "white_solid_dashed",
     "yellow_solid_dashed",
     "botts_dots",
+    "none",
 ]
 LINE_TYPES: tuple[LineType, ...] = (
     "white_solid", "white_dashed", "white_double_solid",
     "yellow_solid", "yellow_dashed", "yellow_double_solid",
-    "white_solid_dashed", "yellow_solid_dashed", "botts_dots",
+    "white_solid_dashed", "yellow_solid_dashed", "botts_dots", "none",
 )
 
 SceneKind = Literal["urban", "suburban", "highway", "rural", "tunnel_approach"]

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
@@ -38,12 +38,21 @@ TRAIN_FRAMES_PER_VARIANT = 5  # frames of one train variation, evenly spaced ove
 CHUNK_FRAMES = 10  # frames per render task: one scene compile (~0.25 s) amortised over ~3 s of rendering
 END_MARGIN_M = 60.0  # road the case validator keeps ahead of the last frame
 SUN_ALTITUDE_JITTER_DEG = 10.0
-# Half the train variations keep the stock camera; the others move its mount so that the lanes' place in the image
-# is not a constant of the data set: lateral offset in the lane (m), height (m) and pitch (degrees, down).
+# The train split must not let a detector place lanes from the road's layout instead of its paint (the
+# paint-free control of the test split measures that). So the layout varies: half the variations move the camera
+# mount (lateral offset in the lane, height, pitch, yaw), lane count and width vary, and lines go unpainted: an
+# edge line, the lane lines of a variation, or (rarely) every line. An unpainted boundary has no label.
 CAMERA_JITTER_SHARE = 0.5
-CAMERA_Y_RANGE_M = (-0.6, 0.6)
+CAMERA_Y_RANGE_M = (-0.7, 0.7)
 CAMERA_Z_RANGE_M = (1.4, 3.2)
 CAMERA_PITCH_RANGE_DEG = (0.0, 4.0)
+CAMERA_YAW_RANGE_DEG = (-3.0, 3.0)
+LANES_PER_DIRECTION_CHOICES = (1, 2, 2, 3)
+LANE_WIDTH_RANGE_M = (2.9, 4.0)
+NO_EDGE_LINE_SHARE = 0.2  # per edge line
+NO_LANE_LINES_SHARE = 0.1  # all lane lines of a variation
+NO_CENTRE_LINE_SHARE = 0.1
+NO_PAINT_SHARE = 0.06  # a variation with no paint at all: no lanes to find
 LANE_LINE_CHOICES: tuple[LineType, ...] = ("white_dashed", "white_solid", "botts_dots", "white_solid_dashed")
 CENTRE_LINE_CHOICES: tuple[LineType, ...] = (
     "yellow_double_solid", "yellow_solid", "yellow_dashed", "yellow_solid_dashed", "white_double_solid",
@@ -60,6 +69,7 @@ class Settings:
     frames_per_case: int | None = None
     train_frames: int = 0
     seed: int = 0
+    no_paint: bool = False  # also render every original with its lane paint removed (the paint-free control)
 
     @property
     def suffix(self) -> str:
@@ -105,6 +115,7 @@ class PlannedCase:
     type_folder: str | None
     severity: int
     source: dict[str, Any] = field(default_factory=dict)
+    paint: bool = True
 
     @property
     def key(self) -> tuple[str, str]:
@@ -123,8 +134,11 @@ class PlannedCase:
 
     def record_extras(self) -> dict[str, Any]:
         """Fields every TuSimple record of this case carries besides the standard ones."""
-        return {"category": self.category, "type": self.type_folder, "severity": self.severity,
-                "case": str(self.folder), "illusion": self.illusion_type, "split": self.split}
+        extras = {"category": self.category, "type": self.type_folder, "severity": self.severity,
+                  "case": str(self.folder), "illusion": self.illusion_type, "split": self.split}
+        if not self.paint:
+            extras["paint"] = False
+        return extras
 
     def raw_file(self, frame_index: int, suffix: str) -> str:
         """Frame path relative to the split folder, e.g. ``Shadow/Fence/03_level3/000000.png``."""
@@ -198,24 +212,44 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None) -> Planne
     )
 
 
-def _markings(case: Case, rng: np.random.Generator) -> list[dict[str, Any]]:
-    """The base's paint with one lane-line type for every lane line and a new centre line; edges kept."""
-    lane_line = LANE_LINE_CHOICES[int(rng.integers(len(LANE_LINE_CHOICES)))]
-    centre_line = CENTRE_LINE_CHOICES[int(rng.integers(len(CENTRE_LINE_CHOICES)))]
-    markings = [marking.model_dump() for marking in case.road.markings]
-    centre = len(markings) // 2
-    for index in range(1, len(markings) - 1):
-        markings[index]["type"] = centre_line if index == centre else lane_line
-    return markings
+NO_PAINT_SUFFIX = "_nopaint"
+
+
+def paint_free(planned: PlannedCase) -> PlannedCase:
+    """The same case and frames with every lane marking removed from the world, in ``<folder>_nopaint``."""
+    data = parse_case(planned.case_text).model_dump()
+    data["road"]["paint"] = False
+    case = parse_case(data)
+    folder = planned.folder.with_name(planned.folder.name + NO_PAINT_SUFFIX)
+    return replace(planned, folder=folder, case_text=case_json(case), paint=False,
+                   source={**planned.source, "paint": False})
+
+
+def _markings(lanes_per_direction: int, rng: np.random.Generator) -> list[dict[str, Any]]:
+    """Paint of every boundary, left to right: one lane-line type for all lane lines and one centre line,
+    white solid edges, each of them possibly left unpainted (``none``); always ten draws."""
+    draws = rng.uniform(0.0, 1.0, 6)
+    lane_line = LANE_LINE_CHOICES[int(draws[0] * len(LANE_LINE_CHOICES))]
+    centre_line = CENTRE_LINE_CHOICES[int(draws[1] * len(CENTRE_LINE_CHOICES))]
+    if draws[2] < NO_LANE_LINES_SHARE:
+        lane_line = "none"
+    if draws[3] < NO_CENTRE_LINE_SHARE:
+        centre_line = "none"
+    edges = ["none" if u < NO_EDGE_LINE_SHARE else "white_solid" for u in draws[4:6]]
+    n = lanes_per_direction
+    names = [edges[0]] + [lane_line] * (n - 1) + [centre_line] + [lane_line] * (n - 1) + [edges[1]]
+    if rng.uniform() < NO_PAINT_SHARE:
+        names = ["none"] * len(names)
+    return [{"type": name} for name in names]
 
 
 def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
     """The base's camera, or (``CAMERA_JITTER_SHARE`` of the time) one moved within the mount ranges."""
     camera = base.camera.model_dump()
-    draws = rng.uniform(0.0, 1.0, 4)  # always four draws, so the variations after this one do not shift
+    draws = rng.uniform(0.0, 1.0, 5)  # always five draws, so what is drawn after this does not shift
+    ranges = (CAMERA_Y_RANGE_M, CAMERA_Z_RANGE_M, CAMERA_PITCH_RANGE_DEG, CAMERA_YAW_RANGE_DEG)
     if draws[0] < CAMERA_JITTER_SHARE:
-        for key, (lo, hi), u in zip(("y", "z", "pitch"), (CAMERA_Y_RANGE_M, CAMERA_Z_RANGE_M, CAMERA_PITCH_RANGE_DEG),
-                                    draws[1:], strict=True):
+        for key, (lo, hi), u in zip(("y", "z", "pitch", "yaw"), ranges, draws[1:], strict=True):
             camera[key] = round(lo + (hi - lo) * float(u), 2)
     return camera
 
@@ -229,7 +263,9 @@ def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, 
     if altitude > 0:
         altitude = float(np.clip(altitude + rng.uniform(-1, 1) * SUN_ALTITUDE_JITTER_DEG, 5.0, 85.0))
     azimuth = round(float(rng.uniform(0.0, 360.0)), 1)
-    lane = int(rng.integers(base.road.lanes_per_direction))
+    lanes_per_direction = int(LANES_PER_DIRECTION_CHOICES[int(rng.integers(len(LANES_PER_DIRECTION_CHOICES)))])
+    lane_width = round(float(rng.uniform(*LANE_WIDTH_RANGE_M)), 2)
+    lane = int(rng.integers(lanes_per_direction))
     drive_m = base.ego.speed * (base.ego.frames - 1) / base.ego.fps
     latest_start = max(0.0, base.road.length - END_MARGIN_M - drive_m - 1.0)
     start_s = round(float(rng.uniform(0.0, latest_start)), 1)
@@ -239,12 +275,14 @@ def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, 
     data["camera"] = camera
     data["weather"] = values["weather"]
     data["sun"] = {**values["sun"], "azimuth": azimuth, "altitude": round(altitude, 1)}
-    data["road"]["markings"] = _markings(base, rng)
+    data["road"].update(lanes_per_direction=lanes_per_direction, lane_width=lane_width,
+                        markings=_markings(lanes_per_direction, rng))
     data["ego"].update(lane=lane, start_s=start_s)
     data["seed"] = case_seed
     data["title"] = f"{base.title} ({preset}, variation {index})"
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
-                  "lane": lane, "start_s": start_s, "camera": {k: camera[k] for k in ("y", "z", "pitch")},
+                  "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
+                  "lane_width": lane_width, "camera": {k: camera[k] for k in ("y", "z", "pitch", "yaw")},
                   "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters
 
@@ -288,6 +326,8 @@ def build_plan(sources: list[SourceCase], settings: Settings) -> DatasetPlan:
     typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
     clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
     planned = [planned_test_case(source, settings.frames_per_case) for source in typed]
+    if settings.no_paint:
+        planned += [paint_free(case) for case in planned if case.severity == 0]
     planned += train_cases(clean, settings.train_frames, settings.seed)
     if not planned:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")

@@ -21,6 +21,8 @@ from .base import Category, CompileContext, Illusion, register
 PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
 LAMP_COLORS: dict[str, tuple[float, float, float]] = {"white": (1.0, 0.95, 0.88), "yellow": (1.0, 0.62, 0.22)}
+NIGHT_ZENITH = np.array([0.001, 0.0015, 0.004], np.float32)
+NIGHT_HORIZON = np.array([0.006, 0.006, 0.009], np.float32)
 LAMP_INTENSITY = 45.0  # radiance scale at 1 m: lights a road 8 m below to about the level of an overcast day
 VEHICLE_AHEAD_M = 13.0  # the first glossy vehicle stands this far ahead of the ego start
 
@@ -104,15 +106,18 @@ class SunlightReflection(Illusion):
 
 @register
 class StreetlightReflection(Illusion):
-    """Night, white or yellow street lamps, a wet road: long light streaks run down the asphalt."""
+    """Dusk to night, white or yellow street lamps, a wet road: long light streaks run down the asphalt."""
 
     CATEGORY: ClassVar[Category] = "reflection"
+    # daylight: what is left of the day's sky light (1 = the case's day, 0 = full night). The level takes the scene
+    # from late dusk to deep night while the road gets wetter and the lamps denser, so the streaks of the lamps
+    # stand out ever more against the darkening road and the paint.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"wetness": 0.35, "puddles": 0.05, "lamp_scale": 0.7, "spacing": 40.0},
-        {"wetness": 0.5, "puddles": 0.12, "lamp_scale": 0.85, "spacing": 34.0},
-        {"wetness": 0.65, "puddles": 0.2, "lamp_scale": 1.0, "spacing": 28.0},
-        {"wetness": 0.8, "puddles": 0.3, "lamp_scale": 1.2, "spacing": 22.0},
-        {"wetness": 0.95, "puddles": 0.4, "lamp_scale": 1.45, "spacing": 17.0},
+        {"daylight": 0.45, "wetness": 0.35, "puddles": 0.05, "lamp_scale": 0.8, "spacing": 40.0},  # late dusk
+        {"daylight": 0.30, "wetness": 0.5, "puddles": 0.12, "lamp_scale": 0.9, "spacing": 34.0},
+        {"daylight": 0.18, "wetness": 0.65, "puddles": 0.2, "lamp_scale": 1.0, "spacing": 28.0},
+        {"daylight": 0.08, "wetness": 0.8, "puddles": 0.3, "lamp_scale": 1.2, "spacing": 22.0},
+        {"daylight": 0.0, "wetness": 0.95, "puddles": 0.4, "lamp_scale": 1.45, "spacing": 17.0},  # wet night
     )
 
     type: Literal["streetlight_reflection"] = "streetlight_reflection"
@@ -126,10 +131,13 @@ class StreetlightReflection(Illusion):
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         env = ctx.env
-        env.night, env.sun_intensity, env.exposure = True, 0.0, NIGHT_EXPOSURE
-        env.ambient = min(env.ambient, 0.01)
-        env.sky_zenith = np.array([0.001, 0.0015, 0.004], np.float32)
-        env.sky_horizon = np.array([0.006, 0.006, 0.009], np.float32)
+        daylight = float(level["daylight"])
+        dusk = daylight**2  # sky light falls off faster than the eye adapts
+        env.night, env.sun_intensity = True, 0.0
+        env.exposure = NIGHT_EXPOSURE + (1.0 - NIGHT_EXPOSURE) * daylight
+        env.ambient = 0.01 + (max(env.ambient, 0.01) - 0.01) * dusk
+        env.sky_zenith = (NIGHT_ZENITH + (env.sky_zenith - NIGHT_ZENITH) * dusk).astype(np.float32)
+        env.sky_horizon = (NIGHT_HORIZON + (env.sky_horizon - NIGHT_HORIZON) * dusk).astype(np.float32)
         env.headlights = HEADLIGHT_INTENSITY if self.headlights else 0.0
         s0 = max(self.start_s(ctx.case) - 20.0, 0.0)
         s1 = s0 + self.length if self.length is not None else _drive_end(ctx)

@@ -307,13 +307,15 @@ class GuardRail(Illusion):
     CATEGORY: ClassVar[Category] = "road_damage"
     # offset: gap between the carriageway edge and the rail (m); far_side: a second rail along the other edge;
     # median: a rail just left of the centre line; shadow_m: how far across the road (from the rail nearest
-    # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept).
+    # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept). The sun is the same at
+    # every level; the rails come closer to the lanes, brighter, and more of them, so their edges and shadows
+    # run ever nearer the lane lines.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"offset": 2.0, "far_side": False, "median": False, "albedo": 0.30, "shadow_m": 0.0},
-        {"offset": 1.5, "far_side": False, "median": False, "albedo": 0.38, "shadow_m": 0.0},
-        {"offset": 1.0, "far_side": False, "median": False, "albedo": 0.45, "shadow_m": 1.5},
-        {"offset": 0.6, "far_side": True, "median": False, "albedo": 0.52, "shadow_m": 2.4},
-        {"offset": 0.3, "far_side": True, "median": True, "albedo": 0.60, "shadow_m": 3.0},
+        {"offset": 2.4, "far_side": False, "median": False, "albedo": 0.30, "shadow_m": 2.5},  # one rail, set back
+        {"offset": 1.6, "far_side": False, "median": False, "albedo": 0.40, "shadow_m": 2.5},
+        {"offset": 1.0, "far_side": True, "median": False, "albedo": 0.50, "shadow_m": 2.5},  # both edges
+        {"offset": 0.5, "far_side": True, "median": False, "albedo": 0.60, "shadow_m": 2.5},
+        {"offset": 0.1, "far_side": True, "median": True, "albedo": 0.70, "shadow_m": 2.5},  # and the median
     )
 
     type: Literal["guard_rail"] = "guard_rail"
@@ -348,8 +350,9 @@ class GuardRail(Illusion):
                                         tuple(float(c) for c in color), name=f"guard rail {index + 1}"))
         shadow_m = _setting(self, "shadow_m")
         if shadow_m > 0:
-            # The sun stands on the side of the rail nearest the ego and throws its shadow over the ego's lanes.
-            nearest = min(rails_t, key=lambda t: abs(t - _ego_center_t(ctx)))
+            # The sun stands on the side of the main rail and throws its shadow over the lanes beside it; the same
+            # sun at every level, whatever other rails the level adds.
+            nearest = rails_t[0]
             ground = ground_height(main, nearest) if abs(nearest) > main.half_width else 0.0
             ctx.env.sun_dir_world = _shadow_sun(float(main.line.heading_at(0.5 * (s0 + s1))),
                                                 1.0 if nearest >= 0 else -1.0, RAIL_TOP_M + ground, shadow_m)

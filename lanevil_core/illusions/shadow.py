@@ -121,18 +121,20 @@ def _road_frame(line: ReferenceLine, p_world: np.ndarray) -> tuple[np.ndarray, n
 class StreetlightShadow(SunShadowIllusion):
     """Rows of street lamps whose long low-sun shadows stripe the lanes."""
 
-    # Lower sun, brighter and harder light, taller, thicker and closer-spaced poles as the level rises.
+    # One low, hard sun from the same bearing at every level (the scene's light does not change between levels);
+    # the level makes the lamps taller, thicker and closer, so their shadows reach further across the lanes and
+    # stripe more of them.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 45.0, "sun_ahead": 25.0, "sun_intensity": 0.8, "penumbra": 0.020, "spacing": 35.0,
-         "pole_height": 7.0, "pole_radius": 0.11, "arm": 1.2},
-        {"sun_altitude": 38.0, "sun_ahead": 33.0, "sun_intensity": 0.95, "penumbra": 0.015, "spacing": 30.0,
-         "pole_height": 8.0, "pole_radius": 0.12, "arm": 1.5},
-        {"sun_altitude": 31.0, "sun_ahead": 40.0, "sun_intensity": 1.1, "penumbra": 0.011, "spacing": 26.0,
-         "pole_height": 9.0, "pole_radius": 0.14, "arm": 1.8},
-        {"sun_altitude": 25.0, "sun_ahead": 48.0, "sun_intensity": 1.3, "penumbra": 0.008, "spacing": 23.0,
-         "pole_height": 10.0, "pole_radius": 0.16, "arm": 2.0},
-        {"sun_altitude": 20.0, "sun_ahead": 55.0, "sun_intensity": 1.5, "penumbra": 0.005, "spacing": 20.0,
-         "pole_height": 11.0, "pole_radius": 0.18, "arm": 2.2},
+        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 50.0,
+         "pole_height": 6.0, "pole_radius": 0.08, "arm": 0.6},  # a few thin lamps, short shadows
+        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 38.0,
+         "pole_height": 7.0, "pole_radius": 0.11, "arm": 1.0},
+        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 29.0,
+         "pole_height": 8.0, "pole_radius": 0.14, "arm": 1.4},
+        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 22.0,
+         "pole_height": 9.0, "pole_radius": 0.17, "arm": 1.8},
+        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 17.0,
+         "pole_height": 10.0, "pole_radius": 0.20, "arm": 2.2},  # tall, thick, dense: shadows over every lane
     )
 
     type: Literal["streetlight_shadow"] = "streetlight_shadow"
@@ -167,19 +169,19 @@ class StreetlightShadow(SunShadowIllusion):
 class FenceShadow(SunShadowIllusion):
     """A slatted fence beside the road whose low-sun shadow lays stripes across the lanes."""
 
-    # A gently lowering sun from a fixed bearing and a taller fence with denser slats: the striped shadow reaches
-    # further across the lanes with every level while the rest of the scene's light changes little.
+    # One low sun from a fixed bearing at every level; the fence grows taller and its slats denser, so the
+    # striped shadow reaches further across the lanes and darkens more of them.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 30.0, "sun_ahead": 32.0, "sun_intensity": 0.9, "penumbra": 0.020, "height": 1.6,
-         "slat_width": 0.10, "slat_gap": 0.40},
-        {"sun_altitude": 26.0, "sun_ahead": 32.0, "sun_intensity": 0.95, "penumbra": 0.015, "height": 2.0,
-         "slat_width": 0.11, "slat_gap": 0.33},
-        {"sun_altitude": 22.0, "sun_ahead": 32.0, "sun_intensity": 1.0, "penumbra": 0.011, "height": 2.4,
-         "slat_width": 0.12, "slat_gap": 0.27},
+        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 0.7,
+         "slat_width": 0.06, "slat_gap": 0.50},  # a low, open fence: a thin striped edge
+        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 1.5,
+         "slat_width": 0.10, "slat_gap": 0.36},
+        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 2.2,
+         "slat_width": 0.12, "slat_gap": 0.28},
         {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 2.8,
-         "slat_width": 0.13, "slat_gap": 0.22},
-        {"sun_altitude": 18.0, "sun_ahead": 32.0, "sun_intensity": 1.1, "penumbra": 0.005, "height": 3.2,
-         "slat_width": 0.15, "slat_gap": 0.15},
+         "slat_width": 0.14, "slat_gap": 0.21},
+        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 3.4,
+         "slat_width": 0.16, "slat_gap": 0.14},  # a tall dense fence: stripes over the ego's lane and beyond
     )
 
     type: Literal["fence_shadow"] = "fence_shadow"
@@ -206,18 +208,19 @@ class FenceShadow(SunShadowIllusion):
 class RailShadow(SunShadowIllusion):
     """An elevated slotted rail deck over the road: a shaded road with bright lines where light comes through."""
 
-    # Slots turn from across the road to along it (bright lines parallel to the lanes), the deck grows longer.
+    # One high sun at every level; the deck grows longer and its slots (along the road: bright lines parallel to
+    # the lanes) wider and closer, so more of the road lies in its striped shade.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 60.0, "sun_ahead": 70.0, "sun_intensity": 0.8, "penumbra": 0.012, "deck_length": 8.0,
-         "slots_along": "t", "slot_width": 0.45, "slot_pitch": 1.8, "deck_depth": 0.25},
-        {"sun_altitude": 55.0, "sun_ahead": 70.0, "sun_intensity": 0.95, "penumbra": 0.009, "deck_length": 12.0,
-         "slots_along": "t", "slot_width": 0.45, "slot_pitch": 1.5, "deck_depth": 0.25},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.1, "penumbra": 0.007, "deck_length": 16.0,
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 4.0,
+         "slots_along": "s", "slot_width": 0.12, "slot_pitch": 1.8, "deck_depth": 0.35},  # a narrow footbridge
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 8.0,
+         "slots_along": "s", "slot_width": 0.18, "slot_pitch": 1.6, "deck_depth": 0.35},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 12.0,
          "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
-        {"sun_altitude": 45.0, "sun_ahead": 75.0, "sun_intensity": 1.3, "penumbra": 0.005, "deck_length": 22.0,
-         "slots_along": "s", "slot_width": 0.27, "slot_pitch": 1.2, "deck_depth": 0.35},
-        {"sun_altitude": 40.0, "sun_ahead": 78.0, "sun_intensity": 1.5, "penumbra": 0.003, "deck_length": 28.0,
-         "slots_along": "s", "slot_width": 0.30, "slot_pitch": 1.1, "deck_depth": 0.35},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 16.0,
+         "slots_along": "s", "slot_width": 0.30, "slot_pitch": 1.25, "deck_depth": 0.35},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 20.0,
+         "slots_along": "s", "slot_width": 0.36, "slot_pitch": 1.1, "deck_depth": 0.35},  # a slotted viaduct
     )
 
     type: Literal["rail_shadow"] = "rail_shadow"

@@ -143,10 +143,9 @@ class TrafficIllusion(Illusion):
         return [s for s in stations if s < length - ROAD_END_MARGIN_M]
 
     def crowd_slots(self, ctx: CompileContext, rng: np.random.Generator, group: int, on_lines: float,
-                    yaw_of: Callable[[np.random.Generator, float], float]) -> list[Slot]:
-        """Slots for ``participants()`` people or bikes in groups of ``group`` across the road: a share
-        ``on_lines`` straddle lane lines (the ego lane's own first), the rest stand in the lanes beside it."""
-        total = self.participants()
+                    yaw_of: Callable[[np.random.Generator, float], float], total: int) -> list[Slot]:
+        """Slots for ``total`` people or bikes in groups of ``group`` across the road: a share ``on_lines``
+        straddle lane lines (the ego lane's own first), the rest stand in the lanes beside it."""
         stations = self.group_stations(ctx, math.ceil(total / group))
         lines, centres = line_order(ctx), lane_centres(ctx)
         slots = []
@@ -161,6 +160,20 @@ class TrafficIllusion(Illusion):
                     t = centres[(k - len(lined) + g) % len(centres)] + rng.uniform(-0.5, 0.5)
                 slots.append(Slot(s, t, yaw_of(rng, t)))
         return slots
+
+    def nested_crowd(self, ctx: CompileContext, rng: np.random.Generator,
+                     yaw_of: Callable[[np.random.Generator, float], float]) -> list[Slot]:
+        """The first ``participants()`` slots of the most severe level's crowd: every level is the same crowd
+        thinned out, so a higher level only adds people (level 1 is a mild version of level 5)."""
+        full = self.SEVERITY[-1]
+        group = self.group or int(full["group"])
+        share = float(full["on_lines"] if self.on_lines is None else self.on_lines)
+        count = self.participants()
+        slots = self.crowd_slots(ctx, rng, group, share, yaw_of, max(count, int(full["count"])))
+        # Take the groups' members in turn (the first of every group, then the second ...), so a thin crowd
+        # still has people all along the drive.
+        order = sorted(range(len(slots)), key=lambda i: (i % group, i // group))
+        return [slots[i] for i in order[:count]]
 
     def add_crowd(self, ctx: CompileContext, slots: list[Slot], make: Callable[[int], Mesh],
                   follow_grade: bool = True) -> None:
@@ -228,18 +241,19 @@ class Pedestrian(TrafficIllusion):
     """People crossing or standing on the road, on the lane lines and in the lanes beside the ego's."""
 
     # count: people; group: people per crossing group; distance: first group ahead of the ego start (m);
-    # on_lines: share of the people standing on a lane line. Level 5 is a crowd crossing right in front of the
-    # ego, on both of its lane lines and the lines beyond.
+    # on_lines: share of the people standing on a lane line. Every level is the first ``count`` people of the same
+    # crowd (groups of 11 from 14 m ahead, 80 % on the lines), so a level only adds people. Level 5 is a crowd
+    # crossing right in front of the ego, on both of its lane lines and the lines beyond.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
-        {"count": 3, "group": 1, "distance": 30.0, "on_lines": 0.34},
-        {"count": 6, "group": 3, "distance": 18.0, "on_lines": 0.5},
-        {"count": 12, "group": 6, "distance": 9.0, "on_lines": 0.67},
-        {"count": 20, "group": 10, "distance": 5.0, "on_lines": 0.8},
+        {"count": 2, "group": 11, "distance": 14.0, "on_lines": 0.8},  # two people on the ego's lines
+        {"count": 5, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a few, on the nearest lines
+        {"count": 9, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a group across the lanes
+        {"count": 15, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a crossing crowd and a second group
+        {"count": 22, "group": 11, "distance": 14.0, "on_lines": 0.8},  # crowds over every line ahead
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
-    group: int | None = Field(None, ge=1, le=12, description="people per group; empty = severity table")
+    group: int | None = Field(None, ge=1, le=12, description="people per group; empty = the level-5 crowd's")
     on_lines: float | None = Field(
         None, ge=0, le=1, description="share of people standing on a lane line; empty = severity table"
     )
@@ -247,10 +261,7 @@ class Pedestrian(TrafficIllusion):
     height: float = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
 
     def compile(self, ctx: CompileContext) -> None:
-        level = self.level()
         rng = ctx.rng(self.seed)
-        group = self.group or int(level["group"])
-        share = float(level["on_lines"] if self.on_lines is None else self.on_lines)
         crossing = self.motion == "crossing"
 
         def yaw_of(r: np.random.Generator, t: float) -> float:
@@ -263,7 +274,7 @@ class Pedestrian(TrafficIllusion):
             height = self.height * float(rng.uniform(0.94, 1.06))
             return props.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
 
-        self.add_crowd(ctx, self.crowd_slots(ctx, rng, group, share, yaw_of), person, follow_grade=False)
+        self.add_crowd(ctx, self.nested_crowd(ctx, rng, yaw_of), person, follow_grade=False)
 
 
 @register
@@ -271,28 +282,26 @@ class Bicycle(TrafficIllusion):
     """Cyclists riding along the lane lines (or crossing the road) beside the ego's path."""
 
     # count: cyclists; group: cyclists side by side; distance: first group ahead of the ego start (m);
-    # on_lines: share of cyclists riding on a lane line. Level 5 is a club ride spread over the whole road just
-    # ahead of the ego, most of it riding on the lane lines.
+    # on_lines: share of cyclists riding on a lane line. Every level is the first ``count`` riders of the same
+    # club ride (groups of 10 from 14 m ahead, 80 % on the lines), so a level only adds riders. Level 5 is the
+    # whole ride spread over the road just ahead of the ego, most of it on the lane lines.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 1, "group": 1, "distance": 45.0, "on_lines": 0.0},
-        {"count": 3, "group": 1, "distance": 30.0, "on_lines": 0.34},
-        {"count": 5, "group": 2, "distance": 18.0, "on_lines": 0.5},
-        {"count": 10, "group": 5, "distance": 9.0, "on_lines": 0.67},
-        {"count": 20, "group": 10, "distance": 6.0, "on_lines": 0.8},
+        {"count": 2, "group": 10, "distance": 14.0, "on_lines": 0.8},  # two riders on the ego's lines
+        {"count": 4, "group": 10, "distance": 14.0, "on_lines": 0.8},  # a few, on the nearest lines
+        {"count": 7, "group": 10, "distance": 14.0, "on_lines": 0.8},  # a bunch across the lanes
+        {"count": 13, "group": 10, "distance": 14.0, "on_lines": 0.8},  # the front group and followers
+        {"count": 20, "group": 10, "distance": 14.0, "on_lines": 0.8},  # the club ride over every line
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
-    group: int | None = Field(None, ge=1, le=12, description="cyclists per group; empty = severity table")
+    group: int | None = Field(None, ge=1, le=12, description="cyclists per group; empty = the level-5 crowd's")
     on_lines: float | None = Field(
         None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
     )
     frame_colors: list[RGB] | None = Field(None, description="bicycle frame colours (linear RGB), cycled")
 
     def compile(self, ctx: CompileContext) -> None:
-        level = self.level()
         rng = ctx.rng(self.seed)
-        group = self.group or int(level["group"])
-        share = float(level["on_lines"] if self.on_lines is None else self.on_lines)
         riding = self.motion == "riding"
 
         def yaw_of(r: np.random.Generator, t: float) -> float:
@@ -304,7 +313,7 @@ class Bicycle(TrafficIllusion):
             color = None if not self.frame_colors else self.frame_colors[index % len(self.frame_colors)]
             return props.bicycle_with_rider(rng, frame_color=color)
 
-        self.add_crowd(ctx, self.crowd_slots(ctx, rng, group, share, yaw_of), cyclist)
+        self.add_crowd(ctx, self.nested_crowd(ctx, rng, yaw_of), cyclist)
 
 
 @register
@@ -314,13 +323,14 @@ class Vehicle(TrafficIllusion):
 
     # count: vehicles; per_row: vehicles side by side in different lanes; distance: first row ahead of the ego
     # start (m); large: share of vans and trucks (mixed kind); lane_change: share straddling a lane line.
-    # The first frame loses about 1, 1.5, 8, 15 and 30 % of its lane-line rows behind them.
+    # The first row stands at the same place at every level; the level adds rows, vehicles side by side, large
+    # vehicles and lane changes, so more of the lines ahead are hidden.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 1, "per_row": 1, "distance": 45.0, "large": 0.0, "lane_change": 0.0},
-        {"count": 2, "per_row": 1, "distance": 35.0, "large": 0.2, "lane_change": 0.0},
-        {"count": 4, "per_row": 2, "distance": 25.0, "large": 0.3, "lane_change": 0.15},
-        {"count": 6, "per_row": 2, "distance": 18.0, "large": 0.4, "lane_change": 0.25},
-        {"count": 9, "per_row": 3, "distance": 12.0, "large": 0.5, "lane_change": 0.35},
+        {"count": 1, "per_row": 1, "distance": 16.0, "large": 0.0, "lane_change": 0.0},  # one car beside the ego
+        {"count": 2, "per_row": 1, "distance": 16.0, "large": 0.2, "lane_change": 0.0},  # a second row, vans
+        {"count": 4, "per_row": 2, "distance": 16.0, "large": 0.3, "lane_change": 0.2},  # pairs side by side
+        {"count": 6, "per_row": 2, "distance": 16.0, "large": 0.4, "lane_change": 0.3},  # a queue with vans
+        {"count": 9, "per_row": 3, "distance": 16.0, "large": 0.5, "lane_change": 0.4},  # dense traffic, trucks
     )
     # Lanes relative to the ego's (+1 = next lane to its right, -1 = to its left), tried in this order.
     LANE_ORDER: ClassVar[tuple[int, ...]] = (1, -1, -2, 2, -3, 3, 0, -4, 4, -5, 5, -6, 6, -7, 7)

@@ -27,6 +27,7 @@ from ..detect.learned import decode_outputs, lanes_of
 from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
 from ..metrics.formats import split_labels
 from ..metrics.tusimple import score_image
+from .aam import AamSettings, attention, build_bank, hard_patches, mix, patch_tensors
 from .augment import AUGMENTS
 from .backbone import load_init
 from .data import LabelledFrames, file_sha256, read_records, split_indices
@@ -35,6 +36,7 @@ from .losses import detector_loss
 from .models import Deployed, build_model
 
 CHECKPOINT_FILE = "checkpoint.pt"
+AAM_BANK_FILE = "aam_bank.pt"
 WARMUP_STEPS = 100
 
 
@@ -58,6 +60,8 @@ class TrainSettings:
     resume: bool = False
     init: Path | None = None
     max_steps: int | None = None  # stop each epoch after this many batches (tests and smoke runs)
+    aam: AamSettings = field(default_factory=AamSettings)
+    threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
 
 
 def pick_device(name: str) -> torch.device:
@@ -68,25 +72,32 @@ def pick_device(name: str) -> torch.device:
     return torch.device(name)
 
 
-def predict_lanes(model: torch.nn.Module, dataset: LabelledFrames, device: torch.device,
-                  batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
-    """(predicted lanes, GT lanes, rows) of every frame of ``dataset``, both on the 1280x720 grid."""
+def predict_on(model: torch.nn.Module, images: np.ndarray, records: list[dict[str, Any]],
+               frame_sizes: list[tuple[int, int]], device: torch.device,
+               batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
+    """(predicted lanes, GT lanes, rows) for ``images`` ((N, H, W, 3) uint8 at the input size) with their TuSimple
+    ``records`` of frames of ``frame_sizes``; both sides on the 1280x720 grid."""
     deployed = Deployed(model).to(device).eval()
     results = []
-    loader = DataLoader(dataset, batch_size=batch, shuffle=False)
     with torch.no_grad():
-        for batch_data in loader:
-            values = deployed(batch_data["image"].to(device))
+        for start in range(0, len(images), batch):
+            chunk = torch.from_numpy(images[start:start + batch].transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
+            values = deployed(chunk.to(device))
             outputs = {name: v.float().cpu().numpy() for name, v in zip(deployed.output_names(), values, strict=True)}
-            for k, index in enumerate(batch_data["index"].tolist()):
-                record = dataset.records[index]
-                gt, rows = on_tusimple_grid(record["lanes"], record["h_samples"], dataset.frame_sizes[index])
-                lines = decode_outputs(model.spec, outputs, k)
-                # decode on the 720 grid: rows are continuous 720-grid rows, lanes_of adds the half pixel
-                pred = lanes_of(model.spec, lines, rows, (1280, 720))
+            for k in range(len(chunk)):
+                record, size = records[start + k], frame_sizes[start + k]
+                gt, rows = on_tusimple_grid(record["lanes"], record["h_samples"], size)
+                # rows are continuous 720-grid rows; lanes_of adds the half pixel of a TuSimple row
+                pred = lanes_of(model.spec, decode_outputs(model.spec, outputs, k), rows, (1280, 720))
                 results.append((pred, gt, rows))
     model.train()
     return results
+
+
+def predict_lanes(model: torch.nn.Module, dataset: LabelledFrames, device: torch.device,
+                  batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
+    """(predicted lanes, GT lanes, rows) of every frame of ``dataset``, both on the 1280x720 grid."""
+    return predict_on(model, dataset.images, dataset.records, dataset.frame_sizes, device, batch)
 
 
 def tusimple_accuracy(results: list[tuple[list[list[int]], list[list[int]], list[float]]]) -> float:
@@ -111,12 +122,48 @@ def _lr_at(step: int, total: int, base: float) -> float:
 Progress = Callable[[str], None]
 
 
+def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, Any]], data_sha: str) -> list:
+    """The AAM bank of this run (rendered once, kept in the model folder for ``--resume``)."""
+    path = settings.out / AAM_BANK_FILE
+    key = {"data_sha256": data_sha, "seed": settings.seed, "input_size": list(settings.spec.input_size),
+           "settings": asdict(settings.aam)}
+    if path.is_file():
+        cached = torch.load(path, weights_only=False)
+        if cached.get("key") == key:
+            return cached["patches"]
+    folders = sorted({str(Path(r["raw_file"]).parent) for r in records})
+    bases = [split_dir / folder / "case.json" for folder in folders if (split_dir / folder / "case.json").is_file()]
+    if not bases:
+        raise TrainError(f"--augment aam: no case.json beside the frames of {split_dir}")
+    patches = build_bank(bases, settings.spec.input_size, settings.seed, settings.aam)
+    settings.out.mkdir(parents=True, exist_ok=True)
+    _save({"key": key, "patches": patches}, path)
+    return patches
+
+
+def aam_batch(model: torch.nn.Module, images: torch.Tensor, hard: list, settings: TrainSettings, epoch: int,
+              step: int) -> torch.Tensor:
+    """The batch with AAM applied to a share of its images (chosen by seed, epoch and step)."""
+    rng = np.random.default_rng([settings.seed, epoch, step, 7])
+    chosen = np.flatnonzero(rng.random(len(images)) < settings.aam.probability)
+    if not len(chosen):
+        return images
+    device = next(model.parameters()).device
+    with torch.no_grad():
+        out = model(images[chosen].to(device))
+    attention_map = attention(out, model.spec.input_size).cpu()
+    patches, masks = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
+    images = images.clone()
+    images[chosen] = mix(images[chosen], attention_map, patches, masks)
+    return images
+
+
 def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]:
     """Train, export and describe a model in ``settings.out``; returns the ``training.json`` content."""
     from tqdm import tqdm
 
     torch.manual_seed(settings.seed)
-    torch.set_num_threads(os.cpu_count() or 1)
+    torch.set_num_threads(settings.threads or os.cpu_count() or 1)
     device = pick_device(settings.device)
     spec = settings.spec
     split_dir = settings.data / "train" if (settings.data / "train").is_dir() else settings.data
@@ -129,7 +176,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         raise TrainError(f"--data {settings.data}: {label_file.name} has no frames")
     groups = [str(Path(r["raw_file"]).parent) for r in records]
     train_idx, val_idx = split_indices(len(records), groups, settings.val_fraction, settings.seed)
-    augment = AUGMENTS[settings.augment]
+    augment = AUGMENTS.get(settings.augment)
     train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed)
     val_set = LabelledFrames(split_dir, spec, val_idx, train=False) if val_idx else None
 
@@ -160,8 +207,17 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         start_epoch = checkpoint["epoch"] + 1
     write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
 
+    bank = aam_bank(settings, split_dir, records, data_sha) if settings.augment == "aam" else []
+    hard: list = []
+
     model.train()
     for epoch in range(start_epoch, settings.epochs):
+        if bank and epoch >= 1:  # the model's attention means something after one epoch
+            scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
+                                [p.frame_size for p in bank], device)
+            for patch, (pred, gt, rows) in zip(bank, scores, strict=True):
+                patch.accuracy = score_image(pred, gt, rows, 0.0).accuracy
+            hard = hard_patches(bank, settings.aam.hard_share)
         started = time.perf_counter()
         train_set.epoch = epoch
         generator = torch.Generator().manual_seed(settings.seed * 1000 + epoch)
@@ -174,6 +230,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
                 break
             for group in optimizer.param_groups:
                 group["lr"] = _lr_at(epoch * steps_per_epoch + step, total_steps, settings.lr)
+            if hard:
+                batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step)
             batch = {k: v.to(device) for k, v in batch.items()}
             loss, terms = detector_loss(spec.family, model(batch["image"]), batch)
             optimizer.zero_grad(set_to_none=True)

@@ -78,7 +78,10 @@ def _color(marking: Marking) -> tuple[float, float, float]:
 
 
 def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: float) -> list[list[float]]:
-    """Stripes of one marking; for double lines the pair is centred on the boundary, the first on the left."""
+    """Stripes of one marking; for double lines the pair is centred on the boundary, the first on the left
+    (none for an unmarked boundary)."""
+    if marking.type == "none":
+        return []
     offset = (marking.width + DOUBLE_LINE_SPACING_M) / 2
     rgb = list(_color(marking))
     period = marking.dash + marking.gap
@@ -99,9 +102,11 @@ def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: 
     return [stripe(t, 2, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M)]
 
 
-def paint_stripes(network: RoadNetwork, markings: list[Marking]) -> FloatArray:
-    """Every painted stripe of the network as rows of the stripe table."""
+def paint_stripes(network: RoadNetwork, markings: list[Marking], paint: bool = True) -> FloatArray:
+    """Every painted stripe of the network as rows of the stripe table (none when ``paint`` is False)."""
     rows: list[list[float]] = []
+    if not paint:
+        return np.zeros((0, STRIPE_COLUMNS), np.float64)
     for index, piece in enumerate(network.pieces):
         last = len(piece.boundaries_t) - 1
         for k, (t, marking) in enumerate(zip(piece.boundaries_t, markings)):
@@ -250,7 +255,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         offset += len(mesh.vertices)
     all_v = np.concatenate(verts)
     all_f = np.concatenate(faces).astype(np.int32)
-    stripes = paint_stripes(scene.network, scene.case.road.markings)
+    stripes = paint_stripes(scene.network, scene.case.road.markings, scene.case.road.paint)
     lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
                       np.float64).reshape(-1, 7)
     packed = PackedScene(

@@ -166,3 +166,48 @@ def test_shipped_model_detects_the_lanes_of_clean_renders(tmp_path, family):
     gt = [json.loads(line) for line in (out / "test" / "test_label.json").read_text().splitlines()]
     scores = [score_image(p["lanes"], g["lanes"], g["h_samples"], 0.0).accuracy for p, g in zip(records, gt)]
     assert np.mean(scores) >= 0.85  # the shipped models score 95-96 % over all stock originals
+
+
+def test_aam_mixing_touches_only_masked_pixels():
+    from lanevil_core.learn.aam import mix
+
+    rng = np.random.default_rng(1)
+    images = torch.from_numpy(rng.random((2, 3, 8, 10), dtype=np.float32))
+    patches = torch.zeros_like(images)
+    masks = torch.zeros(2, 8, 10)
+    masks[:, 2:4, 3:6] = 1.0
+    attention_map = torch.ones(2, 8, 10)
+    mixed = mix(images, attention_map, patches, masks)
+    outside = masks[:, None].expand_as(images) == 0
+    assert torch.equal(mixed[outside], images[outside])
+    assert torch.all(mixed[:, :, 2:4, 3:6] == 0)  # full attention and mask: the patch replaces the pixel
+    half = mix(images, attention_map * 0.5, patches, masks)
+    assert torch.allclose(half[:, :, 2:4, 3:6], images[:, :, 2:4, 3:6] * 0.5)
+
+
+def test_aam_bank_never_holds_a_test_case():
+    import hashlib
+
+    from lanevil_core.case import case_json, load_case
+    from lanevil_core.learn.aam import bank_case
+
+    stock = {hashlib.sha256(case_json(load_case(path)).encode()).hexdigest() for path in SCENES.glob("**/*.json")}
+    clean = [load_case(path) for path in sorted((SCENES / "00_clean").glob("*.json"))]
+    bank = [bank_case(clean, 0, index) for index in range(28)]
+    hashes = {hashlib.sha256(case_json(case).encode()).hexdigest() for case in bank}
+    assert len(hashes) == 28 and not hashes & stock
+    assert {case.illusions[0].type for case in bank} == {path.parent.name for path in SCENES.glob("[1-4]*/*/")}
+
+
+def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):
+    from lanevil_core.learn.aam import AamSettings
+    from lanevil_core.learn.train import AAM_BANK_FILE, TrainSettings, train
+
+    spec = ModelSpec(family="seg", **TINY_SPEC)
+    settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=2, batch=2, augment="aam",
+                             val_fraction=0.5, max_steps=2, aam=AamSettings(bank_cases=2, probability=1.0))
+    summary = train(settings, show_progress=False)
+    assert summary["augment"] == "aam" and len(summary["history"]) == 2
+    bank = torch.load(tmp_path / AAM_BANK_FILE, weights_only=False)["patches"]
+    assert bank and all(0.0 <= p.mask.min() and p.mask.max() <= 1.0 for p in bank)
+    assert all(p.mask.mean() > 0 for p in bank)
