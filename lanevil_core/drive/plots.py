@@ -95,8 +95,9 @@ def path_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:
     route_t = trace.route.t_center
     if trace.illusion_span is not None:
         ax_unrolled.axvspan(*trace.illusion_span, color=ILLUSION_COLOR, alpha=0.25, label="illusion")
-        ax_unrolled.axvline(trace.illusion_span[0] - VIEW_RANGE_M, color=ILLUSION_COLOR, lw=1.0, ls=":",
-                            label="comes into view (camera)")
+        s_view = trace.illusion_span[0] - VIEW_RANGE_M
+        if s_view > s_road[0]:  # stock illusions are in view from the start
+            ax_unrolled.axvline(s_view, color=ILLUSION_COLOR, lw=1.0, ls=":", label="comes into view (camera)")
     ax_unrolled.axhspan(route_t - DEVIATION_THRESHOLD_M, route_t + DEVIATION_THRESHOLD_M, color="#2a9d8f",
                         alpha=0.12, label=f"route +- {DEVIATION_THRESHOLD_M} m")
     ax_unrolled.plot(s_path, [step.t_road for step in trace.steps], color="#e63946", lw=1.6, label="driven")
