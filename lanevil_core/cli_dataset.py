@@ -33,7 +33,11 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--train-frames", type=_count(0), default=0,
                         help="clean train frames, from variations of the clean cases (default 0)")
     parser.add_argument("--frames-per-case", type=_count(1), default=None,
-                        help="frames per test case, evenly spaced over its drive (default: every frame)")
+                        help="frames per test case (default: every frame)")
+    parser.add_argument("--sampling", choices=("in_view", "even"), default="in_view",
+                        help="which test frames with --frames-per-case: in_view (default) = evenly over the frames "
+                             "where the type's level-5 illusion changes the lane band, the same frames for its "
+                             "original and every level; even = evenly over the whole drive")
     parser.add_argument("--size", type=parse_size, default=(1280, 720), help="WIDTHxHEIGHT (default 1280x720)")
     parser.add_argument("--format", choices=("png", "jpg"), default="png", dest="image_format",
                         help="image format (default png)")
@@ -66,7 +70,8 @@ def _run_dataset(args: argparse.Namespace) -> int:
     else:
         executor = functools.partial(run_local, workers=args.workers)
     settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
-                        train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint)
+                        train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint,
+                        sampling=args.sampling)
     try:
         summary = generate_dataset(args.cases, args.out, settings, executor, show_progress=not args.quiet)
     except (PlanError, SchedulerError) as error:

@@ -80,6 +80,32 @@ def with_illusion(case: Case, illusion: dict[str, Any]) -> Case:
     return parse_case(data)
 
 
+def clean_of(case: Case) -> Case:
+    """The case without its illusions (what an illusion's change is measured against)."""
+    return case.model_copy(update={"illusions": []})
+
+
+SHARE_SIZE = (160, 90)  # renders that only locate an illusion are this small
+IN_VIEW_SHARE = 0.05  # a frame shows the illusion when it changes at least this share of the lane band
+
+
+def in_view_frames(case: Case, count: int, step: int = 2) -> tuple[int, ...]:
+    """``count`` frames of the drive, evenly over those where the illusion changes at least ``IN_VIEW_SHARE``
+    of the lane band (every ``step``-th frame tried at ``SHARE_SIZE``); the frames where it changes most when
+    fewer show it; the evenly spaced frames of the whole drive when it never does."""
+    from .dataset.plan import evenly_spaced
+
+    candidates = list(range(0, case.ego.frames, step))
+    changes = frame_changes(clean_of(case), case, candidates, SHARE_SIZE)
+    shown = [frame for frame, change in zip(candidates, changes, strict=True) if change.share >= IN_VIEW_SHARE]
+    if not shown:
+        return evenly_spaced(case.ego.frames, count)
+    if len(shown) < count:  # a short sighting: the frames where it shows most
+        ranked = sorted(zip(candidates, changes, strict=True), key=lambda fc: (-fc[1].share, fc[0]))
+        return tuple(sorted(frame for frame, _ in ranked[:count]))
+    return tuple(shown[i] for i in evenly_spaced(len(shown), count))
+
+
 def frame_changes(original: Case, perturbed: Case, frames: Sequence[int],
                   size: tuple[int, int] = (320, 180)) -> list[BandChange]:
     """Band change of each frame between two renders of the same drive (the original's lanes as the band)."""

@@ -137,7 +137,8 @@ def build_manifest(plan: DatasetPlan, versions: dict[str, str], code_sha256: str
         "versions": {**versions, "renderer_source_sha256": code_sha256},
         "settings": {"size": list(settings.size), "format": settings.image_format,
                      "frames_per_case": settings.frames_per_case, "train_frames": settings.train_frames,
-                     "seed": settings.seed, "no_paint": settings.no_paint},
+                     "seed": settings.seed, "no_paint": settings.no_paint,
+                     "sampling": settings.sampling},
         "splits": splits,
         "cases": [case_entry(case, plan, frame_hashes[case.key]) for case in plan.cases],
     }

@@ -70,6 +70,7 @@ class Settings:
     train_frames: int = 0
     seed: int = 0
     no_paint: bool = False  # also render every original with its lane paint removed (the paint-free control)
+    sampling: str = "in_view"  # test frames: "in_view" of each type's level-5 illusion, or "even" over the drive
 
     @property
     def suffix(self) -> str:
@@ -196,8 +197,29 @@ def discover_cases(root: Path) -> list[SourceCase]:
     return [SourceCase(PurePosixPath(path.relative_to(root).as_posix()), load_case(path)) for path in paths]
 
 
-def planned_test_case(source: SourceCase, frames_per_case: int | None) -> PlannedCase:
-    """The test-split entry of a case with an illusion type."""
+SAMPLINGS = ("in_view", "even")
+
+
+def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None) -> dict[str, tuple[int, ...]]:
+    """Test frames per case folder (a type's original and levels) where that folder's most severe case shows
+    its illusion near the lanes, so Original and every level are scored on the same views."""
+    from ..illusion_effect import in_view_frames
+
+    if frames_per_case is None:
+        return {}
+    strongest: dict[str, SourceCase] = {}
+    for source in typed:
+        if source.case.illusions:
+            folder = str(source.relative.parent)
+            best = strongest.get(folder)
+            if best is None or source.case.illusions[0].severity > best.case.illusions[0].severity:
+                strongest[folder] = source
+    return {folder: in_view_frames(source.case, frames_per_case) for folder, source in strongest.items()}
+
+
+def planned_test_case(source: SourceCase, frames_per_case: int | None,
+                      frames: tuple[int, ...] | None = None) -> PlannedCase:
+    """The test-split entry of a case with an illusion type (``frames``: chosen frames, else evenly spaced)."""
     case = source.case
     illusion_type = case_illusion_type(case, source.folder_type)
     if illusion_type is None:
@@ -206,7 +228,8 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None) -> Planne
     severity = case.illusions[0].severity if case.illusions else 0
     return PlannedCase(
         split=TEST_SPLIT, folder=folder, case_text=case_json(case),
-        frames=evenly_spaced(case.ego.frames, frames_per_case), illusion_type=illusion_type,
+        frames=frames if frames is not None else evenly_spaced(case.ego.frames, frames_per_case),
+        illusion_type=illusion_type,
         category=CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY], type_folder=TYPE_FOLDERS[illusion_type],
         severity=severity, source={"file": str(source.relative)},
     )
@@ -325,7 +348,11 @@ def build_plan(sources: list[SourceCase], settings: Settings) -> DatasetPlan:
         raise PlanError("no case files (*.json) found")
     typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
     clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
-    planned = [planned_test_case(source, settings.frames_per_case) for source in typed]
+    if settings.sampling not in SAMPLINGS:
+        raise PlanError(f"sampling: {settings.sampling!r} is not one of {', '.join(SAMPLINGS)}")
+    chosen = in_view_by_folder(typed, settings.frames_per_case) if settings.sampling == "in_view" else {}
+    planned = [planned_test_case(source, settings.frames_per_case,
+                                 chosen.get(str(source.relative.parent))) for source in typed]
     if settings.no_paint:
         planned += [paint_free(case) for case in planned if case.severity == 0]
     planned += train_cases(clean, settings.train_frames, settings.seed)

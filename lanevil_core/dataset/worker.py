@@ -80,15 +80,29 @@ def frame_record(scene: CompiledScene, task: RenderTask, frame_index: int, frame
     return {**tusimple_record(scene, frame_index, frame, raw_file), **task.extras}
 
 
+def illusion_changes(task: RenderTask) -> dict[int, dict[str, float]]:
+    """Per frame of a case with an illusion: the share of the lane band it changes and its effect there
+    (``illusion_effect``, measured on small renders against the case without its illusions)."""
+    from ..illusion_effect import SHARE_SIZE, clean_of, frame_changes
+
+    case = parse_case(task.case_text)
+    if not case.illusions:
+        return {}
+    changes = frame_changes(clean_of(case), case, task.frames, SHARE_SIZE)
+    return {frame: {"illusion_share": round(change.share, 4), "illusion_effect": round(change.effect, 3)}
+            for frame, change in zip(task.frames, changes, strict=True)}
+
+
 def render_chunk(task: RenderTask) -> list[FrameResult]:
     """Render, label and encode the task's frames (encoding of frame k overlaps rendering of frame k + 1)."""
     scene = compiled_scene(task.case_text, task.case_sha256)
     suffix = FORMATS[task.image_format]
+    changes = illusion_changes(task) if task.split == "test" else {}
     pending: list[tuple[int, dict[str, Any], Future[tuple[bytes, str]]]] = []
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="lanevil-encode") as encoder:
         for frame_index in task.frames:
             frame = render_frame(scene, frame_index, task.size)
-            record = frame_record(scene, task, frame_index, frame)
+            record = {**frame_record(scene, task, frame_index, frame), **changes.get(frame_index, {})}
             pending.append((frame_index, record, encoder.submit(_encode_and_hash, frame.rgb, task.image_format)))
         results = []
         for frame_index, record, future in pending:

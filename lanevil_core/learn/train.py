@@ -101,8 +101,9 @@ def predict_lanes(model: torch.nn.Module, dataset: LabelledFrames, device: torch
 
 
 def tusimple_accuracy(results: list[tuple[list[list[int]], list[list[int]], list[float]]]) -> float:
-    """Mean official per-image accuracy."""
-    scores = [score_image(pred, gt, rows, 0.0).accuracy for pred, gt, rows in results]
+    """Mean official per-image accuracy over the frames with labelled lanes (the metric scores a frame with no
+    lanes 0 whatever is predicted, so unpainted training variations are left out)."""
+    scores = [score_image(pred, gt, rows, 0.0).accuracy for pred, gt, rows in results if gt]
     return float(np.mean(scores)) if scores else float("nan")
 
 

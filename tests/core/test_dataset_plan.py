@@ -34,7 +34,7 @@ def stock() -> list[SourceCase]:
 
 
 def test_stock_library_plan(stock: list[SourceCase]) -> None:
-    plan = build_plan(stock, Settings(frames_per_case=10, train_frames=160))
+    plan = build_plan(stock, Settings(frames_per_case=10, train_frames=160, sampling="even"))
     test = plan.split_cases("test")
     assert len(test) == 6 * len(REGISTRY)  # an original and five levels per illusion type
     assert len({case.folder for case in test}) == len(test)
@@ -73,7 +73,7 @@ def test_clashing_folders_and_missing_cases_are_plan_errors(stock: list[SourceCa
 
 
 def test_tasks_cover_the_pending_frames_in_chunks(stock: list[SourceCase]) -> None:
-    plan = build_plan(stock[:12], Settings(frames_per_case=10))
+    plan = build_plan(stock[:12], Settings(frames_per_case=10, sampling="even"))
     pending = {case.key: list(case.frames) for case in plan.cases}
     tasks = render_tasks(plan, pending, chunk_frames=4)
     assert sum(len(task.frames) for task in tasks) == plan.total_frames
@@ -84,3 +84,15 @@ def test_renderer_sources_reach_the_render_path_only() -> None:
     names = {path.relative_to(_PACKAGE).as_posix() for path in source_files()}
     assert {"dataset/worker.py", "render/renderer.py", "labels.py", "compile.py", "export.py"} <= names
     assert not any(name.startswith(("cli", "dataset/local", "dataset/run")) for name in names)
+
+
+def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[SourceCase]) -> None:
+    from lanevil_core.illusion_effect import IN_VIEW_SHARE, SHARE_SIZE, clean_of, frame_changes
+
+    fence = [source for source in stock if source.relative.parent.name == "fence_shadow"]
+    plan = build_plan(fence, Settings(frames_per_case=4))
+    frames = {case.frames for case in plan.split_cases("test")}
+    assert len(frames) == 1  # the original and every level share the views
+    strongest = max(fence, key=lambda s: s.case.illusions[0].severity if s.case.illusions else 0).case
+    changes = frame_changes(clean_of(strongest), strongest, next(iter(frames)), SHARE_SIZE)
+    assert all(change.share >= IN_VIEW_SHARE for change in changes)
