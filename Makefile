@@ -7,7 +7,7 @@ STAMP := $(VENV)/.lanevil-installed
 # The CPU build of PyTorch (a plain `torch` from the index is a multi-GB CUDA build); only `lanevil train` needs it.
 TORCH ?= torch==2.13.0
 
-.PHONY: run preview test test-fast test-slow test-browser bench clean
+.PHONY: run preview test test-fast test-slow test-browser bench models clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -36,6 +36,19 @@ test-slow: $(STAMP)
 test-browser: $(STAMP)
 	scripts/install-chromium
 	$(PY) -m pytest -q -m browser || test $$? -eq 5
+
+# The shipped learned detectors (lanevil_core/detect/models/ufld and seg): render a diversified clean train split
+# (4,000 frames at 640x360), train both families at 320x180 and copy each model folder's files into place.
+# About 12 min of rendering and 25-35 min of training on 2 idle cores; MODELS_DATA keeps the renders for reruns.
+MODELS_DATA ?= out/models-data
+SHIPPED := lanevil_core/detect/models
+models: $(STAMP)
+	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA) --train-frames 4000 --size 640x360
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld --model ufld --epochs 12
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
+	for family in ufld seg; do mkdir -p $(SHIPPED)/$$family && \
+	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
+	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
 
 bench: $(STAMP)
 	$(PY) -m lanevil_core.cli bench

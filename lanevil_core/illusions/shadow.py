@@ -208,19 +208,19 @@ class FenceShadow(SunShadowIllusion):
 class RailShadow(SunShadowIllusion):
     """An elevated slotted rail deck over the road: a shaded road with bright lines where light comes through."""
 
-    # One high sun at every level; the deck grows longer and its slots (along the road: bright lines parallel to
-    # the lanes) wider and closer, so more of the road lies in its striped shade.
+    # One high sun and one slot pattern (slots along the road: bright lines parallel to the lanes) at every level;
+    # the deck, starting at the same place, grows longer, so each level's striped shade holds the one before.
     SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
         {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 4.0,
-         "slots_along": "s", "slot_width": 0.12, "slot_pitch": 1.8, "deck_depth": 0.35},  # a narrow footbridge
+         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},  # a narrow footbridge
         {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 8.0,
-         "slots_along": "s", "slot_width": 0.18, "slot_pitch": 1.6, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 12.0,
          "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 16.0,
-         "slots_along": "s", "slot_width": 0.30, "slot_pitch": 1.25, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 20.0,
-         "slots_along": "s", "slot_width": 0.36, "slot_pitch": 1.1, "deck_depth": 0.35},  # a slotted viaduct
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 13.0,
+         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 19.0,
+         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
+        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 26.0,
+         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},  # a slotted viaduct
     )
 
     type: Literal["rail_shadow"] = "rail_shadow"
