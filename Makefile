@@ -6,13 +6,15 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.lanevil-installed
 # The CPU build of PyTorch (a plain `torch` from the index is a multi-GB CUDA build); only `lanevil train` needs it.
 TORCH ?= torch==2.13.0
+# Every extra: the library alone needs none of them (pip install -e . gives cases, renderer, labels, dataset, metrics).
+EXTRAS ?= web,dask,report,learn,test
 
 .PHONY: run preview test test-fast test-slow test-browser bench models clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet $(TORCH)
-	$(PY) -m pip install --quiet -e '.[test,learn]'
+	$(PY) -m pip install --quiet -e '.[$(EXTRAS)]'
 	touch $(STAMP)
 
 # The web backend, demo website, study and viser editor, on the stock library (Ctrl+C stops both servers).
