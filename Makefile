@@ -9,7 +9,7 @@ TORCH ?= torch==2.13.0
 # Every extra: the library alone needs none of them (pip install -e . gives cases, renderer, labels, dataset, metrics).
 EXTRAS ?= web,dask,report,learn,test
 
-.PHONY: run preview test test-fast test-slow test-browser bench models clean
+.PHONY: run preview test lint test-fast test-slow test-browser bench models clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -25,7 +25,11 @@ run: $(STAMP)
 preview: $(STAMP)
 	$(PY) -m app.cli preview --out out
 
-test: test-fast test-slow test-browser
+test: lint test-fast test-slow test-browser
+
+# ruff (pycodestyle, pyflakes, isort, bugbear, pyupgrade) over the code and its tests.
+lint: $(STAMP)
+	$(PY) -m ruff check lanevil_core app tests bench scripts
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -n auto

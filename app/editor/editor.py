@@ -21,8 +21,8 @@ import viser
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, CaseError, parse_case
 from lanevil_core.compile import roadside_key
-from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.illusions import REGISTRY, Illusion
+from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.presets import preset_values
 from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.scene import CompiledScene

@@ -14,7 +14,8 @@ ILLUSION_TYPES: tuple[str, ...] = tuple(REGISTRY)
 
 # The ``illusions`` list of a case: a discriminated union on ``type``.
 if len(REGISTRY) >= 2:
-    IllusionSpec = Annotated[Union[tuple(REGISTRY.values())], Field(discriminator="type")]  # type: ignore[valid-type]
+    # Union[...] over the registry's tuple of classes: X | Y has no spelling for a tuple built at run time.
+    IllusionSpec = Annotated[Union[tuple(REGISTRY.values())], Field(discriminator="type")]  # type: ignore[valid-type]  # noqa: UP007
 else:  # while the registry is being filled
     IllusionSpec = Illusion  # type: ignore[misc]
 

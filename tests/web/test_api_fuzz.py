@@ -35,7 +35,8 @@ CHECKS = [not_a_server_error, status_code_conformance, content_type_conformance,
 
 
 @pytest.mark.slow
-def test_api_never_answers_5xx_and_answers_what_its_schema_says(settings: Settings, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_api_never_answers_5xx_and_answers_what_its_schema_says(settings: Settings,
+                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(labels, "MAX_LABEL_FRAMES", 2)
     monkeypatch.setattr(exports, "SYNC_EXPORT_FRAMES", 1)
     small = settings.model_copy(update={"max_width": 160, "max_height": 96})

@@ -106,7 +106,7 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     seen = [before]
     for current, name in (("none", "hough"), ("hough", "ufld")):
         pick(page, current, name)
-        wait_for(lambda: editor.panel.detector.value == name, f"the Detector dropdown at {name}")
+        wait_for(lambda name=name: editor.panel.detector.value == name, f"the Detector dropdown at {name}")
         assert editor.preview.wait_idle(WAIT_S)
         score = page.get_by_text(f"{name} (magenta):").first
         score.wait_for(timeout=WAIT_S * 1000)
