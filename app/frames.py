@@ -23,7 +23,7 @@ from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
 from lanevil_core.compile import compile_scene, roadside_key
 from lanevil_core.detector_catalog import available_detector
-from lanevil_core.export import jpeg_bytes, png_bytes
+from lanevil_core.encode import jpeg_bytes, png_bytes
 from lanevil_core.frame_detection import FrameDetection, detect_frame
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record

@@ -111,7 +111,7 @@ def image_path(path: Path, flag: str = "--out") -> Path:
 
 def encode_image(rgb: np.ndarray, path: Path) -> bytes:
     """(H, W, 3) uint8 pixels encoded as ``path``'s suffix says (PNG or JPEG)."""
-    from .export import jpeg_bytes, png_bytes
+    from .encode import jpeg_bytes, png_bytes
 
     return png_bytes(rgb) if IMAGE_FORMATS[path.suffix.lower()] == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
 
@@ -231,7 +231,7 @@ def preview_path(case_path: Path, out_dir: Path, root: Path = SCENES_DIR) -> Pat
 
 
 def _run_preview(args: argparse.Namespace) -> int:
-    from .export import png_bytes
+    from .encode import png_bytes
     from .overlay import draw_lanes
 
     paths = args.cases or stock_scenes()

@@ -68,7 +68,7 @@ def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_sheet(args: argparse.Namespace) -> int:
-    from .export import png_bytes
+    from .encode import png_bytes
     from .sheet import contact_sheet
 
     types = None

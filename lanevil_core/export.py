@@ -14,7 +14,6 @@ Every file is written atomically and byte-for-byte deterministically (PNG withou
 
 from __future__ import annotations
 
-import io
 import json
 from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass, field
@@ -22,21 +21,19 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
-from PIL import Image
 
-from .case import Case, Marking, case_json, write_atomic
+from .case import Case, case_json, write_atomic
 from .compile import compile_scene
+from .encode import png_bytes
 from .labels import CULANE_SIZE, TUSIMPLE_SIZE, culane_lines, tusimple_record
+from .paint import MATERIAL_ALBEDO, paint_mesh
+from .primitives import flat_trimesh
 from .render import render_frame
-from .render.packed import MATERIAL_ALBEDO, STRIPE_COLUMNS, paint_stripes
-from .road_layout import RoadNetwork
 from .road_mesh import road_surface
 from .scene import CompiledScene
-from .typed import Float32Array, FloatArray, IntArray, UInt8Array
+from .typed import Float32Array, FloatArray, IntArray
 
 FORMATS: tuple[str, ...] = ("tusimple", "culane")
-PAINT_LIFT_M = 0.01  # paint quads float this far above the asphalt in the glTF scene
-PAINT_STEP_M = 1.0  # length of one paint quad along the road
 # glTF is +Y up: world (x, y, z) -> glTF (x, z, -y).
 R_GLTF_WORLD = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 
@@ -49,21 +46,6 @@ class ExportResult:
 
     out_dir: Path
     files: list[str] = field(default_factory=list)
-
-
-def png_bytes(rgb: UInt8Array) -> bytes:
-    """PNG encoding of an (H, W, 3) uint8 image, with no metadata (same pixels -> same bytes)."""
-    buffer = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8), "RGB").save(buffer, format="PNG", compress_level=6)
-    return buffer.getvalue()
-
-
-def jpeg_bytes(rgb: UInt8Array, quality: int) -> bytes:
-    """Baseline JPEG (4:2:0) of an (H, W, 3) uint8 image, with no metadata (same pixels -> same bytes)."""
-    buffer = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8), "RGB").save(
-        buffer, format="JPEG", quality=quality, subsampling=2, optimize=False)
-    return buffer.getvalue()
 
 
 def _check_formats(formats: Collection[str]) -> None:
@@ -132,65 +114,23 @@ def export_case(
     return result
 
 
-def _flat_trimesh(vertices: FloatArray, faces: IntArray, colors: Float32Array) -> trimesh.Trimesh:
-    """A trimesh in glTF axes with one colour per face (vertices unshared so colours stay flat)."""
-    p_world = vertices[faces].reshape(-1, 3)
-    rgba = np.empty((len(faces), 4), np.uint8)
-    rgba[:, :3] = np.clip(np.round(np.asarray(colors, np.float64) * 255.0), 0, 255).astype(np.uint8)
-    rgba[:, 3] = 255
-    return trimesh.Trimesh(
-        vertices=p_world @ R_GLTF_WORLD.T,
-        faces=np.arange(len(p_world), dtype=np.int64).reshape(-1, 3),
-        vertex_colors=np.repeat(rgba, 3, axis=0),
-        process=False,
-    )
-
-
-def _dash_spans(s0: float, s1: float, pattern: int, on: float, period: float) -> list[tuple[float, float]]:
-    """Painted [a, b) spans of one stripe; dashes and dots start at ``s0`` with period ``period``."""
-    if pattern == 0:
-        return [(s0, s1)]
-    starts = np.arange(s0, s1, period)
-    return [(float(a), float(min(a + on, s1))) for a in starts]
-
-
-def paint_mesh(network: RoadNetwork, markings: list[Marking],
-               paint: bool = True) -> tuple[FloatArray, IntArray, Float32Array]:
-    """Quads of every paint stripe just above the road: vertices (n, 3), faces (m, 3), colours (m, 3)."""
-    stripes = paint_stripes(network, markings, paint).reshape(-1, STRIPE_COLUMNS)
-    vertices, faces, colors = [], [], []
-    count = 0
-    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary in stripes:
-        line = network.pieces[int(piece)].line
-        for a, b_end in _dash_spans(s0, s1, int(pattern), on, period):
-            s_road = np.append(np.arange(a, b_end, PAINT_STEP_M), b_end)
-            left = line.to_world(s_road, t_c + half, PAINT_LIFT_M)
-            right = line.to_world(s_road, t_c - half, PAINT_LIFT_M)
-            n = len(s_road)
-            vertices.append(np.concatenate([left, right]))
-            i = np.arange(n - 1)
-            quads = np.stack([i, i + n, i + 1, i + 1, i + n, i + n + 1], axis=1).reshape(-1, 3) + count
-            faces.append(quads)
-            colors.append(np.tile([r, g, b], (len(quads), 1)))
-            count += 2 * n
-    if not faces:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32)
-    return (np.concatenate(vertices), np.concatenate(faces).astype(np.int32),
-            np.concatenate(colors).astype(np.float32))
+def _gltf(vertices: FloatArray, faces: IntArray, colors: Float32Array) -> trimesh.Trimesh:
+    """A flat-coloured mesh in glTF axes."""
+    return flat_trimesh(np.asarray(vertices, np.float64) @ R_GLTF_WORLD.T, faces, colors)
 
 
 def scene_glb(scene: CompiledScene) -> bytes:
     """The compiled 3D scene (road surface, paint, visible objects) as glTF binary bytes, +Y up."""
     gltf_scene = trimesh.Scene()
     road = road_surface(scene.network)
-    gltf_scene.add_geometry(_flat_trimesh(road.vertices, road.faces, MATERIAL_ALBEDO[road.material]),
+    gltf_scene.add_geometry(_gltf(road.vertices, road.faces, MATERIAL_ALBEDO[road.material]),
                             geom_name="road", node_name="road")
     paint = paint_mesh(scene.network, scene.case.road.markings, scene.case.road.paint)
     if len(paint[1]):
-        gltf_scene.add_geometry(_flat_trimesh(*paint), geom_name="paint", node_name="paint")
+        gltf_scene.add_geometry(_gltf(*paint), geom_name="paint", node_name="paint")
     for index, mesh in enumerate(scene.meshes):
         if mesh.visible and len(mesh.faces):
             name = f"{index:04d}_{mesh.name}"
-            gltf_scene.add_geometry(_flat_trimesh(mesh.vertices, mesh.faces, mesh.colors),
+            gltf_scene.add_geometry(_gltf(mesh.vertices, mesh.faces, mesh.colors),
                                     geom_name=name, node_name=name)
     return gltf_scene.export(file_type="glb")

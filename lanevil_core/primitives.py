@@ -13,7 +13,7 @@ import trimesh
 
 from .road_geometry import ReferenceLine
 from .scene import Mesh
-from .typed import FloatArray
+from .typed import Float32Array, FloatArray, IntArray
 
 ColorLike = Sequence[float] | np.ndarray
 
@@ -34,6 +34,16 @@ def to_mesh(
     emitted = None if emission is None else np.broadcast_to(np.asarray(emission, np.float32), (m, 3))
     return Mesh(np.array(tm.vertices, np.float64), np.array(tm.faces, np.int32), colors, name=name, kind=kind,
                 casts_shadow=casts_shadow, gloss=gloss, emission=emitted)
+
+
+def flat_trimesh(vertices: FloatArray, faces: IntArray, colors: Float32Array) -> trimesh.Trimesh:
+    """A trimesh of (n, 3) ``vertices`` and (m, 3) ``faces`` with one (m, 3) linear colour per face, as 8-bit
+    vertex colours (vertices unshared, so colours and normals stay flat); for the glTF scene and the editor."""
+    p = np.asarray(vertices, np.float64)[faces].reshape(-1, 3)
+    rgba = np.full((len(faces), 4), 255, np.uint8)
+    rgba[:, :3] = np.clip(np.round(np.asarray(colors, np.float64) * 255.0), 0, 255).astype(np.uint8)
+    return trimesh.Trimesh(vertices=p, faces=np.arange(len(p), dtype=np.int64).reshape(-1, 3),
+                           vertex_colors=np.repeat(rgba, 3, axis=0), process=False)
 
 
 def merge(meshes: Sequence[Mesh], name: str = "object", kind: str = "prop", gloss: float | None = None) -> Mesh:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .case import write_atomic
+from .encode import figure_png
 from .metrics.evaluate import ScoredImage
 from .metrics.tusimple import summarize
 
@@ -250,10 +251,7 @@ def severity_plot(report: Report) -> bytes:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return buffer.getvalue()
+    return figure_png(fig)
 
 
 def write_report(report: Report, out_dir: str | Path) -> list[Path]:

@@ -7,11 +7,11 @@ one line per detector. Each detector's own full report (``report.md`` ...) goes 
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
 from .case import write_atomic
+from .encode import figure_png
 from .report import ALL, CATEGORY_ORDER, LEVELS, Report, Row, _csv, _number, _pct, write_report
 
 COMPARE_MD, COMPARE_CSV, COMPARE_PNG = "compare.md", "compare.csv", "compare.png"
@@ -148,10 +148,7 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return buffer.getvalue()
+    return figure_png(fig)
 
 
 def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str) -> list[Path]:

@@ -8,7 +8,7 @@ Nodes (all under fixed names, so rebuilding one replaces it):
   /sun           an arrow towards the sun and a small sun ball
   /gizmo         the move handle of the selected illusion (along / across the road)
 
-Geometry comes from ``lanevil_core`` (``road_surface``, ``export.paint_mesh``, the meshes and surface layers of the
+Geometry comes from ``lanevil_core`` (``road_surface``, ``paint.paint_mesh``, the meshes and surface layers of the
 compiled scene, ``ego_camera``); this module only converts it to viser nodes. Colours are the scene's linear albedos,
 written as glTF vertex colours (linear by the glTF spec), so the view matches the renderer's materials.
 """
@@ -25,8 +25,8 @@ from PIL import Image
 
 from lanevil_core.camera import PinholeCamera, ego_camera
 from lanevil_core.case import Case
-from lanevil_core.export import paint_mesh
-from lanevil_core.render.packed import MATERIAL_ALBEDO
+from lanevil_core.paint import MATERIAL_ALBEDO, paint_mesh
+from lanevil_core.primitives import flat_trimesh
 from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.road_mesh import RoadSurface, road_surface
 from lanevil_core.scene import CompiledScene, Mesh, SurfaceLayer
@@ -44,15 +44,6 @@ SUN_COLOR = (255, 210, 60)
 SELECTED_TINT = np.array([1.0, 0.55, 0.1], np.float32)
 
 MoveHandler = Callable[[FloatArray], None]
-
-
-def flat_trimesh(vertices: FloatArray, faces: IntArray, colors: Float32Array) -> trimesh.Trimesh:
-    """A world-frame trimesh with one linear colour per face (vertices unshared so colours and normals stay flat)."""
-    p_world = np.asarray(vertices, np.float64)[faces].reshape(-1, 3)
-    rgba = np.full((len(faces), 4), 255, np.uint8)
-    rgba[:, :3] = np.clip(np.round(np.asarray(colors, np.float64) * 255.0), 0, 255).astype(np.uint8)
-    return trimesh.Trimesh(vertices=p_world, faces=np.arange(len(p_world), dtype=np.int64).reshape(-1, 3),
-                           vertex_colors=np.repeat(rgba, 3, axis=0), process=False)
 
 
 def merged(parts: Sequence[tuple[FloatArray, IntArray, Float32Array]]) -> tuple[FloatArray, IntArray, Float32Array]:

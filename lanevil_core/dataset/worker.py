@@ -18,7 +18,7 @@ from typing import Any
 from ..benchmark_layout import frame_file
 from ..case import parse_case
 from ..compile import compile_scene
-from ..export import jpeg_bytes, png_bytes
+from ..encode import jpeg_bytes, png_bytes
 from ..labels import tusimple_record
 from ..render import render_frame
 from ..scene import CompiledScene
@@ -44,7 +44,7 @@ TaskDone = Callable[[RenderTask, list[FrameResult]], None]  # called in the call
 
 
 def encode_image(rgb: UInt8Array, image_format: str) -> bytes:
-    """PNG (``export.png_bytes``) or JPEG (quality 95, 4:2:0) bytes with no metadata: same pixels, same bytes."""
+    """PNG (``encode.png_bytes``) or JPEG (quality 95, 4:2:0) bytes with no metadata: same pixels, same bytes."""
     if image_format == "png":
         return png_bytes(rgb)
     if image_format == "jpg":

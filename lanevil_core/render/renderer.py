@@ -8,9 +8,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..camera import PinholeCamera, ego_camera
+from ..paint import MATERIAL_ALBEDO
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
-from .packed import MATERIAL_ALBEDO, PackedScene, pack_scene
+from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
 from .raster import rasterize_perspective
 from .shading import shade, shade_mirror

@@ -16,7 +16,7 @@ from lanevil_core.cli import main
 from lanevil_core.compile import compile_scene
 from lanevil_core.detect import DETECTORS, GroundCamera, detect_split
 from lanevil_core.detect.common import lane_columns
-from lanevil_core.export import png_bytes
+from lanevil_core.encode import png_bytes
 from lanevil_core.labels import tusimple_record
 from lanevil_core.metrics.tusimple import score_image, summarize
 from lanevil_core.render import render_frame

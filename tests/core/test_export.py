@@ -12,7 +12,9 @@ import trimesh
 from PIL import Image
 
 from lanevil_core.case import Case, load_case
-from lanevil_core.export import _dash_spans, export_case, paint_mesh, png_bytes
+from lanevil_core.encode import png_bytes
+from lanevil_core.export import export_case
+from lanevil_core.paint import dash_spans, paint_mesh
 from lanevil_core.road_layout import build_network
 
 CASE = Case.model_validate({"ego": {"frames": 50}, "scene": {"density": 0.3}})
@@ -89,9 +91,9 @@ def test_glb_scene_is_y_up_with_road_paint_and_objects(exported):
 
 
 def test_dash_spans_follow_the_marking_period():
-    spans = _dash_spans(0.0, 100.0, 1, 3.0, 12.0)
+    spans = dash_spans(0.0, 100.0, 1, 3.0, 12.0)
     assert spans[:2] == [(0.0, 3.0), (12.0, 15.0)] and spans[-1] == (96.0, 99.0) and len(spans) == 9
-    assert _dash_spans(5.0, 50.0, 0, 3.0, 12.0) == [(5.0, 50.0)]
+    assert dash_spans(5.0, 50.0, 0, 3.0, 12.0) == [(5.0, 50.0)]
 
 
 def test_paint_mesh_covers_every_stripe():

@@ -13,7 +13,7 @@ from lanevil_core.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, frame_
 from lanevil_core.case import load_case
 from lanevil_core.cli import main
 from lanevil_core.compile import compile_scene
-from lanevil_core.export import png_bytes
+from lanevil_core.encode import png_bytes
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import tusimple_record
 from lanevil_core.metrics.evaluate import ScoredImage, score_tusimple_files
