@@ -8,7 +8,7 @@ from typing import Any
 from fastapi import APIRouter
 
 from lanevil_core.case import case_schema
-from lanevil_core.cli_library import illusion_info
+from lanevil_core.cli.library import illusion_info
 from lanevil_core.illusions import CATEGORIES, REGISTRY
 
 from .errors import ApiRoute

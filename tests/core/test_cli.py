@@ -15,6 +15,8 @@ from PIL import Image
 
 from lanevil_core import bench, cli, files
 from lanevil_core.case import save_case
+from lanevil_core.cli import base as cli_base
+from lanevil_core.cli import core as cli_core
 
 
 @pytest.fixture
@@ -164,11 +166,11 @@ def test_export_frames_and_formats(case_file, tmp_path):
 
 
 def test_frame_range_parsing():
-    assert cli.frame_range(":", 50) == range(50)
-    assert cli.frame_range("10:", 50) == range(10, 50)
-    assert cli.frame_range(":3", 50) == range(3)
+    assert cli_base.frame_range(":", 50) == range(50)
+    assert cli_base.frame_range("10:", 50) == range(10, 50)
+    assert cli_base.frame_range(":3", 50) == range(3)
     with pytest.raises(cli.UsageError):
-        cli.frame_range("0:51", 50)
+        cli_base.frame_range("0:51", 50)
 
 
 def test_preview_writes_image_and_overlay(case_file, tmp_path, capsys):
@@ -182,8 +184,8 @@ def test_preview_writes_image_and_overlay(case_file, tmp_path, capsys):
 
 def test_preview_path_keeps_the_folder_below_scenes(tmp_path):
     root = tmp_path / "scenes"
-    assert cli.preview_path(root / "01_shadow" / "a.json", Path("out"), root) == Path("out/01_shadow/a.png")
-    assert cli.preview_path(tmp_path / "b.json", Path("out"), root) == Path("out/b.png")
+    assert cli_core.preview_path(root / "01_shadow" / "a.json", Path("out"), root) == Path("out/01_shadow/a.png")
+    assert cli_core.preview_path(tmp_path / "b.json", Path("out"), root) == Path("out/b.png")
 
 
 def test_bench_json_is_one_object(monkeypatch, capsys, make_case):
@@ -205,12 +207,12 @@ def test_frames_to_time_spreads_over_the_drive(make_case):
 
 
 def test_extension_modules_add_commands(monkeypatch):
-    module = types.ModuleType("lanevil_core.cli_fake")
+    module = types.ModuleType("lanevil_core.cli.fake")
     module.COMMANDS = {"fake": cli.Command("a test command", lambda parser: parser.add_argument("--n", type=int),
                                            lambda args: args.n)}
-    monkeypatch.setitem(sys.modules, "lanevil_core.cli_fake", module)
+    monkeypatch.setitem(sys.modules, "lanevil_core.cli.fake", module)
     real = cli.pkgutil.iter_modules
-    fake = types.SimpleNamespace(name="cli_fake", ispkg=False)
+    fake = types.SimpleNamespace(name="fake", ispkg=False)
     monkeypatch.setattr(cli.pkgutil, "iter_modules", lambda path: [*real(path), fake])
     assert {"render", "export", "preview", "bench", "fake"} <= set(cli.all_commands())
     assert cli.main(["fake", "--n", "7"]) == 7

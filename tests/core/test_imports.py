@@ -21,7 +21,8 @@ import importlib, json, pkgutil, sys
 import lanevil_core
 
 skip = sys.argv[1]
-names = sorted(info.name for info in pkgutil.walk_packages(lanevil_core.__path__, "lanevil_core."))
+names = sorted(info.name for info in pkgutil.walk_packages(lanevil_core.__path__, "lanevil_core.")
+               if not info.name.endswith(".__main__"))  # running a command is not importing it
 for name in names:
     if not (skip and (name == skip or name.startswith(skip + "."))):
         importlib.import_module(name)

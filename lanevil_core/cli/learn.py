@@ -6,12 +6,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from .cli import Command, UsageError, parse_size
-from .cli_dataset import _count
+from .base import Command, UsageError, parse_size
+from .dataset import _count
 
 
 def _train_arguments(parser: argparse.ArgumentParser) -> None:
-    from .detect.model_spec import BACKBONES, FAMILIES
+    from ..detect.model_spec import BACKBONES, FAMILIES
 
     parser.add_argument("--data", type=Path, required=True,
                         help="dataset folder written by `lanevil dataset` (its train/ split and train_label.json)")
@@ -47,8 +47,8 @@ def _run_train(args: argparse.Namespace) -> int:
         import torch  # noqa: F401
     except ImportError:
         raise UsageError("lanevil train needs PyTorch: pip install -e '.[learn]'") from None
-    from .detect.model_spec import ModelSpec, ModelSpecError
-    from .learn.train import TrainError, TrainSettings, train
+    from ..detect.model_spec import ModelSpec, ModelSpecError
+    from ..learn.train import TrainError, TrainSettings, train
 
     if not args.data.is_dir():
         raise UsageError(f"--data {args.data}: no such folder")

@@ -9,7 +9,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from .cli import Command, UsageError, parse_size
+from .base import Command, UsageError, parse_size
 
 
 def _count(minimum: int) -> Callable[[str], int]:
@@ -55,9 +55,9 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_dataset(args: argparse.Namespace) -> int:
-    from .dataset import PlanError, Settings, generate_dataset
-    from .dataset.distributed import SchedulerError, check_scheduler_address, run_dask
-    from .dataset.local import run_local
+    from ..dataset import PlanError, Settings, generate_dataset
+    from ..dataset.distributed import SchedulerError, check_scheduler_address, run_dask
+    from ..dataset.local import run_local
 
     if not args.cases.is_dir():
         raise UsageError(f"--cases {args.cases}: no such folder")

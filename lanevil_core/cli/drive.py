@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .cli import Command, UsageError, parse_size
+from .base import Command, UsageError, parse_size
 
 
 def _seconds(text: str) -> float:
@@ -20,9 +20,9 @@ def _seconds(text: str) -> float:
 
 
 def _drive_arguments(parser: argparse.ArgumentParser) -> None:
-    from .drive.controllers import CONTROLLERS
-    from .drive.detectors import DRIVE_DETECTORS
-    from .drive.loop import DEFAULT_SIZE
+    from ..drive.controllers import CONTROLLERS
+    from ..drive.detectors import DRIVE_DETECTORS
+    from ..drive.loop import DEFAULT_SIZE
 
     parser.add_argument("case", type=Path, nargs="?", help="case file (JSON); leave out with --suite")
     parser.add_argument("--suite", type=Path, default=None, metavar="DIR",
@@ -43,15 +43,15 @@ def _drive_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _settings(args: argparse.Namespace):  # noqa: ANN202 - DriveSettings, imported lazily
-    from .drive.loop import DriveSettings
+    from ..drive.loop import DriveSettings
 
     return DriveSettings(detector=args.detector, controller=args.controller, seconds=args.seconds, size=args.size,
                          weights=str(args.weights) if args.weights is not None else None)
 
 
 def _check_detector(args: argparse.Namespace) -> None:
-    from .drive.detectors import drive_detector
-    from .metrics.formats import LaneFileError
+    from ..drive.detectors import drive_detector
+    from ..metrics.formats import LaneFileError
 
     try:
         drive_detector(args.detector, args.weights)
@@ -60,7 +60,7 @@ def _check_detector(args: argparse.Namespace) -> None:
 
 
 def _run_suite(args: argparse.Namespace) -> int:
-    from .drive.suite import markdown, run_suite, suite_cases, suite_json, write_suite
+    from ..drive.suite import markdown, run_suite, suite_cases, suite_json, write_suite
 
     if not args.suite.is_dir():
         raise UsageError(f"--suite {args.suite}: no such folder")
@@ -78,8 +78,8 @@ def _run_suite(args: argparse.Namespace) -> int:
 
 
 def _run_drive(args: argparse.Namespace) -> int:
-    from .case import load_case
-    from .drive.outputs import drive_to_folder, summary_json
+    from ..case import load_case
+    from ..drive.outputs import drive_to_folder, summary_json
 
     if (args.case is None) == (args.suite is None):
         raise UsageError("give one case file or --suite DIR")

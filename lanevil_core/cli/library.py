@@ -7,9 +7,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from .case import write_atomic
-from .cli import Command, UsageError, parse_size
-from .illusions import REGISTRY, Illusion
+from ..case import write_atomic
+from ..illusions import REGISTRY, Illusion
+from .base import Command, UsageError, parse_size
 
 
 def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
@@ -68,8 +68,8 @@ def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_sheet(args: argparse.Namespace) -> int:
-    from .encode import png_bytes
-    from .sheet import contact_sheet
+    from ..encode import png_bytes
+    from ..sheet import contact_sheet
 
     types = None
     if args.types:
@@ -89,7 +89,7 @@ def _library_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_library(args: argparse.Namespace) -> int:
-    from .stock import write_library
+    from ..stock import write_library
 
     written = write_library(args.out)
     print(f"{len(written)} cases in {args.out}")
@@ -101,7 +101,7 @@ def _schema_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_schema(args: argparse.Namespace) -> int:
-    from .case import case_schema
+    from ..case import case_schema
 
     text = json.dumps(case_schema(), indent=2, sort_keys=True) + "\n"
     if args.out is None:

@@ -7,10 +7,10 @@ import json
 import sys
 from pathlib import Path
 
-from .case import write_atomic
-from .cli import Command, UsageError
-from .metrics.formats import LaneFileError
-from .metrics.tusimple import F1_VARIANTS
+from ..case import write_atomic
+from ..metrics.formats import LaneFileError
+from ..metrics.tusimple import F1_VARIANTS
+from .base import Command, UsageError
 
 METRIC_CHOICES = ("tusimple", "culane")
 
@@ -36,7 +36,7 @@ def _format_eval(result: dict) -> str:
 
 
 def _run_eval(args: argparse.Namespace) -> int:
-    from .metrics.evaluate import evaluate
+    from ..metrics.evaluate import evaluate
 
     try:
         result = evaluate(args.gt, args.pred, args.metric, args.f1)
@@ -58,7 +58,7 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_detect(args: argparse.Namespace) -> int:
-    from .detect import detect_split
+    from ..detect import detect_split
 
     def progress(done: int, total: int) -> None:
         if done % 50 == 0 or done == total:
@@ -85,10 +85,10 @@ def _report_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_report(args: argparse.Namespace) -> int:
-    from .metrics.evaluate import score_tusimple_files
-    from .metrics.formats import split_labels
-    from .report import build_report, write_report
-    from .report_compare import Detector, write_comparison
+    from ..metrics.evaluate import score_tusimple_files
+    from ..metrics.formats import split_labels
+    from ..report import build_report, write_report
+    from ..report_compare import Detector, write_comparison
 
     names = args.name or [path.stem for path in args.pred]
     if len(names) != len(args.pred):
