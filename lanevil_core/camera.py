@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .case import Camera, Case
+from .road_geometry import ReferenceLine
 from .road_layout import RoadNetwork
 from .typed import FloatArray
 
@@ -105,13 +106,45 @@ class VehiclePose:
     yaw: float
 
 
+@dataclass(frozen=True)
+class EgoPath:
+    """The case's scripted drive, resolved against its road: the camera mount, and the ego on its lane centre of
+    the main road, aligned with it, moving at constant speed. Compiled into the scene, so the renderer and the
+    labels place the camera without the case."""
+
+    mount: Camera  # where the camera sits on the vehicle, its field of view and image size
+    line: ReferenceLine  # the main road's reference line
+    t_road: float  # the ego lane's centre (m, + left of the reference line)
+    start_s: float  # station of frame 0 (m)
+    speed: float  # m/s
+    fps: float
+    frames: int
+
+    def s_road(self, frame: int) -> float:
+        """Station (m along the main road) of the ego at frame ``frame``."""
+        return self.start_s + self.speed * (frame / self.fps)
+
+    def vehicle_transform(self, frame: int) -> FloatArray:
+        """(4, 4) ``T_world_vehicle`` of frame ``frame``. Vehicle frame: +X forward (along the grade), +Y left
+        (horizontal), +Z up."""
+        p_world, forward, left = self.line.frame(self.s_road(frame))
+        return _transform(p_world + left * self.t_road, forward, left)
+
+    def camera(self, frame: int, size: tuple[int, int] | None = None) -> PinholeCamera:
+        """The ego camera of frame ``frame``, optionally at another image size."""
+        return mounted_camera(self.mount, self.vehicle_transform(frame), size)
+
+
+def ego_path(case: Case, network: RoadNetwork) -> EgoPath:
+    """The case's scripted drive on ``network`` (its main road)."""
+    return EgoPath(mount=case.camera, line=network.main.line, t_road=network.lane_center_t(case.ego.lane),
+                   start_s=case.ego.start_s, speed=case.ego.speed, fps=case.ego.fps, frames=case.ego.frames)
+
+
 def scripted_vehicle_transform(case: Case, network: RoadNetwork, frame: int) -> FloatArray:
     """(4, 4) ``T_world_vehicle`` of frame ``frame`` of the case's scripted drive: on its lane centre, aligned with
     the road. Vehicle frame: +X forward (along the grade), +Y left (horizontal), +Z up."""
-    s_road = case.ego_s(frame)
-    t_road = network.lane_center_t(case.ego.lane)
-    p_world, forward, left = network.main.line.frame(s_road)
-    return _transform(p_world + left * t_road, forward, left)
+    return ego_path(case, network).vehicle_transform(frame)
 
 
 def vehicle_transform(network: RoadNetwork, pose: VehiclePose) -> FloatArray:
@@ -152,7 +185,7 @@ def mounted_camera(cam: Camera, T_world_vehicle: FloatArray, size: tuple[int, in
 
 def ego_camera(case: Case, network: RoadNetwork, frame: int, size: tuple[int, int] | None = None) -> PinholeCamera:
     """The ego camera of frame ``frame``: the vehicle sits on its lane centre, aligned with the road."""
-    return mounted_camera(case.camera, scripted_vehicle_transform(case, network, frame), size)
+    return ego_path(case, network).camera(frame, size)
 
 
 def pose_camera(case: Case, network: RoadNetwork, pose: VehiclePose,

@@ -7,9 +7,11 @@ import json
 
 import numpy as np
 
+from .camera import ego_path
 from .case import Case
 from .environment import environment_for, is_night
 from .illusions import CompileContext
+from .paint import road_paint
 from .road_layout import RoadNetwork, build_network
 from .scene import CompiledScene, Mesh
 from .scenery import roadside_meshes
@@ -43,5 +45,5 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None) -> CompiledSce
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
         illusion.compile(ctx)
-    return CompiledScene(case=case, network=network, env=ctx.env, meshes=ctx.meshes, layers=ctx.layers,
-                         lights=ctx.lights)
+    return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),
+                         ego=ego_path(case, network), meshes=ctx.meshes, layers=ctx.layers, lights=ctx.lights)

@@ -26,7 +26,7 @@ from .case import Case, case_json, write_atomic
 from .compile import compile_scene
 from .encode import png_bytes
 from .labels import CULANE_SIZE, TUSIMPLE_SIZE, culane_lines, tusimple_record
-from .paint import MATERIAL_ALBEDO, paint_mesh
+from .paint import MATERIAL_ALBEDO
 from .primitives import flat_trimesh
 from .render import render_frame
 from .road_mesh import road_surface
@@ -125,7 +125,7 @@ def scene_glb(scene: CompiledScene) -> bytes:
     road = road_surface(scene.network)
     gltf_scene.add_geometry(_gltf(road.vertices, road.faces, MATERIAL_ALBEDO[road.material]),
                             geom_name="road", node_name="road")
-    paint = paint_mesh(scene.network, scene.case.road.markings, scene.case.road.paint)
+    paint = scene.paint.mesh(scene.network)
     if len(paint[1]):
         gltf_scene.add_geometry(_gltf(*paint), geom_name="paint", node_name="paint")
     for index, mesh in enumerate(scene.meshes):

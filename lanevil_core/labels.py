@@ -53,7 +53,7 @@ class BoundaryInView:
     Attributes:
         index: boundary index in ``network.main.boundaries_t`` (0 = leftmost).
         t_road: lateral position of the boundary (m, left positive).
-        line_type: paint type from ``case.road.markings``.
+        line_type: paint type of the boundary's marking (``scene.paint``).
         s_road: (n,) float64 arc length of the samples, increasing away from the camera.
         uv_image: (n, 2) float64 continuous image coordinates (NaN closer than ``NEAR_M`` or where an edge line
             breaks for a junction arm).
@@ -122,15 +122,15 @@ def lane_boundaries_in_view(scene: CompiledScene, camera: PinholeCamera) -> list
     s0 = max(main.s_start, s_camera - BEHIND_M)
     s1 = min(main.line.length, s_camera + RANGE_M)
     s_road = np.arange(s0, s1, SAMPLE_STEP_M)
-    markings = scene.case.road.markings
+    line_types = scene.paint.line_types
     views = []
     for index, t_road in enumerate(main.boundaries_t):
-        if markings[index].type == "none":
+        if line_types[index] == "none":
             continue
         p_world = main.line.to_world(s_road, float(t_road))
         uv_image, depth = camera.project(p_world)
         uv_image[(depth <= NEAR_M) | ~_painted(main, index, s_road)] = np.nan
-        views.append(BoundaryInView(index, float(t_road), markings[index].type, s_road, uv_image, depth))
+        views.append(BoundaryInView(index, float(t_road), line_types[index], s_road, uv_image, depth))
     return views
 
 

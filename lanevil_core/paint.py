@@ -8,9 +8,12 @@ reference line).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
+
 import numpy as np
 
-from .case import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, DOUBLE_LINE_SPACING_M, Marking
+from .case import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, DOUBLE_LINE_SPACING_M, Marking, Road
 from .road_layout import RoadNetwork
 from .typed import Float32Array, FloatArray, IntArray
 
@@ -33,6 +36,33 @@ STOP_LINE_M = 0.4
 STRIPE_COLUMNS = 12
 PAINT_LIFT_M = 0.01  # paint quads float this far above the asphalt in meshes (glTF scene, editor)
 PAINT_STEP_M = 1.0  # length of one paint quad along the road
+
+
+@dataclass(frozen=True)
+class RoadPaint:
+    """The main road's markings, resolved at compile time: one per lane boundary, left to right, and whether paint
+    is drawn at all (``painted`` False: the paint-free control; the labels still follow the markings)."""
+
+    markings: tuple[Marking, ...]
+    painted: bool = True
+
+    @property
+    def line_types(self) -> tuple[str, ...]:
+        """The marking type of each boundary, left to right (``none``: unmarked, no label)."""
+        return tuple(marking.type for marking in self.markings)
+
+    def stripes(self, network: RoadNetwork) -> FloatArray:
+        """The stripe table of this paint on ``network`` (see ``paint_stripes``)."""
+        return paint_stripes(network, self.markings, self.painted)
+
+    def mesh(self, network: RoadNetwork) -> tuple[FloatArray, IntArray, Float32Array]:
+        """The paint as quads (see ``paint_mesh``)."""
+        return paint_mesh(network, self.markings, self.painted)
+
+
+def road_paint(road: Road) -> RoadPaint:
+    """A road's markings and paint switch."""
+    return RoadPaint(markings=tuple(road.markings), painted=road.paint)
 
 
 def _color(marking: Marking) -> tuple[float, float, float]:
@@ -64,7 +94,7 @@ def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: 
     return [stripe(t, 2, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M)]
 
 
-def paint_stripes(network: RoadNetwork, markings: list[Marking], paint: bool = True) -> FloatArray:
+def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True) -> FloatArray:
     """Every painted stripe of the network as rows of the stripe table (none when ``paint`` is False)."""
     rows: list[list[float]] = []
     if not paint:
@@ -108,7 +138,7 @@ def dash_spans(s0: float, s1: float, pattern: int, on: float, period: float) -> 
     return [(float(a), float(min(a + on, s1))) for a in starts]
 
 
-def paint_mesh(network: RoadNetwork, markings: list[Marking],
+def paint_mesh(network: RoadNetwork, markings: Sequence[Marking],
                paint: bool = True) -> tuple[FloatArray, IntArray, Float32Array]:
     """Quads of every paint stripe just above the road: vertices (n, 3), faces (m, 3), colours (m, 3)."""
     stripes = paint_stripes(network, markings, paint).reshape(-1, STRIPE_COLUMNS)

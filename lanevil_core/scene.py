@@ -14,7 +14,9 @@ import numpy as np
 from .typed import Float32Array, FloatArray, IntArray
 
 if TYPE_CHECKING:
+    from .camera import EgoPath
     from .case import Case
+    from .paint import RoadPaint
     from .road_layout import RoadNetwork
 
 # Object ids in the per-pixel id buffer.
@@ -133,11 +135,14 @@ class Environment:
 
 @dataclass
 class CompiledScene:
-    """Everything the renderer and the label generator need for any frame of a case."""
+    """Everything the renderer, the label generator and the exporters need for any frame of a case; they read
+    nothing else of the case (``case`` is kept for the drive, the editor and recompiles)."""
 
     case: Case
     network: RoadNetwork
     env: Environment
+    paint: RoadPaint  # the main road's markings and the paint switch
+    ego: EgoPath  # the camera mount and the scripted drive
     meshes: list[Mesh] = field(default_factory=list)
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)

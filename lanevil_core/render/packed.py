@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..paint import MATERIAL_ALBEDO, paint_stripes, stripe_index
+from ..paint import MATERIAL_ALBEDO, stripe_index
 from ..road_mesh import RoadSurface, road_surface
 from ..scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
@@ -171,7 +171,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         offset += len(mesh.vertices)
     all_v = np.concatenate(verts)
     all_f = np.concatenate(faces).astype(np.int32)
-    stripes = paint_stripes(scene.network, scene.case.road.markings, scene.case.road.paint)
+    stripes = scene.paint.stripes(scene.network)
     lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
                       np.float64).reshape(-1, 7)
     packed = PackedScene(
@@ -184,7 +184,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),
         shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
         mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),
-        stripes=stripes, stripe_index=stripe_index(stripes, len(scene.network.pieces), len(scene.case.road.markings)),
+        stripes=stripes, stripe_index=stripe_index(stripes, len(scene.network.pieces), len(scene.paint.markings)),
         layers=layer_atlas(scene), lights=lights,
         overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..camera import PinholeCamera, ego_camera
+from ..camera import PinholeCamera
 from ..paint import MATERIAL_ALBEDO
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
@@ -114,7 +114,7 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
 
 def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None) -> Frame:
     """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV)."""
-    return render_view(scene, ego_camera(scene.case, scene.network, frame, size))
+    return render_view(scene, scene.ego.camera(frame, size))
 
 
 def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:

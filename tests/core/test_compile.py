@@ -33,3 +33,28 @@ def test_reuse_is_ignored_when_the_roadside_changed() -> None:
     scene = compile_scene(night, reuse=base)
     assert scene.network is not base.network
     _assert_same(scene, compile_scene(night))
+
+
+class _NoCase:
+    """Stands in for ``scene.case``: any read fails, naming what was read."""
+
+    def __getattr__(self, name: str) -> None:
+        raise AssertionError(f"a later stage read scene.case.{name}")
+
+
+def test_renderer_labels_and_exporter_read_nothing_of_the_case(make_case) -> None:
+    from lanevil_core.export import scene_glb
+    from lanevil_core.labels import culane_lines, tusimple_record
+    from lanevil_core.render import render_frame
+
+    types = ("white_solid", "white_dashed", "yellow_double_solid", "none", "white_solid")
+    case = make_case(road={"type": "t_junction", "markings": [{"type": kind} for kind in types]},
+                     illusions=[{"type": "streetlight_shadow", "severity": 3}])
+    scene = compile_scene(case)
+    assert scene.paint.line_types == types
+    assert scene.ego.frames == case.ego.frames and scene.ego.mount == case.camera
+    scene.case = _NoCase()  # type: ignore[assignment]
+    frame = render_frame(scene, 5, size=(160, 90))
+    assert len(tusimple_record(scene, 5, frame, raw_file="000005.png")["lanes"]) >= 2
+    assert isinstance(culane_lines(scene, frame), str)
+    assert scene_glb(scene)[:4] == b"glTF"
