@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
         parameters[field] = {key: spec[key] for key in keys if key in spec}
     return {"name": cls.model_fields["type"].default, "category": cls.CATEGORY,
             "description": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()), "parameters": parameters,
-            "severity": [dict(row) for row in cls.SEVERITY]}
+            "severity": [dataclasses.asdict(row) for row in cls.SEVERITY]}
 
 
 def _range(spec: dict[str, Any]) -> str:

@@ -8,7 +8,7 @@ into real scene elements (meshes, road-surface layers, lights, sun and wetness c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -54,6 +54,11 @@ class CompileContext:
         self.lights.append(light)
 
 
+@dataclass(frozen=True)
+class Level:
+    """Base of the severity rows: each illusion type's row is a frozen dataclass of what one level sets."""
+
+
 class Illusion(BaseModel):
     """Base of every illusion type. Subclasses set ``type`` (a Literal), ``CATEGORY`` and ``SEVERITY``."""
 
@@ -61,7 +66,7 @@ class Illusion(BaseModel):
 
     CATEGORY: ClassVar[Category]
     # Five rows, level 1 (subtle) to 5 (most deceptive): what each level sets.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]]
+    SEVERITY: ClassVar[tuple[Level, ...]]
 
     type: str
     severity: int = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
@@ -70,8 +75,8 @@ class Illusion(BaseModel):
         None, ge=0, description="distance along the road where it starts (m); empty = just ahead of the ego start"
     )
 
-    def level(self) -> dict[str, Any]:
-        """The severity table row of this illusion's level."""
+    def level(self) -> Level:
+        """The severity table row of this illusion's level (subclasses narrow the type to their row's)."""
         return self.SEVERITY[self.severity - 1]
 
     def start_s(self, case: Case) -> float:

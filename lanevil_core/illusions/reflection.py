@@ -6,7 +6,8 @@ reflection and a glossy lobe) and adds what gets reflected: the sun placed low a
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Literal
+from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -16,7 +17,7 @@ from ..primitives import pose_on_road, transformed
 from ..props import car, van
 from ..scene import PointLight, SurfaceLayer
 from ..structures import streetlight, streetlight_lamp_offset
-from .base import Category, CompileContext, Illusion, register
+from .base import Category, CompileContext, Illusion, Level, register
 
 PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
@@ -76,17 +77,27 @@ def _set_sun(ctx: CompileContext, azimuth: float, altitude: float, intensity: fl
     ctx.env.sun_intensity = intensity * (1.0 - 0.85 * ctx.env.cloudiness)
 
 
+@dataclass(frozen=True)
+class SunlightReflectionLevel(Level):
+    """What one severity level of ``SunlightReflection`` sets."""
+
+    sun_altitude: float
+    sun_intensity: float
+    wetness: float
+    puddles: float
+
+
 @register
 class SunlightReflection(Illusion):
     """Driving into a low sun on a wet road: specular glare and puddle mirrors wash out the lines."""
 
     CATEGORY: ClassVar[Category] = "reflection"
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 24.0, "sun_intensity": 1.0, "wetness": 0.35, "puddles": 0.08},
-        {"sun_altitude": 17.0, "sun_intensity": 1.15, "wetness": 0.5, "puddles": 0.16},
-        {"sun_altitude": 12.0, "sun_intensity": 1.3, "wetness": 0.65, "puddles": 0.25},
-        {"sun_altitude": 8.0, "sun_intensity": 1.5, "wetness": 0.8, "puddles": 0.35},
-        {"sun_altitude": 5.0, "sun_intensity": 1.8, "wetness": 0.95, "puddles": 0.45},
+    SEVERITY: ClassVar[tuple[SunlightReflectionLevel, ...]] = (
+        SunlightReflectionLevel(sun_altitude=24.0, sun_intensity=1.0, wetness=0.35, puddles=0.08),
+        SunlightReflectionLevel(sun_altitude=17.0, sun_intensity=1.15, wetness=0.5, puddles=0.16),
+        SunlightReflectionLevel(sun_altitude=12.0, sun_intensity=1.3, wetness=0.65, puddles=0.25),
+        SunlightReflectionLevel(sun_altitude=8.0, sun_intensity=1.5, wetness=0.8, puddles=0.35),
+        SunlightReflectionLevel(sun_altitude=5.0, sun_intensity=1.8, wetness=0.95, puddles=0.45),
     )
 
     type: Literal["sunlight_reflection"] = "sunlight_reflection"
@@ -94,14 +105,29 @@ class SunlightReflection(Illusion):
     length: float = Field(150.0, gt=5, le=1000, description="extent of the puddled stretch (m)")
     puddle_size: float = Field(1.6, gt=0.2, le=10, description="typical puddle size (m)")
 
+    def level(self) -> SunlightReflectionLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         s0 = self.start_s(ctx.case) - 20.0
         heading = _road_heading_deg(ctx, s0 + 40.0)
-        _set_sun(ctx, heading + self.sun_offset, level["sun_altitude"], level["sun_intensity"])
+        _set_sun(ctx, heading + self.sun_offset, level.sun_altitude, level.sun_intensity)
         ctx.env.penumbra = min(ctx.env.penumbra, 0.01)
-        _wet_road(ctx, ctx.rng(self.seed), max(s0, 0.0), self.length, level["wetness"], level["puddles"],
+        _wet_road(ctx, ctx.rng(self.seed), max(s0, 0.0), self.length, level.wetness, level.puddles,
                   self.puddle_size, "sun-glare puddles")
+
+
+@dataclass(frozen=True)
+class StreetlightReflectionLevel(Level):
+    """What one severity level of ``StreetlightReflection`` sets."""
+
+    daylight: float
+    wetness: float
+    puddles: float
+    lamp_scale: float
+    spacing: float
 
 
 @register
@@ -112,12 +138,13 @@ class StreetlightReflection(Illusion):
     # daylight: what is left of the day's sky light (1 = the case's day, 0 = full night). The level takes the scene
     # from late dusk to deep night while the road gets wetter and the lamps denser, so the streaks of the lamps
     # stand out ever more against the darkening road and the paint.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"daylight": 0.45, "wetness": 0.35, "puddles": 0.05, "lamp_scale": 0.8, "spacing": 40.0},  # late dusk
-        {"daylight": 0.30, "wetness": 0.5, "puddles": 0.12, "lamp_scale": 0.9, "spacing": 34.0},
-        {"daylight": 0.18, "wetness": 0.65, "puddles": 0.2, "lamp_scale": 1.0, "spacing": 28.0},
-        {"daylight": 0.08, "wetness": 0.8, "puddles": 0.3, "lamp_scale": 1.2, "spacing": 22.0},
-        {"daylight": 0.0, "wetness": 0.95, "puddles": 0.4, "lamp_scale": 1.45, "spacing": 17.0},  # wet night
+    SEVERITY: ClassVar[tuple[StreetlightReflectionLevel, ...]] = (
+        StreetlightReflectionLevel(daylight=0.45, wetness=0.35, puddles=0.05, lamp_scale=0.8,
+                                   spacing=40.0),  # late dusk
+        StreetlightReflectionLevel(daylight=0.30, wetness=0.5, puddles=0.12, lamp_scale=0.9, spacing=34.0),
+        StreetlightReflectionLevel(daylight=0.18, wetness=0.65, puddles=0.2, lamp_scale=1.0, spacing=28.0),
+        StreetlightReflectionLevel(daylight=0.08, wetness=0.8, puddles=0.3, lamp_scale=1.2, spacing=22.0),
+        StreetlightReflectionLevel(daylight=0.0, wetness=0.95, puddles=0.4, lamp_scale=1.45, spacing=17.0),  # wet night
     )
 
     type: Literal["streetlight_reflection"] = "streetlight_reflection"
@@ -128,10 +155,14 @@ class StreetlightReflection(Illusion):
     length: float | None = Field(None, gt=10, le=2000, description="extent (m); empty = to the end of the drive")
     headlights: bool = Field(True, description="the ego's own headlights light the road ahead")
 
+    def level(self) -> StreetlightReflectionLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         env = ctx.env
-        daylight = float(level["daylight"])
+        daylight = float(level.daylight)
         dusk = daylight**2  # sky light falls off faster than the eye adapts
         env.night, env.sun_intensity = True, 0.0
         env.exposure = NIGHT_EXPOSURE + (1.0 - NIGHT_EXPOSURE) * daylight
@@ -141,7 +172,7 @@ class StreetlightReflection(Illusion):
         env.headlights = HEADLIGHT_INTENSITY if self.headlights else 0.0
         s0 = max(self.start_s(ctx.case) - 20.0, 0.0)
         s1 = s0 + self.length if self.length is not None else _drive_end(ctx)
-        spacing = self.spacing if self.spacing is not None else level["spacing"]
+        spacing = self.spacing if self.spacing is not None else level.spacing
         color = LAMP_COLORS[self.lamp_color]
         piece = ctx.network.main
         t_pole = piece.half_width + 1.2
@@ -154,8 +185,19 @@ class StreetlightReflection(Illusion):
                 ctx.add_mesh(transformed(pole, T_world_local).renamed(f"streetlight {side:+d} {k}"))
                 p_world = T_world_local[:3, :3] @ offset + T_world_local[:3, 3]
                 ctx.add_light(PointLight(p_world, np.array(color, np.float32),
-                                         LAMP_INTENSITY * level["lamp_scale"], name=f"lamp {side:+d} {k}"))
-        _wet_road(ctx, ctx.rng(self.seed), s0, s1 - s0, level["wetness"], level["puddles"], 1.4, "night puddles")
+                                         LAMP_INTENSITY * level.lamp_scale, name=f"lamp {side:+d} {k}"))
+        _wet_road(ctx, ctx.rng(self.seed), s0, s1 - s0, level.wetness, level.puddles, 1.4, "night puddles")
+
+
+@dataclass(frozen=True)
+class VehicleReflectionLevel(Level):
+    """What one severity level of ``VehicleReflection`` sets."""
+
+    count: int
+    gloss: float
+    wetness: float
+    puddles: float
+    sun_altitude: float
 
 
 @register
@@ -163,12 +205,12 @@ class VehicleReflection(Illusion):
     """Glossy vehicles ahead mirrored in a wet road, their paint catching a low sun."""
 
     CATEGORY: ClassVar[Category] = "reflection"
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 1, "gloss": 0.55, "wetness": 0.4, "puddles": 0.08, "sun_altitude": 30.0},
-        {"count": 2, "gloss": 0.65, "wetness": 0.55, "puddles": 0.15, "sun_altitude": 24.0},
-        {"count": 3, "gloss": 0.75, "wetness": 0.7, "puddles": 0.22, "sun_altitude": 18.0},
-        {"count": 4, "gloss": 0.85, "wetness": 0.85, "puddles": 0.3, "sun_altitude": 13.0},
-        {"count": 6, "gloss": 0.95, "wetness": 1.0, "puddles": 0.4, "sun_altitude": 9.0},
+    SEVERITY: ClassVar[tuple[VehicleReflectionLevel, ...]] = (
+        VehicleReflectionLevel(count=1, gloss=0.55, wetness=0.4, puddles=0.08, sun_altitude=30.0),
+        VehicleReflectionLevel(count=2, gloss=0.65, wetness=0.55, puddles=0.15, sun_altitude=24.0),
+        VehicleReflectionLevel(count=3, gloss=0.75, wetness=0.7, puddles=0.22, sun_altitude=18.0),
+        VehicleReflectionLevel(count=4, gloss=0.85, wetness=0.85, puddles=0.3, sun_altitude=13.0),
+        VehicleReflectionLevel(count=6, gloss=0.95, wetness=1.0, puddles=0.4, sun_altitude=9.0),
     )
 
     type: Literal["vehicle_reflection"] = "vehicle_reflection"
@@ -177,14 +219,18 @@ class VehicleReflection(Illusion):
     color: tuple[float, float, float] | None = Field(None, description="linear RGB paint; empty = varied")
     length: float = Field(150.0, gt=5, le=1000, description="extent of the wet stretch (m)")
 
+    def level(self) -> VehicleReflectionLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         rng = ctx.rng(self.seed)
         s_first = self.s if self.s is not None else ctx.case.ego.start_s + VEHICLE_AHEAD_M
         piece = ctx.network.main
         heading = _road_heading_deg(ctx, s_first)
-        _set_sun(ctx, heading + 20.0, level["sun_altitude"], 1.3)
-        count = self.count if self.count is not None else level["count"]
+        _set_sun(ctx, heading + 20.0, level.sun_altitude, 1.3)
+        count = self.count if self.count is not None else level.count
         lanes = ctx.network.lanes_per_direction
         palette = ((0.02, 0.02, 0.025), (0.6, 0.6, 0.62), (0.35, 0.02, 0.02), (0.02, 0.06, 0.25), (0.8, 0.8, 0.78))
         for k in range(count):
@@ -193,7 +239,7 @@ class VehicleReflection(Illusion):
             t = ctx.network.lane_center_t(lane) + float(rng.uniform(-0.3, 0.3))
             paint = self.color if self.color is not None else palette[int(rng.integers(len(palette)))]
             body = van(paint) if k % 4 == 3 else car(paint)
-            body.gloss = level["gloss"]
+            body.gloss = level.gloss
             ctx.add_mesh(transformed(body, pose_on_road(piece.line, s, t)).renamed(f"glossy vehicle {k}"))
-        _wet_road(ctx, rng, max(s_first - 25.0, 0.0), self.length, level["wetness"], level["puddles"], 1.8,
+        _wet_road(ctx, rng, max(s_first - 25.0, 0.0), self.length, level.wetness, level.puddles, 1.8,
                   "wet road")

@@ -7,7 +7,7 @@ along the road, whose bright top edge and shadow run parallel to the lane lines.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 import numpy as np
@@ -16,7 +16,7 @@ from pydantic import Field
 from .. import surface_textures as tex
 from ..environment import sun_direction
 from ..scene import SurfaceLayer
-from .base import Category, CompileContext, Illusion, register
+from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -83,7 +83,7 @@ class _SurfaceDamage(Illusion):
 def _setting(illusion: Illusion, key: str) -> Any:
     """The field ``key`` where the user set it, else the value of the illusion's severity row."""
     value = getattr(illusion, key)
-    return illusion.level()[key] if value is None else value
+    return getattr(illusion.level(), key) if value is None else value
 
 
 def _ego_center_t(ctx: CompileContext) -> float:
@@ -113,6 +113,19 @@ def _beside(lines_t: list[float], count: int, gaps: np.ndarray) -> list[float]:
 # ---------------------------------------------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
+class RoadCrackLevel(Level):
+    """What one severity level of ``RoadCrack`` sets."""
+
+    density: float
+    width: float
+    darkness: float
+    along_lines: int
+    alligator_share: float
+    joints: int
+    spall: float
+
+
 @register
 class RoadCrack(_SurfaceDamage):
     """Dark branching cracks in the asphalt: transverse, longitudinal and alligator, and at the higher levels
@@ -123,17 +136,17 @@ class RoadCrack(_SurfaceDamage):
     # density: cracks per 100 m^2; width: core width of a main crack (1-3 cm); along_lines: long cracks right
     # beside the lane lines nearest the ego; joints: those lines whose paving joint has failed into a band of
     # alligator cracking along the line; spall: broken-down crack edges (wider, darker stained rims).
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"density": 0.8, "width": 0.010, "darkness": 0.60, "along_lines": 0, "alligator_share": 0.00,
-         "joints": 0, "spall": 0.0},
-        {"density": 1.5, "width": 0.014, "darkness": 0.70, "along_lines": 0, "alligator_share": 0.10,
-         "joints": 0, "spall": 0.1},
-        {"density": 2.5, "width": 0.018, "darkness": 0.80, "along_lines": 1, "alligator_share": 0.15,
-         "joints": 1, "spall": 0.25},
-        {"density": 4.0, "width": 0.024, "darkness": 0.90, "along_lines": 2, "alligator_share": 0.20,
-         "joints": 2, "spall": 0.5},
-        {"density": 8.0, "width": 0.030, "darkness": 1.00, "along_lines": 6, "alligator_share": 0.25,
-         "joints": 5, "spall": 1.0},
+    SEVERITY: ClassVar[tuple[RoadCrackLevel, ...]] = (
+        RoadCrackLevel(density=0.8, width=0.010, darkness=0.60, along_lines=0, alligator_share=0.00,
+                       joints=0, spall=0.0),
+        RoadCrackLevel(density=1.5, width=0.014, darkness=0.70, along_lines=0, alligator_share=0.10,
+                       joints=0, spall=0.1),
+        RoadCrackLevel(density=2.5, width=0.018, darkness=0.80, along_lines=1, alligator_share=0.15,
+                       joints=1, spall=0.25),
+        RoadCrackLevel(density=4.0, width=0.024, darkness=0.90, along_lines=2, alligator_share=0.20,
+                       joints=2, spall=0.5),
+        RoadCrackLevel(density=8.0, width=0.030, darkness=1.00, along_lines=6, alligator_share=0.25,
+                       joints=5, spall=1.0),
     )
 
     type: Literal["road_crack"] = "road_crack"
@@ -144,6 +157,10 @@ class RoadCrack(_SurfaceDamage):
     darkness: float | None = Field(None, ge=0, le=1, description="opacity of the crack core")
     along_lines: int | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
     joints: int | None = Field(None, ge=0, le=12, description="lane lines with failed joints cracked along them")
+
+    def level(self) -> RoadCrackLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
 
     def compile(self, ctx: CompileContext) -> None:
         area = self._area(ctx)
@@ -156,11 +173,11 @@ class RoadCrack(_SurfaceDamage):
         along = [area.local_t(t) for t in _beside(lines, _setting(self, "along_lines"), gaps)]
         joints = [area.local_t(t) for t in lines[:_setting(self, "joints")]]
         density = _setting(self, "density")
-        shares = self._shares(self.level()["alligator_share"])
+        shares = self._shares(self.level().alligator_share)
         layers = tex.crack_layers(crack_rng, area.shape, area.texel,
                                   {kind: density * share for kind, share in shares.items()},
                                   _setting(self, "width"), _setting(self, "darkness"), along, ctx.env.wetness,
-                                  joint_t=joints, spall=self.level()["spall"])
+                                  joint_t=joints, spall=self.level().spall)
         self._emit(ctx, area, layers.stains, None, over_paint=False, name="crack stains")
         self._emit(ctx, area, layers.cracks, layers.wet, over_paint=True, name="cracks")
 
@@ -170,6 +187,21 @@ class RoadCrack(_SurfaceDamage):
             return {kind: float(kind == self.kind) for kind in tex.CRACK_KINDS}
         rest = 1.0 - alligator_share
         return {"transverse": 0.65 * rest, "longitudinal": 0.35 * rest, "alligator": alligator_share}
+
+
+@dataclass(frozen=True)
+class RoadRepairLevel(Level):
+    """What one severity level of ``RoadRepair`` sets."""
+
+    patches: int
+    strips: int
+    parallel: int
+    trenches: int
+    unpainted: int
+    size: float
+    contrast: float
+    strip_width: float
+    bright_share: float
 
 
 @register
@@ -182,17 +214,17 @@ class RoadRepair(_SurfaceDamage):
     # reinstatements (joint inlays) along the lane lines nearest the ego, repainted: the line runs over them;
     # unpainted: patches laid across those lines after the paint, so the line breaks off there; size: patch
     # size scale; contrast: fresh-asphalt darkness and opacity.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"patches": 2, "strips": 2, "parallel": 0, "trenches": 0, "unpainted": 0, "size": 0.80, "contrast": 0.35,
-         "strip_width": 0.05, "bright_share": 0.00},
-        {"patches": 4, "strips": 3, "parallel": 0, "trenches": 0, "unpainted": 0, "size": 0.90, "contrast": 0.50,
-         "strip_width": 0.06, "bright_share": 0.15},
-        {"patches": 6, "strips": 5, "parallel": 1, "trenches": 1, "unpainted": 1, "size": 1.00, "contrast": 0.65,
-         "strip_width": 0.07, "bright_share": 0.30},
-        {"patches": 8, "strips": 7, "parallel": 2, "trenches": 2, "unpainted": 3, "size": 1.10, "contrast": 0.80,
-         "strip_width": 0.09, "bright_share": 0.40},
-        {"patches": 11, "strips": 9, "parallel": 4, "trenches": 5, "unpainted": 6, "size": 1.30, "contrast": 1.00,
-         "strip_width": 0.12, "bright_share": 0.50},
+    SEVERITY: ClassVar[tuple[RoadRepairLevel, ...]] = (
+        RoadRepairLevel(patches=2, strips=2, parallel=0, trenches=0, unpainted=0, size=0.80, contrast=0.35,
+                        strip_width=0.05, bright_share=0.00),
+        RoadRepairLevel(patches=4, strips=3, parallel=0, trenches=0, unpainted=0, size=0.90, contrast=0.50,
+                        strip_width=0.06, bright_share=0.15),
+        RoadRepairLevel(patches=6, strips=5, parallel=1, trenches=1, unpainted=1, size=1.00, contrast=0.65,
+                        strip_width=0.07, bright_share=0.30),
+        RoadRepairLevel(patches=8, strips=7, parallel=2, trenches=2, unpainted=3, size=1.10, contrast=0.80,
+                        strip_width=0.09, bright_share=0.40),
+        RoadRepairLevel(patches=11, strips=9, parallel=4, trenches=5, unpainted=6, size=1.30, contrast=1.00,
+                        strip_width=0.12, bright_share=0.50),
     )
 
     type: Literal["road_repair"] = "road_repair"
@@ -206,32 +238,49 @@ class RoadRepair(_SurfaceDamage):
     strip_width: float | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
     bright_share: float | None = Field(None, ge=0, le=1, description="share of strips in bright weathered filler")
 
+    def level(self) -> RoadRepairLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         area = self._area(ctx)
         if area is None:
             return
-        v = {key: _setting(self, key) for key in self.level()}
+        v = replace(self.level(), **{row.name: _setting(self, row.name) for row in fields(self.level())})
         rng = ctx.rng(self.seed)
         patch_rng, strip_rng, unpainted_rng = (np.random.default_rng(int(b))
                                                for b in rng.integers(0, 2**63 - 1, size=3))
         gaps = rng.uniform(1.5 * PAINT_CLEARANCE_M, 3.5 * PAINT_CLEARANCE_M, size=8)
         swing = rng.uniform(-0.15, 0.15, size=8)  # a trench follows its line within a few centimetres
         lines = _lines_near_ego(ctx)
-        trench_t = [area.local_t(lines[k % len(lines)] + float(swing[k % 8])) for k in range(v["trenches"])]
-        rectangles = (v["patches"] + 1) // 2 + v["patches"] // 4
+        trench_t = [area.local_t(lines[k % len(lines)] + float(swing[k % 8])) for k in range(v.trenches)]
+        rectangles = (v.patches + 1) // 2 + v.patches // 4
         rgba, _ = tex.patches(patch_rng, area.shape, area.texel, rectangles=rectangles,
-                              blobs=v["patches"] - rectangles, trench_t=trench_t, size_scale=v["size"],
-                              contrast=v["contrast"])
+                              blobs=v.patches - rectangles, trench_t=trench_t, size_scale=v.size,
+                              contrast=v.contrast)
         self._emit(ctx, area, rgba, None, over_paint=False, name="repair patches")
-        across_t = [area.local_t(lines[k % len(lines)]) for k in range(v["unpainted"])]
+        across_t = [area.local_t(lines[k % len(lines)]) for k in range(v.unpainted)]
         rgba, _ = tex.patches(unpainted_rng, area.shape, area.texel, rectangles=0, blobs=0, across_t=across_t,
-                              size_scale=v["size"], contrast=v["contrast"])
+                              size_scale=v.size, contrast=v.contrast)
         self._emit(ctx, area, rgba, None, over_paint=True, name="unpainted patches")
-        parallel_t = [area.local_t(t) for t in _beside(lines, v["parallel"], gaps)]
-        rgba, _ = tex.patches(strip_rng, area.shape, area.texel, rectangles=0, blobs=0, strips=v["strips"],
-                              parallel_t=parallel_t, contrast=v["contrast"], strip_width_m=v["strip_width"],
-                              bright_share=v["bright_share"])
+        parallel_t = [area.local_t(t) for t in _beside(lines, v.parallel, gaps)]
+        rgba, _ = tex.patches(strip_rng, area.shape, area.texel, rectangles=0, blobs=0, strips=v.strips,
+                              parallel_t=parallel_t, contrast=v.contrast, strip_width_m=v.strip_width,
+                              bright_share=v.bright_share)
         self._emit(ctx, area, rgba, None, over_paint=True, name="sealant")
+
+
+@dataclass(frozen=True)
+class TireMarksLevel(Level):
+    """What one severity level of ``TireMarks`` sets."""
+
+    straight: int
+    swerve: int
+    yaw: int
+    on_line: int
+    darkness: float
+    track_width: float
+    cluster: float
 
 
 @register
@@ -243,17 +292,17 @@ class TireMarks(_SurfaceDamage):
     # cluster: how tightly the marks of the incident bunch at the start of the marked stretch (0 = spread
     # over it; 0.9 = all start within its first tenth, most of them already under way where it begins, so the
     # rubber is at its darkest in the camera's first view).
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"straight": 1, "swerve": 0, "yaw": 0, "on_line": 0, "darkness": 0.45, "track_width": 0.18,
-         "cluster": 0.0},
-        {"straight": 2, "swerve": 0, "yaw": 0, "on_line": 0, "darkness": 0.55, "track_width": 0.19,
-         "cluster": 0.3},
-        {"straight": 2, "swerve": 1, "yaw": 0, "on_line": 1, "darkness": 0.68, "track_width": 0.20,
-         "cluster": 0.55},
-        {"straight": 4, "swerve": 2, "yaw": 1, "on_line": 2, "darkness": 0.82, "track_width": 0.21,
-         "cluster": 0.75},
-        {"straight": 6, "swerve": 4, "yaw": 2, "on_line": 4, "darkness": 0.95, "track_width": 0.22,
-         "cluster": 0.9},
+    SEVERITY: ClassVar[tuple[TireMarksLevel, ...]] = (
+        TireMarksLevel(straight=1, swerve=0, yaw=0, on_line=0, darkness=0.45, track_width=0.18,
+                       cluster=0.0),
+        TireMarksLevel(straight=2, swerve=0, yaw=0, on_line=0, darkness=0.55, track_width=0.19,
+                       cluster=0.3),
+        TireMarksLevel(straight=2, swerve=1, yaw=0, on_line=1, darkness=0.68, track_width=0.20,
+                       cluster=0.55),
+        TireMarksLevel(straight=4, swerve=2, yaw=1, on_line=2, darkness=0.82, track_width=0.21,
+                       cluster=0.75),
+        TireMarksLevel(straight=6, swerve=4, yaw=2, on_line=4, darkness=0.95, track_width=0.22,
+                       cluster=0.9),
     )
     HALF_GAUGE_M: ClassVar[float] = 0.82  # a car's track centre to its wheel tracks
 
@@ -266,12 +315,16 @@ class TireMarks(_SurfaceDamage):
     length_min: float = Field(20.0, gt=1, le=200, description="shortest mark (m)")
     length_max: float = Field(45.0, gt=1, le=200, description="longest mark (m)")
 
+    def level(self) -> TireMarksLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         area = self._area(ctx)
         if area is None:
             return
         straight, swerve, yaw = (_setting(self, key) for key in ("straight", "swerve", "yaw"))
-        on_line = min(self.level()["on_line"], straight)
+        on_line = min(self.level().on_line, straight)
         lanes, lines = _lanes_near_ego(ctx), _lines_near_ego(ctx)
         astride = [lines[k % len(lines)] + (1.0 if k % 2 else -1.0) * self.HALF_GAUGE_M for k in range(on_line)]
         center_t = ([lanes[k % len(lanes)] for k in range(straight - on_line)] + astride
@@ -282,7 +335,7 @@ class TireMarks(_SurfaceDamage):
             center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
             length_m=(min(self.length_min, self.length_max), max(self.length_min, self.length_max)),
             darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"),
-            start_m=self._starts(area, self.level()["cluster"]))
+            start_m=self._starts(area, self.level().cluster))
         self._emit(ctx, area, rgba, None, over_paint=True, name="tyre marks")
 
     def _starts(self, area: _Area, cluster: float) -> tuple[float, float]:
@@ -300,6 +353,17 @@ MEDIAN_RAIL_T = 0.45  # a median rail stands just left of the centre line, clear
 SUN_SWING_RAD = np.radians(30.0)  # the shadow-casting sun stands this far behind the cross-road direction
 
 
+@dataclass(frozen=True)
+class GuardRailLevel(Level):
+    """What one severity level of ``GuardRail`` sets."""
+
+    offset: float
+    far_side: bool
+    median: bool
+    albedo: float
+    shadow_m: float
+
+
 @register
 class GuardRail(Illusion):
     """W-beam guard rails along the road edge whose bright top edge and shadow run parallel to the lane lines."""
@@ -310,12 +374,12 @@ class GuardRail(Illusion):
     # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept). The sun is the same at
     # every level; the rails come closer to the lanes, brighter, and more of them, so their edges and shadows
     # run ever nearer the lane lines.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"offset": 2.4, "far_side": False, "median": False, "albedo": 0.30, "shadow_m": 2.5},  # one rail, set back
-        {"offset": 1.6, "far_side": False, "median": False, "albedo": 0.40, "shadow_m": 2.5},
-        {"offset": 1.0, "far_side": True, "median": False, "albedo": 0.50, "shadow_m": 2.5},  # both edges
-        {"offset": 0.5, "far_side": True, "median": False, "albedo": 0.60, "shadow_m": 2.5},
-        {"offset": 0.1, "far_side": True, "median": True, "albedo": 0.70, "shadow_m": 2.5},  # and the median
+    SEVERITY: ClassVar[tuple[GuardRailLevel, ...]] = (
+        GuardRailLevel(offset=2.4, far_side=False, median=False, albedo=0.30, shadow_m=2.5),  # one rail, set back
+        GuardRailLevel(offset=1.6, far_side=False, median=False, albedo=0.40, shadow_m=2.5),
+        GuardRailLevel(offset=1.0, far_side=True, median=False, albedo=0.50, shadow_m=2.5),  # both edges
+        GuardRailLevel(offset=0.5, far_side=True, median=False, albedo=0.60, shadow_m=2.5),
+        GuardRailLevel(offset=0.1, far_side=True, median=True, albedo=0.70, shadow_m=2.5),  # and the median
     )
 
     type: Literal["guard_rail"] = "guard_rail"
@@ -327,6 +391,10 @@ class GuardRail(Illusion):
     color: tuple[_Unit, _Unit, _Unit] | None = Field(None, description="linear albedo of the steel; empty = grey")
     shadow_m: float | None = Field(None, ge=0, le=20, description="shadow reach across the road (m); 0 = keep sun")
     post_spacing: float = Field(2.0, ge=0.5, le=10, description="distance between posts (m)")
+
+    def level(self) -> GuardRailLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
 
     def start_s(self, case: Case) -> float:
         """Where along the road the rails start: by default beside the ego, so they line the whole view."""
@@ -341,7 +409,7 @@ class GuardRail(Illusion):
         s1 = min(s0 + self.extent, main.line.length)
         if s1 - s0 < 1.0:
             return
-        color = self.color if self.color is not None else (self.level()["albedo"],) * 3
+        color = self.color if self.color is not None else (self.level().albedo,) * 3
         rails_t = self._rails_t(ctx)
         for index, t_rail in enumerate(rails_t):
             median = abs(t_rail) < main.half_width

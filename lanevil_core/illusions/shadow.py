@@ -11,7 +11,8 @@ back towards the camera.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -19,7 +20,7 @@ from pydantic import Field
 from ..environment import sun_direction
 from ..primitives import pose_on_road, transformed
 from ..structures import clear_runs, fence, ground_height, outside_gaps, overhead_rail, power_lines, streetlight
-from .base import Category, CompileContext, Illusion, register
+from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -33,6 +34,23 @@ ROAD_END_MARGIN_M = 5.0
 MAX_AHEAD_DEG = 75.0  # the sun never stands further ahead than this when its azimuth is solved for
 UPRIGHT_KINDS = ("streetlight", "pole")  # props already standing beside the road that our posts must not hit
 UPRIGHT_CLEARANCE_M = 1.5
+
+
+@dataclass(frozen=True)
+class ShadowLevel(Level):
+    """What every shadow level sets: the sun (degrees above the horizon, luminance) and the shadow's softness."""
+
+    sun_altitude: float
+    sun_intensity: float
+    penumbra: float  # metres of blur at 1 m from the occluder
+
+
+@dataclass(frozen=True)
+class SunAheadLevel(ShadowLevel):
+    """A shadow level whose sun bearing comes from the table: ``sun_ahead`` degrees from square-on to the road
+    towards the direction of travel."""
+
+    sun_ahead: float
 
 
 class SunShadowIllusion(Illusion):
@@ -52,9 +70,15 @@ class SunShadowIllusion(Illusion):
         None, ge=0, le=3, description="direct sun luminance (1 = clear noon); empty = from the severity table"
     )
 
+    SEVERITY: ClassVar[tuple[ShadowLevel, ...]]
+
+    def level(self) -> ShadowLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def altitude(self) -> float:
         """Sun altitude (degrees): the override or the table's."""
-        return float(self.level()["sun_altitude"] if self.sun_altitude is None else self.sun_altitude)
+        return float(self.level().sun_altitude if self.sun_altitude is None else self.sun_altitude)
 
     def apply_sun(self, ctx: CompileContext, s_road: float, side_sign: float, ahead: float | None = None) -> None:
         """Set the environment's sun from the table row or the overrides.
@@ -67,11 +91,14 @@ class SunShadowIllusion(Illusion):
         azimuth = self.sun_azimuth
         if azimuth is None:
             heading_deg = float(np.degrees(ctx.network.main.line.heading_at(s_road)))
-            ahead = level["sun_ahead"] if ahead is None else ahead
+            if ahead is None:
+                if not isinstance(level, SunAheadLevel):
+                    raise TypeError(f"{type(self).__name__}'s table has no sun_ahead: pass ahead")
+                ahead = level.sun_ahead
             azimuth = heading_deg + side_sign * (90.0 - ahead)
         ctx.env.sun_dir_world = sun_direction(azimuth, altitude)
-        ctx.env.sun_intensity = float(level["sun_intensity"] if self.sun_intensity is None else self.sun_intensity)
-        ctx.env.penumbra = float(level["penumbra"])
+        ctx.env.sun_intensity = float(level.sun_intensity if self.sun_intensity is None else self.sun_intensity)
+        ctx.env.penumbra = float(level.penumbra)
 
     def extent(self, case: Case, length: float | None) -> tuple[float, float]:
         """(s0, s1) along the main road: from ``start_s`` over ``length``, or to past the end of the drive."""
@@ -117,6 +144,16 @@ def _road_frame(line: ReferenceLine, p_world: np.ndarray) -> tuple[np.ndarray, n
     return s_road, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
 
 
+@dataclass(frozen=True)
+class StreetlightShadowLevel(SunAheadLevel):
+    """What one severity level of ``StreetlightShadow`` sets."""
+
+    spacing: float
+    pole_height: float
+    pole_radius: float
+    arm: float
+
+
 @register
 class StreetlightShadow(SunShadowIllusion):
     """Rows of street lamps whose long low-sun shadows stripe the lanes."""
@@ -124,17 +161,18 @@ class StreetlightShadow(SunShadowIllusion):
     # One low, hard sun from the same bearing at every level (the scene's light does not change between levels);
     # the level makes the lamps taller, thicker and closer, so their shadows reach further across the lanes and
     # stripe more of them.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 50.0,
-         "pole_height": 6.0, "pole_radius": 0.08, "arm": 0.6},  # a few thin lamps, short shadows
-        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 38.0,
-         "pole_height": 7.0, "pole_radius": 0.11, "arm": 1.0},
-        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 29.0,
-         "pole_height": 8.0, "pole_radius": 0.14, "arm": 1.4},
-        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 22.0,
-         "pole_height": 9.0, "pole_radius": 0.17, "arm": 1.8},
-        {"sun_altitude": 40.0, "sun_ahead": 50.0, "sun_intensity": 1.2, "penumbra": 0.008, "spacing": 17.0,
-         "pole_height": 10.0, "pole_radius": 0.20, "arm": 2.2},  # tall, thick, dense: shadows over every lane
+    SEVERITY: ClassVar[tuple[StreetlightShadowLevel, ...]] = (
+        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=50.0,
+                               pole_height=6.0, pole_radius=0.08, arm=0.6),  # a few thin lamps, short shadows
+        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=38.0,
+                               pole_height=7.0, pole_radius=0.11, arm=1.0),
+        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=29.0,
+                               pole_height=8.0, pole_radius=0.14, arm=1.4),
+        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=22.0,
+                               pole_height=9.0, pole_radius=0.17, arm=1.8),
+        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=17.0,
+                               pole_height=10.0, pole_radius=0.20,
+                               arm=2.2),  # tall, thick, dense: shadows over every lane
     )
 
     type: Literal["streetlight_shadow"] = "streetlight_shadow"
@@ -145,11 +183,15 @@ class StreetlightShadow(SunShadowIllusion):
     offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
     spacing: float | None = Field(None, ge=10, le=100, description="distance between lamps (m); empty = from the table")
 
+    def level(self) -> StreetlightShadowLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         piece = ctx.network.main
         s0, s1 = self.extent(ctx.case, self.length)
-        spacing = self.spacing if self.spacing is not None else level["spacing"]
+        spacing = self.spacing if self.spacing is not None else level.spacing
         signs = (-1.0, 1.0) if self.side == "both" else (side_sign(self.side),)
         self.apply_sun(ctx, s0, signs[0])
         gaps = blocked(ctx, piece)
@@ -157,12 +199,21 @@ class StreetlightShadow(SunShadowIllusion):
             s_poles = np.arange(s0 + 0.5 * spacing * k, s1, spacing)
             t_pole = roadside_t(piece, self.offset, sign)
             yaw = 0.0 if sign < 0 else np.pi  # the arm reaches over the road
-            lamp = streetlight(level["pole_height"], level["arm"], pole_radius=level["pole_radius"])
+            lamp = streetlight(level.pole_height, level.arm, pole_radius=level.pole_radius)
             for index, s_pole in enumerate(s_poles[outside_gaps(s_poles, t_pole, gaps)]):
                 pose = pose_on_road(piece.line, float(s_pole), t_pole, yaw, ground_height(piece, t_pole))
                 mesh = transformed(lamp, pose)
                 mesh.name = f"streetlight {'left' if sign > 0 else 'right'} {index + 1}"
                 ctx.add_mesh(mesh)
+
+
+@dataclass(frozen=True)
+class FenceShadowLevel(SunAheadLevel):
+    """What one severity level of ``FenceShadow`` sets."""
+
+    height: float
+    slat_width: float
+    slat_gap: float
 
 
 @register
@@ -171,17 +222,17 @@ class FenceShadow(SunShadowIllusion):
 
     # One low sun from a fixed bearing at every level; the fence grows taller and its slats denser, so the
     # striped shadow reaches further across the lanes and darkens more of them.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 0.7,
-         "slat_width": 0.06, "slat_gap": 0.50},  # a low, open fence: a thin striped edge
-        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 1.5,
-         "slat_width": 0.10, "slat_gap": 0.36},
-        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 2.2,
-         "slat_width": 0.12, "slat_gap": 0.28},
-        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 2.8,
-         "slat_width": 0.14, "slat_gap": 0.21},
-        {"sun_altitude": 20.0, "sun_ahead": 32.0, "sun_intensity": 1.05, "penumbra": 0.008, "height": 3.4,
-         "slat_width": 0.16, "slat_gap": 0.14},  # a tall dense fence: stripes over the ego's lane and beyond
+    SEVERITY: ClassVar[tuple[FenceShadowLevel, ...]] = (
+        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=0.7,
+                         slat_width=0.06, slat_gap=0.50),  # a low, open fence: a thin striped edge
+        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=1.5,
+                         slat_width=0.10, slat_gap=0.36),
+        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=2.2,
+                         slat_width=0.12, slat_gap=0.28),
+        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=2.8,
+                         slat_width=0.14, slat_gap=0.21),
+        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=3.4,
+                         slat_width=0.16, slat_gap=0.14),  # a tall dense fence: stripes over the ego's lane and beyond
     )
 
     type: Literal["fence_shadow"] = "fence_shadow"
@@ -192,6 +243,10 @@ class FenceShadow(SunShadowIllusion):
     offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
     color: tuple[Albedo, Albedo, Albedo] = Field((0.13, 0.085, 0.05), description="linear albedo of the slats")
 
+    def level(self) -> FenceShadowLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         piece = ctx.network.main
@@ -200,8 +255,19 @@ class FenceShadow(SunShadowIllusion):
         self.apply_sun(ctx, s0, sign)
         t_fence = roadside_t(piece, self.offset, sign)
         for index, (a, b) in enumerate(clear_runs(s0, s1, t_fence, blocked(ctx, piece))):
-            ctx.add_mesh(fence(piece.line, a, b, t_fence, level["height"], level["slat_width"], level["slat_gap"],
+            ctx.add_mesh(fence(piece.line, a, b, t_fence, level.height, level.slat_width, level.slat_gap,
                                ground=ground_height(piece, t_fence), color=self.color, name=f"fence {index + 1}"))
+
+
+@dataclass(frozen=True)
+class RailShadowLevel(SunAheadLevel):
+    """What one severity level of ``RailShadow`` sets."""
+
+    deck_length: float
+    slots_along: str
+    slot_width: float
+    slot_pitch: float
+    deck_depth: float
 
 
 @register
@@ -210,17 +276,17 @@ class RailShadow(SunShadowIllusion):
 
     # One high sun and one slot pattern (slots along the road: bright lines parallel to the lanes) at every level;
     # the deck, starting at the same place, grows longer, so each level's striped shade holds the one before.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 4.0,
-         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},  # a narrow footbridge
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 8.0,
-         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 13.0,
-         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 19.0,
-         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},
-        {"sun_altitude": 50.0, "sun_ahead": 72.0, "sun_intensity": 1.2, "penumbra": 0.006, "deck_length": 26.0,
-         "slots_along": "s", "slot_width": 0.24, "slot_pitch": 1.4, "deck_depth": 0.35},  # a slotted viaduct
+    SEVERITY: ClassVar[tuple[RailShadowLevel, ...]] = (
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=4.0,
+                        slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),  # a narrow footbridge
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=8.0,
+                        slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=13.0,
+                        slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=19.0,
+                        slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=26.0,
+                        slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),  # a slotted viaduct
     )
 
     type: Literal["rail_shadow"] = "rail_shadow"
@@ -231,17 +297,33 @@ class RailShadow(SunShadowIllusion):
     clearance: float = Field(5.5, ge=4.5, le=15, description="height of the deck's underside above the road (m)")
     margin: float = Field(3.0, ge=0.5, le=15, description="how far the deck reaches beyond each paved edge (m)")
 
+    def level(self) -> RailShadowLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         piece = ctx.network.main
-        deck_length = self.deck_length if self.deck_length is not None else level["deck_length"]
+        deck_length = self.deck_length if self.deck_length is not None else level.deck_length
         s_center = min(self.start_s(ctx.case) + deck_length / 2,
                        ctx.case.road.length - ROAD_END_MARGIN_M - deck_length / 2)
         self.apply_sun(ctx, s_center, side_sign(self.side))
         span = 2.0 * abs(roadside_t(piece, self.margin, 1.0))
-        ctx.add_mesh(overhead_rail(piece.line, s_center, span, deck_length, level["slot_width"], level["slot_pitch"],
-                                   self.clearance, slots_along=level["slots_along"], deck_depth=level["deck_depth"],
+        ctx.add_mesh(overhead_rail(piece.line, s_center, span, deck_length, level.slot_width, level.slot_pitch,
+                                   self.clearance, slots_along=level.slots_along, deck_depth=level.deck_depth,
                                    gaps=piece.gaps, name="overhead rail"))
+
+
+@dataclass(frozen=True)
+class WireShadowLevel(ShadowLevel):
+    """What one severity level of ``WireShadow`` sets."""
+
+    n_wires: int
+    wire_radius: float
+    wire_spacing: float
+    height: float
+    cross_every: int
+    cross_skew: float
 
 
 @register
@@ -251,17 +333,17 @@ class WireShadow(SunShadowIllusion):
     # More and thicker wires under a harder sun; wires start to cross the road, then diagonally. The sun's
     # azimuth is solved so the wires along the road shadow the ego's lane (see ``_sun_ahead``).
     # cross_every: every n-th pole sends wires across the road (0 = none; smaller = more crossings).
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"sun_altitude": 55.0, "sun_intensity": 0.8, "penumbra": 0.010, "n_wires": 2, "wire_radius": 0.020,
-         "wire_spacing": 1.2, "height": 8.0, "cross_every": 0, "cross_skew": 0.0},
-        {"sun_altitude": 52.0, "sun_intensity": 0.95, "penumbra": 0.008, "n_wires": 2, "wire_radius": 0.028,
-         "wire_spacing": 1.0, "height": 8.5, "cross_every": 3, "cross_skew": 0.0},
-        {"sun_altitude": 50.0, "sun_intensity": 1.1, "penumbra": 0.006, "n_wires": 3, "wire_radius": 0.035,
-         "wire_spacing": 0.9, "height": 9.0, "cross_every": 2, "cross_skew": 6.0},
-        {"sun_altitude": 47.0, "sun_intensity": 1.3, "penumbra": 0.004, "n_wires": 3, "wire_radius": 0.045,
-         "wire_spacing": 0.8, "height": 9.0, "cross_every": 1, "cross_skew": 10.0},
-        {"sun_altitude": 45.0, "sun_intensity": 1.5, "penumbra": 0.003, "n_wires": 4, "wire_radius": 0.055,
-         "wire_spacing": 0.7, "height": 9.5, "cross_every": 1, "cross_skew": 12.0},
+    SEVERITY: ClassVar[tuple[WireShadowLevel, ...]] = (
+        WireShadowLevel(sun_altitude=55.0, sun_intensity=0.8, penumbra=0.010, n_wires=2, wire_radius=0.020,
+                        wire_spacing=1.2, height=8.0, cross_every=0, cross_skew=0.0),
+        WireShadowLevel(sun_altitude=52.0, sun_intensity=0.95, penumbra=0.008, n_wires=2, wire_radius=0.028,
+                        wire_spacing=1.0, height=8.5, cross_every=3, cross_skew=0.0),
+        WireShadowLevel(sun_altitude=50.0, sun_intensity=1.1, penumbra=0.006, n_wires=3, wire_radius=0.035,
+                        wire_spacing=0.9, height=9.0, cross_every=2, cross_skew=6.0),
+        WireShadowLevel(sun_altitude=47.0, sun_intensity=1.3, penumbra=0.004, n_wires=3, wire_radius=0.045,
+                        wire_spacing=0.8, height=9.0, cross_every=1, cross_skew=10.0),
+        WireShadowLevel(sun_altitude=45.0, sun_intensity=1.5, penumbra=0.003, n_wires=4, wire_radius=0.055,
+                        wire_spacing=0.7, height=9.5, cross_every=1, cross_skew=12.0),
     )
 
     type: Literal["wire_shadow"] = "wire_shadow"
@@ -275,6 +357,10 @@ class WireShadow(SunShadowIllusion):
     )
     pole_spacing: float = Field(35.0, ge=15, le=80, description="distance between poles (m)")
 
+    def level(self) -> WireShadowLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         piece = ctx.network.main
@@ -282,12 +368,12 @@ class WireShadow(SunShadowIllusion):
         s0, s1 = self.extent(ctx.case, self.length)
         t_row = roadside_t(piece, self.offset, sign)
         sag = 0.25 + 0.01 * self.pole_spacing
-        self.apply_sun(ctx, s0, sign, self._sun_ahead(ctx, t_row, level["height"] - sag / 2))
-        t_poles = (t_row, roadside_t(piece, self.offset, -sign)) if level["cross_every"] else (t_row,)
-        radius = self.wire_radius if self.wire_radius is not None else level["wire_radius"]
-        ctx.add_mesh(power_lines(piece.line, s0, s1, t_poles, level["n_wires"], radius, level["height"],
-                                 pole_spacing=self.pole_spacing, wire_spacing=level["wire_spacing"], sag=sag,
-                                 cross_every=level["cross_every"], cross_skew=level["cross_skew"] * -sign,
+        self.apply_sun(ctx, s0, sign, self._sun_ahead(ctx, t_row, level.height - sag / 2))
+        t_poles = (t_row, roadside_t(piece, self.offset, -sign)) if level.cross_every else (t_row,)
+        radius = self.wire_radius if self.wire_radius is not None else level.wire_radius
+        ctx.add_mesh(power_lines(piece.line, s0, s1, t_poles, level.n_wires, radius, level.height,
+                                 pole_spacing=self.pole_spacing, wire_spacing=level.wire_spacing, sag=sag,
+                                 cross_every=level.cross_every, cross_skew=level.cross_skew * -sign,
                                  ground=ground_height(piece, t_row), gaps=blocked(ctx, piece),
                                  name="power lines"))
 

@@ -16,7 +16,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
 import trimesh
@@ -25,7 +25,7 @@ from pydantic import Field
 from .. import props
 from ..primitives import pose_on_road, rotation_z, to_mesh, transformed
 from ..scene import Mesh
-from .base import Category, CompileContext, Illusion, register
+from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -106,6 +106,15 @@ class Footprints:
         return None
 
 
+@dataclass(frozen=True)
+class TrafficLevel(Level):
+    """What every traffic level sets: how many participants, and how far ahead of the ego start the first stands
+    (m)."""
+
+    count: int
+    distance: float
+
+
 class TrafficIllusion(Illusion):
     """Fields and placement shared by the traffic illusions (not registered itself)."""
 
@@ -120,14 +129,20 @@ class TrafficIllusion(Illusion):
         description="distance between successive groups along the road (m); empty = spread over the drive",
     )
 
+    SEVERITY: ClassVar[tuple[TrafficLevel, ...]]
+
+    def level(self) -> TrafficLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def participants(self) -> int:
-        return int(self.level()["count"] if self.count is None else self.count)
+        return int(self.level().count if self.count is None else self.count)
 
     def first_s(self, case: Case) -> float:
         """Where the first group stands: ``s`` if given, else ``distance`` (or the table's) ahead of the start."""
         if self.s is not None:
             return self.s
-        return case.ego.start_s + float(self.level()["distance"] if self.distance is None else self.distance)
+        return case.ego.start_s + float(self.level().distance if self.distance is None else self.distance)
 
     def group_stations(self, ctx: CompileContext, groups: int) -> list[float]:
         """s of every group: from the first, ``spacing`` apart, or spread evenly up to ``BEYOND_DRIVE_M`` past
@@ -166,10 +181,12 @@ class TrafficIllusion(Illusion):
         """The first ``participants()`` slots of the most severe level's crowd: every level is the same crowd
         thinned out, so a higher level only adds people (level 1 is a mild version of level 5)."""
         full = self.SEVERITY[-1]
-        group = self.group or int(full["group"])
-        share = float(full["on_lines"] if self.on_lines is None else self.on_lines)
+        if not isinstance(full, CrowdLevel):
+            raise TypeError(f"{type(self).__name__}'s table has no crowd (group, on_lines)")
+        group = self.group or int(full.group)
+        share = float(full.on_lines if self.on_lines is None else self.on_lines)
         count = self.participants()
-        slots = self.crowd_slots(ctx, rng, group, share, yaw_of, max(count, int(full["count"])))
+        slots = self.crowd_slots(ctx, rng, group, share, yaw_of, max(count, int(full.count)))
         # Take the groups' members in turn (the first of every group, then the second ...), so a thin crowd
         # still has people all along the drive.
         order = sorted(range(len(slots)), key=lambda i: (i % group, i // group))
@@ -236,6 +253,14 @@ def on_line(index: int, share: float) -> bool:
     return math.ceil((index + 1) * share - 1e-9) > math.ceil(index * share - 1e-9)
 
 
+@dataclass(frozen=True)
+class CrowdLevel(TrafficLevel):
+    """What one severity level of a crowd (``Pedestrian``, ``Bicycle``) sets."""
+
+    group: int
+    on_lines: float
+
+
 @register
 class Pedestrian(TrafficIllusion):
     """People crossing or standing on the road, on the lane lines and in the lanes beside the ego's."""
@@ -244,12 +269,12 @@ class Pedestrian(TrafficIllusion):
     # on_lines: share of the people standing on a lane line. Every level is the first ``count`` people of the same
     # crowd (groups of 11 from 14 m ahead, 80 % on the lines), so a level only adds people. Level 5 is a crowd
     # crossing right in front of the ego, on both of its lane lines and the lines beyond.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 2, "group": 11, "distance": 14.0, "on_lines": 0.8},  # two people on the ego's lines
-        {"count": 5, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a few, on the nearest lines
-        {"count": 9, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a group across the lanes
-        {"count": 15, "group": 11, "distance": 14.0, "on_lines": 0.8},  # a crossing crowd and a second group
-        {"count": 22, "group": 11, "distance": 14.0, "on_lines": 0.8},  # crowds over every line ahead
+    SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
+        CrowdLevel(count=2, group=11, distance=14.0, on_lines=0.8),  # two people on the ego's lines
+        CrowdLevel(count=5, group=11, distance=14.0, on_lines=0.8),  # a few, on the nearest lines
+        CrowdLevel(count=9, group=11, distance=14.0, on_lines=0.8),  # a group across the lanes
+        CrowdLevel(count=15, group=11, distance=14.0, on_lines=0.8),  # a crossing crowd and a second group
+        CrowdLevel(count=22, group=11, distance=14.0, on_lines=0.8),  # crowds over every line ahead
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
@@ -259,6 +284,10 @@ class Pedestrian(TrafficIllusion):
     )
     shirt_colors: list[RGB] | None = Field(None, description="shirt colours (linear RGB), cycled; empty = random")
     height: float = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
+
+    def level(self) -> CrowdLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
 
     def compile(self, ctx: CompileContext) -> None:
         rng = ctx.rng(self.seed)
@@ -285,12 +314,12 @@ class Bicycle(TrafficIllusion):
     # on_lines: share of cyclists riding on a lane line. Every level is the first ``count`` riders of the same
     # club ride (groups of 10 from 14 m ahead, 80 % on the lines), so a level only adds riders. Level 5 is the
     # whole ride spread over the road just ahead of the ego, most of it on the lane lines.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 2, "group": 10, "distance": 14.0, "on_lines": 0.8},  # two riders on the ego's lines
-        {"count": 4, "group": 10, "distance": 14.0, "on_lines": 0.8},  # a few, on the nearest lines
-        {"count": 7, "group": 10, "distance": 14.0, "on_lines": 0.8},  # a bunch across the lanes
-        {"count": 13, "group": 10, "distance": 14.0, "on_lines": 0.8},  # the front group and followers
-        {"count": 20, "group": 10, "distance": 14.0, "on_lines": 0.8},  # the club ride over every line
+    SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
+        CrowdLevel(count=2, group=10, distance=14.0, on_lines=0.8),  # two riders on the ego's lines
+        CrowdLevel(count=4, group=10, distance=14.0, on_lines=0.8),  # a few, on the nearest lines
+        CrowdLevel(count=7, group=10, distance=14.0, on_lines=0.8),  # a bunch across the lanes
+        CrowdLevel(count=13, group=10, distance=14.0, on_lines=0.8),  # the front group and followers
+        CrowdLevel(count=20, group=10, distance=14.0, on_lines=0.8),  # the club ride over every line
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
@@ -299,6 +328,10 @@ class Bicycle(TrafficIllusion):
         None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
     )
     frame_colors: list[RGB] | None = Field(None, description="bicycle frame colours (linear RGB), cycled")
+
+    def level(self) -> CrowdLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
 
     def compile(self, ctx: CompileContext) -> None:
         rng = ctx.rng(self.seed)
@@ -316,6 +349,15 @@ class Bicycle(TrafficIllusion):
         self.add_crowd(ctx, self.nested_crowd(ctx, rng, yaw_of), cyclist)
 
 
+@dataclass(frozen=True)
+class VehicleLevel(TrafficLevel):
+    """What one severity level of ``Vehicle`` sets."""
+
+    per_row: int
+    large: float
+    lane_change: float
+
+
 @register
 class Vehicle(TrafficIllusion):
     """Cars, vans and trucks standing in the lanes beside the ego's, some changing lanes across a line, and in
@@ -325,12 +367,12 @@ class Vehicle(TrafficIllusion):
     # start (m); large: share of vans and trucks (mixed kind); lane_change: share straddling a lane line.
     # The first row stands at the same place at every level; the level adds rows, vehicles side by side, large
     # vehicles and lane changes, so more of the lines ahead are hidden.
-    SEVERITY: ClassVar[tuple[dict[str, Any], ...]] = (
-        {"count": 1, "per_row": 1, "distance": 16.0, "large": 0.0, "lane_change": 0.0},  # one car beside the ego
-        {"count": 2, "per_row": 1, "distance": 16.0, "large": 0.2, "lane_change": 0.0},  # a second row, vans
-        {"count": 4, "per_row": 2, "distance": 16.0, "large": 0.3, "lane_change": 0.2},  # pairs side by side
-        {"count": 6, "per_row": 2, "distance": 16.0, "large": 0.4, "lane_change": 0.3},  # a queue with vans
-        {"count": 9, "per_row": 3, "distance": 16.0, "large": 0.5, "lane_change": 0.4},  # dense traffic, trucks
+    SEVERITY: ClassVar[tuple[VehicleLevel, ...]] = (
+        VehicleLevel(count=1, per_row=1, distance=16.0, large=0.0, lane_change=0.0),  # one car beside the ego
+        VehicleLevel(count=2, per_row=1, distance=16.0, large=0.2, lane_change=0.0),  # a second row, vans
+        VehicleLevel(count=4, per_row=2, distance=16.0, large=0.3, lane_change=0.2),  # pairs side by side
+        VehicleLevel(count=6, per_row=2, distance=16.0, large=0.4, lane_change=0.3),  # a queue with vans
+        VehicleLevel(count=9, per_row=3, distance=16.0, large=0.5, lane_change=0.4),  # dense traffic, trucks
     )
     # Lanes relative to the ego's (+1 = next lane to its right, -1 = to its left), tried in this order.
     LANE_ORDER: ClassVar[tuple[int, ...]] = (1, -1, -2, 2, -3, 3, 0, -4, 4, -5, 5, -6, 6, -7, 7)
@@ -347,11 +389,15 @@ class Vehicle(TrafficIllusion):
         None, description="glTF/GLB/OBJ model used instead of the procedural bodies, scaled to the vehicle size"
     )
 
+    def level(self) -> VehicleLevel:
+        """This illusion's row of ``SEVERITY``."""
+        return self.SEVERITY[self.severity - 1]
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         rng = ctx.rng(self.seed)
-        per_row = self.per_row or int(level["per_row"])
-        lane_change = float(level["lane_change"] if self.lane_change is None else self.lane_change)
+        per_row = self.per_row or int(level.per_row)
+        lane_change = float(level.lane_change if self.lane_change is None else self.lane_change)
         total = self.participants()
         stations = self.group_stations(ctx, math.ceil(total / per_row))
         free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
@@ -361,7 +407,7 @@ class Vehicle(TrafficIllusion):
             for lane_t in self._row_lanes(ctx, s, per_row, row):
                 if index >= total:
                     return
-                kind = self._kind(rng, float(level["large"]))
+                kind = self._kind(rng, float(level.large))
                 length, width, height = VEHICLE_SIZE[kind]
                 s_vehicle, reach = s + rng.uniform(-2.0, 2.0), paved_reach(ctx.network.main)
                 changing = on_line(index, lane_change)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -33,10 +34,12 @@ def test_registry_is_the_benchmark_taxonomy() -> None:
 
 
 @pytest.mark.parametrize("name", TYPES)
-def test_severity_table_has_five_rows_with_the_same_keys(name: str) -> None:
+def test_severity_table_has_five_rows_of_one_frozen_type(name: str) -> None:
     table = REGISTRY[name].SEVERITY
     assert len(table) == 5
-    assert all(row.keys() == table[0].keys() for row in table)
+    assert all(type(row) is type(table[0]) for row in table)
+    assert dataclasses.is_dataclass(table[0]) and type(table[0]).__dataclass_params__.frozen
+    assert REGISTRY[name](severity=2).level() is table[1]
 
 
 @pytest.mark.parametrize("name", TYPES)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -45,9 +47,9 @@ def test_registered_with_a_monotone_five_row_table(name: str) -> None:
     cls = REGISTRY[name]
     assert cls.CATEGORY == "road_damage"
     rows = cls.SEVERITY
-    assert len(rows) == 5 and all(row.keys() == rows[0].keys() for row in rows)
-    for key in rows[0]:
-        values = [row[key] for row in rows]
+    assert len(rows) == 5 and all(type(row) is type(rows[0]) for row in rows)
+    for key in (field.name for field in dataclasses.fields(rows[0])):
+        values = [getattr(row, key) for row in rows]
         if key == "offset":  # the rail closes in on the lanes
             assert values == sorted(values, reverse=True)
         else:
@@ -176,7 +178,7 @@ def test_guard_rail_sun_throws_its_shadow_across_the_lanes() -> None:
     sun = scene.env.sun_dir_world
     assert sun[1] < 0  # on the right of a road heading +X, so the shadow falls towards +t (onto the road)
     reach = 0.75 * (-sun[1]) / np.hypot(sun[0], sun[1]) / np.tan(np.arcsin(sun[2]))
-    assert reach == pytest.approx(REGISTRY["guard_rail"].SEVERITY[2]["shadow_m"], rel=0.05)
+    assert reach == pytest.approx(REGISTRY["guard_rail"].SEVERITY[2].shadow_m, rel=0.05)
 
 
 def test_guard_rail_fields_override_the_table() -> None:

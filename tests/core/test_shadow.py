@@ -56,10 +56,10 @@ def shadow_points(scene: CompiledScene) -> np.ndarray:
 def test_severity_tables_are_monotone(name: str) -> None:
     table = REGISTRY[name].SEVERITY
     assert REGISTRY[name].CATEGORY == "shadow"
-    assert all(row.keys() == table[0].keys() for row in table)
-    altitude = [row["sun_altitude"] for row in table]
-    intensity = [row["sun_intensity"] for row in table]
-    penumbra = [row["penumbra"] for row in table]
+    assert all(type(row) is type(table[0]) for row in table)
+    altitude = [row.sun_altitude for row in table]
+    intensity = [row.sun_intensity for row in table]
+    penumbra = [row.penumbra for row in table]
     assert all(a >= b for a, b in zip(altitude, altitude[1:]))
     assert all(a <= b for a, b in zip(intensity, intensity[1:]))
     assert all(a >= b for a, b in zip(penumbra, penumbra[1:]))
@@ -79,10 +79,10 @@ def test_every_level_compiles_deterministically(name: str, severity: int) -> Non
         assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
         assert np.array_equal(a.colors, b.colors) and a.name == b.name
     assert np.array_equal(first.env.sun_dir_world, again.env.sun_dir_world)
-    assert first.env.sun_intensity == REGISTRY[name].SEVERITY[severity - 1]["sun_intensity"]
-    assert first.env.penumbra == REGISTRY[name].SEVERITY[severity - 1]["penumbra"]
+    assert first.env.sun_intensity == REGISTRY[name].SEVERITY[severity - 1].sun_intensity
+    assert first.env.penumbra == REGISTRY[name].SEVERITY[severity - 1].penumbra
     altitude = np.degrees(np.arcsin(first.env.sun_dir_world[2]))
-    assert altitude == pytest.approx(REGISTRY[name].SEVERITY[severity - 1]["sun_altitude"])
+    assert altitude == pytest.approx(REGISTRY[name].SEVERITY[severity - 1].sun_altitude)
 
 
 @pytest.mark.parametrize("name", SHADOW_TYPES)
@@ -210,6 +210,6 @@ def test_fence_sun_keeps_its_bearing_while_the_fence_grows() -> None:
     assert np.ptp(azimuth) < 1.0  # the rest of the scene's shadows only lengthen from level to level
     height = [own_vertices(s)[:, 2].max() for s in scenes]
     assert all(a < b for a, b in zip(height, height[1:]))
-    slats = [REGISTRY["fence_shadow"].SEVERITY[k]["slat_width"] / REGISTRY["fence_shadow"].SEVERITY[k]["slat_gap"]
+    slats = [REGISTRY["fence_shadow"].SEVERITY[k].slat_width / REGISTRY["fence_shadow"].SEVERITY[k].slat_gap
              for k in range(5)]
     assert all(a < b for a, b in zip(slats, slats[1:]))  # denser slats: darker stripes

@@ -82,9 +82,9 @@ def test_traffic_types_are_registered() -> None:
     for name in TRAFFIC:
         assert REGISTRY[name].CATEGORY == "traffic"
         rows = REGISTRY[name].SEVERITY
-        assert len(rows) == 5 and all(row.keys() == rows[0].keys() for row in rows)
-        counts = [row["count"] for row in rows]
-        distances = [row["distance"] for row in rows]
+        assert len(rows) == 5 and all(type(row) is type(rows[0]) for row in rows)
+        counts = [row.count for row in rows]
+        distances = [row.distance for row in rows]
         assert counts == sorted(counts) and distances == sorted(distances, reverse=True)
 
 
