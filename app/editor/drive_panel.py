@@ -75,6 +75,7 @@ class DrivePanel:
         self.frames: list[np.ndarray] = []
         self.fps = 10.0
         self._play_token = 0
+        self._stopped = threading.Event()
         with gui.add_folder("Drive (closed loop)", expand_by_default=False):
             self.own_detector = None if chosen_detector is not None else gui.add_dropdown(
                 "Detector", list(DRIVE_DETECTORS), initial_value=GROUND_TRUTH, hint="gt = the projected ground truth")
@@ -114,21 +115,28 @@ class DrivePanel:
 
     def _follow(self, job: Job) -> None:
         while not job.finished.wait(POLL_S):
+            if self._stopped.is_set():
+                return
             self.status.content = f"driving with **{job.meta['detector']}**: step {job.done} of {job.total}"
+        if self._stopped.is_set():
+            return
         if job.status != "done" or job.result is None:
             self.status.content = f"⚠ the drive {job.status}: {job.error or ''}"
             return
         summary = json.loads((job.result / SUMMARY_FILE).read_text(encoding="utf-8"))
         self.status.content = verdict_text(summary)
         self.plot.image = cv2.cvtColor(cv2.imread(str(job.result / TRACE_PLOT_FILE)), cv2.COLOR_BGR2RGB)
-        self.frames = video_frames(job.result)
-        self.replay.disabled = not self.frames
+        frames = video_frames(job.result)
+        if self._stopped.is_set():
+            return
+        self.frames = frames
+        self.replay.disabled = not frames
         self.play()
 
     def stop(self) -> None:
-        """Stop a playback (the editor is closing)."""
+        """Stop following the drive and playing it (the editor is closing)."""
+        self._stopped.set()
         self._play_token += 1
-        self.frames = []
 
     def play(self) -> None:
         """Play the last drive's frames once (a new call restarts it)."""
@@ -137,9 +145,8 @@ class DrivePanel:
                          daemon=True).start()
 
     def _play(self, token: int) -> None:
-        stop = threading.Event()
         for frame in self.frames:
-            if token != self._play_token:
+            if token != self._play_token or self._stopped.is_set():
                 return
             self.video.image = frame
-            stop.wait(1.0 / self.fps)
+            self._stopped.wait(1.0 / self.fps)

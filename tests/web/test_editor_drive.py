@@ -27,9 +27,7 @@ def test_drive_button_runs_the_open_case_and_plays_it(editor: Editor) -> None:
     assert job is not None and job.kind == "drive"
     assert job.meta["detector"] == "gt"  # the preview shows no detector: the ground truth drives
     assert job.finished.wait(WAIT_S) and job.status == "done", job.error
-    deadline = time.monotonic() + 10
-    while not editor.drive.frames and time.monotonic() < deadline:
-        time.sleep(0.1)
+    _wait_for_playback(editor)
     assert len(editor.drive.frames) == 10 and editor.drive.frames[0].shape == (360, 640, 3)
     assert "no success" in editor.drive.status.content and not editor.drive.replay.disabled
 
@@ -40,3 +38,11 @@ def test_drive_uses_the_preview_detector(editor: Editor) -> None:
     job = editor.drive.start()
     assert job is not None and job.meta["detector"] == "hough"
     assert job.finished.wait(WAIT_S) and job.status == "done", job.error
+    _wait_for_playback(editor)
+
+
+def _wait_for_playback(editor: Editor) -> None:
+    """Until the finished drive's frames are loaded (no video decoding left running when the editor stops)."""
+    deadline = time.monotonic() + 10
+    while not editor.drive.frames and time.monotonic() < deadline:
+        time.sleep(0.1)
