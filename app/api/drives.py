@@ -55,7 +55,7 @@ def drive_body(job: Job, request: Request) -> dict[str, Any]:
     """A drive job's state, its links, and once done its summary and file URLs."""
     body: dict[str, Any] = {**job.to_dict(), "links": {"self": str(request.url_for("get_drive", job_id=job.id))}}
     files = _files(job)
-    if files:
+    if files and job.result is not None:
         body["files"] = {name: str(request.url_for("drive_file", job_id=job.id, name=name)) for name in files}
         body["summary"] = json.loads((job.result / SUMMARY_FILE).read_text(encoding="utf-8"))
     return body

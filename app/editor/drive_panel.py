@@ -89,8 +89,11 @@ class DrivePanel:
             self.video = gui.add_image(BLANK, label="Drive", format="jpeg", jpeg_quality=85)
             self.plot = gui.add_image(BLANK, label="Deviation over time", format="png")
             self.replay = gui.add_button("Replay", icon=viser.Icon.PLAYER_PLAY, disabled=True)
-        self.button.on_click(lambda event: self.start())
+        self.button.on_click(lambda event: self._start_clicked())
         self.replay.on_click(lambda event: self.play())
+
+    def _start_clicked(self) -> None:
+        self.start()
 
     def detector(self) -> str:
         if self.own_detector is not None:
@@ -104,7 +107,8 @@ class DrivePanel:
         except Exception as error:  # noqa: BLE001 - no case open: say why in the folder
             self.status.content = f"⚠ {error}"
             return None
-        settings = DriveSettings(detector=self.detector(), controller=str(self.controller.value),
+        controller = next(name for name in CONTROLLERS if name == self.controller.value)
+        settings = DriveSettings(detector=self.detector(), controller=controller,
                                  seconds=float(self.seconds.value), size=DEFAULT_SIZE)
         self.fps = case.ego.fps
         self.job = drive_job(self.state.jobs, case, settings,
@@ -125,7 +129,9 @@ class DrivePanel:
             return
         summary = json.loads((job.result / SUMMARY_FILE).read_text(encoding="utf-8"))
         self.status.content = verdict_text(summary)
-        self.plot.image = cv2.cvtColor(cv2.imread(str(job.result / TRACE_PLOT_FILE)), cv2.COLOR_BGR2RGB)
+        plot = cv2.imread(str(job.result / TRACE_PLOT_FILE))
+        if plot is not None:
+            self.plot.image = np.ascontiguousarray(plot[..., ::-1])
         frames = video_frames(job.result)
         if self._stopped.is_set():
             return

@@ -33,7 +33,7 @@ class LanePath:
     coeffs: tuple[float, ...]
 
     def y_at(self, x_vehicle: FloatArray | float) -> FloatArray:
-        return np.polynomial.polynomial.polyval(np.asarray(x_vehicle, np.float64), self.coeffs)
+        return np.asarray(np.polynomial.polynomial.polyval(np.asarray(x_vehicle, np.float64), self.coeffs), np.float64)
 
     def slope_at(self, x_vehicle: float) -> float:
         return float(np.polynomial.polynomial.polyval(x_vehicle, np.polynomial.polynomial.polyder(self.coeffs)))

@@ -134,13 +134,13 @@ def markdown(entries: list[SuiteEntry], settings: DriveSettings) -> str:
                   "|---|---|---|---|---|---|"]
         for entry in clean:
             s = entry.summary
-            departure, off_road = "yes" if s.lane_departure else "", "yes" if s.off_road else ""
-            lines.append(f"| {entry.path} | {entry.type} | {s.max_abs_deviation:.3f} | {departure} | {off_road} | "
+            departed, left_road = "yes" if s.lane_departure else "", "yes" if s.off_road else ""
+            lines.append(f"| {entry.path} | {entry.type} | {s.max_abs_deviation:.3f} | {departed} | {left_road} | "
                          f"{s.mean_accuracy:.2f} |")
     departures = sum(entry.summary.lane_departure for entry in entries)
     off_road = sum(entry.summary.off_road for entry in entries)
-    rates = [entry.summary.steps_per_second for entry in entries if entry.summary.steps_per_second]
-    speed = f", {sum(rates) / len(rates):.1f} steps/s" if rates else ""
+    speeds = [entry.summary.steps_per_second for entry in entries if entry.summary.steps_per_second]
+    speed = f", {sum(speeds) / len(speeds):.1f} steps/s" if speeds else ""
     lines += ["", f"{len(entries)} drives, {departures} lane departures, {off_road} off the road{speed}.", ""]
     return "\n".join(lines)
 

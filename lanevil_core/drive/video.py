@@ -74,7 +74,7 @@ class DriveVideo:
         image = drive_frame(view)
         if self._writer is None and not self._gif and self.path.suffix == ".mp4":
             height, width = image.shape[:2]
-            writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*"mp4v"), self.fps, (width, height))
+            writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter.fourcc(*"mp4v"), self.fps, (width, height))
             if writer.isOpened():
                 self._writer = writer
             else:

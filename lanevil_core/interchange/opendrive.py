@@ -119,7 +119,7 @@ def elevation_records(line: ReferenceLine, s0: float = 0.0, s1: float | None = N
         return [(0.0, float(line.z_at(s0)), float(grade[0]), 0.0, 0.0)]
     knots = np.unique(np.append(np.arange(s0, s1, ELEVATION_STEP_M), s1))
     z, g = line.z_at(knots), line.grade_at(knots)
-    records = []
+    records: list[tuple[float, ...]] = []
     for i in range(len(knots) - 1):
         h = knots[i + 1] - knots[i]
         dz = z[i + 1] - z[i]
