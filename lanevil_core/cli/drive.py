@@ -80,6 +80,7 @@ def _run_suite(args: argparse.Namespace) -> int:
 def _run_drive(args: argparse.Namespace) -> int:
     from ..case import load_case
     from ..drive.outputs import drive_to_folder, summary_json
+    from ..drive.plots import plots_available
 
     if (args.case is None) == (args.suite is None):
         raise UsageError("give one case file or --suite DIR")
@@ -92,6 +93,8 @@ def _run_drive(args: argparse.Namespace) -> int:
         print(f"\rstep {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
     output = drive_to_folder(case, _settings(args), args.out, video=args.video is not False, progress=progress)
+    if not plots_available():
+        print("note: matplotlib is not installed (pip install 'lanevil[report]'): no plots written", file=sys.stderr)
     summary = output.summary
     if args.json:
         print(summary_json(summary), end="")

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..case import Case, write_atomic
 from .loop import DriveSettings, DriveTrace, Progress, drive_case
-from .plots import path_plot, trace_plot
+from .plots import path_plot, plots_available, trace_plot
 from .summary import DriveSummary, summarize
 from .video import DriveVideo
 
@@ -52,9 +52,10 @@ class DriveOutput:
 
 
 def write_drive(trace: DriveTrace, summary: DriveSummary, out_dir: Path, plots: bool = True) -> dict[str, Path]:
-    """Write the trace, the summary and (with ``plots``) the two plots into ``out_dir``."""
+    """Write the trace, the summary and (with ``plots``, when matplotlib is installed) the two plots into
+    ``out_dir``."""
     files = {TRACE_FILE: trace_csv(trace).encode("utf-8"), SUMMARY_FILE: summary_json(summary).encode("utf-8")}
-    if plots:
+    if plots and plots_available():
         files[TRACE_PLOT_FILE] = trace_plot(trace, summary)
         files[PATH_PLOT_FILE] = path_plot(trace, summary)
     for name, data in files.items():

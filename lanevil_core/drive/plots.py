@@ -1,11 +1,15 @@
-"""Plots of a drive (PNG bytes, matplotlib's Agg backend): deviation over time, and the path from above."""
+"""Plots of a drive (PNG bytes, matplotlib's Agg backend): deviation over time, and the path from above.
+
+matplotlib comes with the ``report`` extra; without it a drive writes no plots (``plots_available``).
+"""
 
 from __future__ import annotations
 
-import io
+import importlib.util
 
 import numpy as np
 
+from ..encode import figure_png
 from .illusion_view import VIEW_RANGE_M
 from .loop import DriveTrace
 from .summary import DEVIATION_THRESHOLD_M, SUCCESS_WINDOW_S, DriveSummary
@@ -22,11 +26,9 @@ def _pyplot():  # noqa: ANN202 - matplotlib's module
     return plt
 
 
-def _png(fig) -> bytes:  # noqa: ANN001
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    _pyplot().close(fig)
-    return buffer.getvalue()
+def plots_available() -> bool:
+    """Whether matplotlib is installed (``pip install 'lanevil[report]'``)."""
+    return importlib.util.find_spec("matplotlib") is not None
 
 
 def _title(summary: DriveSummary) -> str:
@@ -67,7 +69,7 @@ def trace_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:
     for ax in (ax_dev, ax_steer, ax_acc):
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    return _png(fig)
+    return figure_png(fig)
 
 
 def path_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:
@@ -110,5 +112,5 @@ def path_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:
     for ax in (ax_top, ax_unrolled):
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    return _png(fig)
+    return figure_png(fig)
 
