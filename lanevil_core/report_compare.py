@@ -37,7 +37,7 @@ def _heading(row: Row) -> str:
     return "Average" if row.category == ALL else row.category
 
 
-def markdown(detectors: list[Detector], f1_variant: str) -> str:
+def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = None) -> str:
     first = category_rows(detectors[0].report)
     heads = [_heading(row) for row in first]
     lines = ["# Robustness of several detectors", "",
@@ -71,7 +71,8 @@ def markdown(detectors: list[Detector], f1_variant: str) -> str:
             lines.append(f"| {detector.name} | {_pct(getattr(row.original, 'accuracy', None))} | "
                          f"{_pct(getattr(row.no_paint, 'accuracy', None))} |")
         lines.append("")
-    lines += defence_table(detectors)
+    if baseline is not None:
+        lines += defence_table(sorted(detectors, key=lambda d: d.name != baseline))
     lines += ["## Accuracy drop by severity (all categories)", "",
               "| Detector | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
               "|---|---:|" + "---:|" * len(LEVELS)]
@@ -85,7 +86,8 @@ def markdown(detectors: list[Detector], f1_variant: str) -> str:
 
 def defence_table(detectors: list[Detector]) -> list[str]:
     """Markdown lines: each detector's Perturbed accuracy per category and average, its gain over the first
-    detector (the vanilla model when comparing training defences), and its clean (Original) accuracy and change."""
+    detector (the baseline: the vanilla model when comparing training defences), and its clean (Original)
+    accuracy and change."""
     if len(detectors) < 2:
         return []
     base = {_heading(row): row for row in category_rows(detectors[0].report)}
@@ -151,13 +153,14 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
     return figure_png(fig)
 
 
-def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str) -> list[Path]:
+def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str,
+                     baseline: str | None = None) -> list[Path]:
     """compare.md, compare.csv and compare.png in ``out_dir`` and each detector's report in ``out_dir/<name>/``."""
     out_dir = Path(out_dir)
     written = []
     for detector in detectors:
         written += write_report(detector.report, out_dir / detector.name)
-    files = {COMPARE_MD: markdown(detectors, f1_variant).encode("utf-8"),
+    files = {COMPARE_MD: markdown(detectors, f1_variant, baseline).encode("utf-8"),
              COMPARE_CSV: comparison_csv(detectors).encode("utf-8"), COMPARE_PNG: comparison_plot(detectors)}
     for name, data in files.items():
         write_atomic(out_dir / name, data)

@@ -79,6 +79,9 @@ def _report_arguments(parser: argparse.ArgumentParser) -> None:
                         help="predictions (TuSimple JSON lines); repeat for several detectors side by side")
     parser.add_argument("--name", action="append", default=None,
                         help="detector name for each --pred, in order (default: the file names)")
+    parser.add_argument("--baseline", default=None, metavar="NAME",
+                        help="with several --pred: add the defence table, each detector's perturbed accuracy and its "
+                             "gain over this one (e.g. the model trained with --augment none)")
     parser.add_argument("--out", type=Path, required=True, help="report folder")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet", help="F1 variant (default ganet)")
     parser.add_argument("--title", default=None, help="report title (default: from the prediction file name)")
@@ -112,7 +115,9 @@ def _run_report(args: argparse.Namespace) -> int:
     if len(detectors) == 1:
         paths = write_report(detectors[0].report, args.out)
     else:
-        paths = write_comparison(detectors, args.out, args.f1)
+        if args.baseline is not None and args.baseline not in names:
+            raise UsageError(f"--baseline {args.baseline!r}: not one of the detector names {', '.join(names)}")
+        paths = write_comparison(detectors, args.out, args.f1, args.baseline)
     for path in paths:
         print(path)
     return 0

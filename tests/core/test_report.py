@@ -108,3 +108,38 @@ def test_end_to_end_detect_eval_report(tiny_split, tmp_path, capsys):
         assert float(row["accuracy_gap"]) == pytest.approx(gap, abs=2e-6)
     text = (out / "report.md").read_text()
     assert "| Shadow | Fence | 1/1 |" in text and "F1 variant `ganet`" in text
+    hough = tmp_path / "hough.json"
+    assert main(["detect", str(tiny_split), "--method", "hough", "--out", str(hough)]) == 0
+    both = tmp_path / "both"
+    assert main(["report", "--gt", str(tiny_split), "--pred", str(preds), "--pred", str(hough), "--out", str(both),
+                 "--baseline", "hough"]) == 0
+    compare = (both / "compare.md").read_text()
+    assert "| birdseye | P |" in compare and "| hough | P |" in compare and "gain over `hough`" in compare
+    assert (both / "birdseye" / "report.md").is_file() and (both / "compare.png").is_file()
+    assert main(["report", "--gt", str(tiny_split), "--pred", str(preds), "--pred", str(hough), "--out", str(both),
+                 "--baseline", "nope"]) == 2
+    assert main(["report", "--gt", str(tiny_split), "--pred", str(preds), "--pred", str(preds), "--out",
+                 str(both)]) == 2  # two detectors of one name
+
+
+def test_paint_free_control_and_several_detectors(tmp_path):
+    from lanevil_core.report_compare import Detector, markdown as compare_markdown, write_comparison
+
+    def images(clean: float, perturbed: float, no_paint: float) -> list[ScoredImage]:
+        control = scored("Shadow", "Fence", 0, no_paint)
+        control = ScoredImage("nopaint.png", control.score, {**control.extra, "paint": False})
+        return [scored("Shadow", "Fence", 0, clean), scored("Shadow", "Fence", 5, perturbed), control]
+
+    vanilla = build_report(images(0.95, 0.70, 0.02), "ganet")
+    total = vanilla.rows[-1]
+    assert total.original.accuracy == 0.95 and total.original.images == 1  # the control is not an original
+    assert total.no_paint.accuracy == 0.02
+    assert "## Paint-free control" in markdown(vanilla) and "| 95.00 | 2.00 |" in markdown(vanilla)
+    detectors = [Detector("vanilla", vanilla), Detector("aam", build_report(images(0.94, 0.80, 0.01), "ganet"))]
+    assert "## Defences" not in compare_markdown(detectors, "ganet")
+    text = compare_markdown(detectors, "ganet", baseline="vanilla")
+    assert "| aam | 80.00 (+10.00) | 80.00 (+10.00) | 94.00 (-1.00) |" in text
+    assert "| vanilla | 95.00 | 2.00 |" in text and "| aam | 94.00 | 1.00 |" in text
+    paths = write_comparison(detectors, tmp_path, "ganet", "vanilla")
+    assert (tmp_path / "compare.png").read_bytes()[:4] == b"\x89PNG" and (tmp_path / "aam" / "report.md").is_file()
+    assert len(paths) == 3 + 2 * 4
