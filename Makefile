@@ -27,9 +27,10 @@ preview: $(STAMP)
 
 test: lint test-fast test-slow test-browser
 
-# ruff (pycodestyle, pyflakes, isort, bugbear, pyupgrade) over the code and its tests.
+# ruff (pycodestyle, pyflakes, isort, bugbear, pyupgrade) over the code and its tests; mypy over lanevil_core and app.
 lint: $(STAMP)
 	$(PY) -m ruff check lanevil_core app tests bench scripts
+	$(PY) -m mypy
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -n auto

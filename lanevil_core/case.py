@@ -17,7 +17,7 @@ from .illusions import IllusionSpec
 from .presets import preset_values
 from .typed import LineType, RoadType, SceneKind, Turn
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION: Literal[1] = 1
 
 # Real marking dimensions (m): paint width, dash length and gap (MUTCD-style 3 m / 9 m).
 PAINT_WIDTH_M = 0.15
@@ -51,10 +51,8 @@ class Marking(_Model):
 def default_markings(lanes_per_direction: int) -> list[Marking]:
     """Yellow double centre line, white dashed lane lines, white solid edges (left to right)."""
     n = lanes_per_direction
-    names: list[LineType] = (
-        ["white_solid"] + ["white_dashed"] * (n - 1) + ["yellow_double_solid"]
-        + ["white_dashed"] * (n - 1) + ["white_solid"]
-    )
+    dashed: list[LineType] = ["white_dashed"] * (n - 1)
+    names: list[LineType] = ["white_solid", *dashed, "yellow_double_solid", *dashed, "white_solid"]
     return [Marking(type=name) for name in names]
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from .scene import Environment
 from .typed import FloatArray
@@ -23,7 +24,7 @@ def sun_direction(azimuth_deg: float, altitude_deg: float) -> FloatArray:
     return np.array([np.cos(alt) * np.cos(az), np.cos(alt) * np.sin(az), np.sin(alt)])
 
 
-def _mix(a: FloatArray, b: FloatArray, k: float) -> np.ndarray:
+def _mix(a: npt.ArrayLike, b: npt.ArrayLike, k: float) -> np.ndarray:
     return (np.asarray(a) * (1.0 - k) + np.asarray(b) * k).astype(np.float32)
 
 

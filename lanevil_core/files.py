@@ -70,7 +70,7 @@ def process_alive(pid: int) -> bool:
 def stale_temp(path: Path) -> bool:
     """Whether ``path`` is a temporary file of ``write_atomic`` whose writing process is gone."""
     match = TEMP_NAME.match(path.name)
-    return bool(match) and not process_alive(int(match["pid"]))
+    return match is not None and not process_alive(int(match["pid"]))
 
 
 def remove_stale_temps(folder: Path, recursive: bool = False) -> list[Path]:

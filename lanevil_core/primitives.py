@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 import trimesh
 
 from .road_geometry import ReferenceLine
@@ -16,6 +17,7 @@ from .scene import Mesh
 from .typed import Float32Array, FloatArray, IntArray
 
 ColorLike = Sequence[float] | np.ndarray
+PointsLike = npt.ArrayLike  # (n, k) coordinates: nested sequences or an array
 
 
 def to_mesh(
@@ -102,7 +104,7 @@ def cylinder(
     center: ColorLike = (0.0, 0.0, 0.0),
     color: ColorLike = (0.2, 0.2, 0.2),
     *,
-    segment: ColorLike | None = None,
+    segment: PointsLike | None = None,
     sections: int = 10,
     **kw,
 ) -> Mesh:
@@ -117,7 +119,7 @@ def cylinder(
     return to_mesh(tm, color, **kw)
 
 
-def prism(profile: ColorLike, lo: float, hi: float, color: ColorLike = (0.2, 0.2, 0.2), *, axis: str = "y",
+def prism(profile: PointsLike, lo: float, hi: float, color: ColorLike = (0.2, 0.2, 0.2), *, axis: str = "y",
           **kw) -> Mesh:
     """A closed prism: the convex polygon ``profile`` (k, 2) extruded from ``lo`` to ``hi`` along ``axis``.
 
@@ -149,7 +151,7 @@ def _signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
-def quad(corners: ColorLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
+def quad(corners: PointsLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     """A one-sided panel (2 faces) over the (4, 3) ``corners``, counter-clockwise seen from its front."""
     corners = np.asarray(corners, np.float64)
     return to_mesh(trimesh.Trimesh(corners, [[0, 1, 2], [0, 2, 3]], process=False), color, **kw)
@@ -168,7 +170,7 @@ def beam(p0: ColorLike, p1: ColorLike, width: float, depth: float | None = None,
     return to_mesh(tm, color, **kw)
 
 
-def loft(rings: ColorLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
+def loft(rings: PointsLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     """A closed solid through ``rings`` (n, k, 3): n >= 2 convex rings of k corresponding points, joined by
     quads and closed by fans at both ends."""
     rings = np.asarray(rings, np.float64)
@@ -186,7 +188,7 @@ def loft(rings: ColorLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     return to_mesh(trimesh.Trimesh(vertices, faces, process=False), color, **kw)
 
 
-def swept(line: ReferenceLine, s_road: ColorLike, profile_th: ColorLike, color: ColorLike = (0.2, 0.2, 0.2),
+def swept(line: ReferenceLine, s_road: PointsLike, profile_th: PointsLike, color: ColorLike = (0.2, 0.2, 0.2),
           **kw) -> Mesh:
     """A closed solid following the road: the convex (k, 2) cross-section ``profile_th`` ((t, h) road-frame
     points, h above the road surface) swept through the increasing stations ``s_road`` (n,)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from .primitives import ColorLike, beam, box, cylinder, loft, merge, prism, quad, to_mesh, translation
+from .primitives import ColorLike, PointsLike, beam, box, cylinder, loft, merge, prism, quad, to_mesh, translation
 from .scene import Mesh
 from .typed import FloatArray
 
@@ -41,7 +41,7 @@ def _pick(rng: np.random.Generator, palette: tuple[tuple[float, float, float], .
     return np.asarray(palette[int(rng.integers(len(palette)))], np.float64)
 
 
-def _panel(corners: ColorLike, outward: ColorLike, color: ColorLike, **kw) -> Mesh:
+def _panel(corners: PointsLike, outward: ColorLike, color: ColorLike, **kw) -> Mesh:
     """A one-sided quad over (4, 3) ``corners`` (in order around it) facing ``outward`` (3,)."""
     corners = np.asarray(corners, np.float64)
     normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
@@ -63,7 +63,7 @@ def _slanted_panel(a_xz: ColorLike, b_xz: ColorLike, half_y: float, inset: float
     return _panel(corners, (n[0], 0.0, n[1]), color)
 
 
-def _side_panels(polygon_xz: ColorLike, half_y: float, color: ColorLike) -> list[Mesh]:
+def _side_panels(polygon_xz: PointsLike, half_y: float, color: ColorLike) -> list[Mesh]:
     """The same (4, 2) window outline on both sides (|y| = half_y + 2 cm), each facing outwards."""
     polygon_xz = np.asarray(polygon_xz, np.float64)
     panels = []

@@ -200,7 +200,7 @@ def report_csv(report: Report) -> str:
     """report.csv: one line per row with original/perturbed/gap accuracy and F1 (fractions)."""
     header = ["category", "type", "images_original", "images_perturbed", "accuracy_original",
               "accuracy_perturbed", "accuracy_gap", "f1_original", "f1_perturbed", "f1_gap", "f1_variant"]
-    rows: list[list[str | int]] = [header]
+    rows: list[list[str | int]] = [list(header)]
     for row in report.rows:
         rows.append([row.category, row.type, _images(row.original), _images(row.perturbed),
                      _number(getattr(row.original, "accuracy", None)),
@@ -214,7 +214,7 @@ def severity_csv(report: Report) -> str:
     """report_severity.csv: one line per row and level 0-5 (0 = originals) with accuracy, FP, FN, F1, gaps."""
     header = ["category", "type", "severity", "images", "accuracy", "fp", "fn", "f1", "accuracy_gap", "f1_gap",
               "f1_variant"]
-    rows: list[list[str | int]] = [header]
+    rows: list[list[str | int]] = [list(header)]
     for row in report.rows:
         for level in (0, *LEVELS):
             stats = row.original if level == 0 else row.levels[level]

@@ -122,8 +122,9 @@ class ReferenceLine:
         heading = self.heading[nearest]
         along = float(np.dot(xy - self.xy[nearest], [np.cos(heading), np.sin(heading)]))
         s_road = float(np.clip(self.s[nearest] + along, 0.0, self.length))
-        x, y = self._interp(self.xy[:, 0], s_road), self._interp(self.xy[:, 1], s_road)
-        heading = self._interp(self.heading, s_road)
+        s_at = np.asarray(s_road)
+        x, y = self._interp(self.xy[:, 0], s_at), self._interp(self.xy[:, 1], s_at)
+        heading = self._interp(self.heading, s_at)
         t_road = float(np.dot(xy - [x, y], [-np.sin(heading), np.cos(heading)]))
         return s_road, t_road
 

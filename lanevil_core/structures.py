@@ -125,7 +125,7 @@ def sweep(line: ReferenceLine, s_road: FloatArray, t_road: float, ground: float,
     p_world = line.to_world(np.repeat(s_road[:, None], k, axis=1), t, h).reshape(-1, 3)
     ring = np.arange(k)
     nxt = (ring + 1) % k
-    sides = []
+    sides: list[np.ndarray] = []
     for i in range(n - 1):
         a, b, c, d = i * k + ring, i * k + nxt, (i + 1) * k + nxt, (i + 1) * k + ring
         sides.append(np.stack([a, b, c], 1))
@@ -400,7 +400,7 @@ def wire(points_world: FloatArray, radius: float, sides: int = 4) -> tuple[Float
     vertices = (points_world[:, None, :] + ring).reshape(-1, 3)
     n, k = len(points_world), sides
     j = np.arange(k)
-    tris = []
+    tris: list[np.ndarray] = []
     for i in range(n - 1):
         a, b, c, d = i * k + j, i * k + (j + 1) % k, (i + 1) * k + (j + 1) % k, (i + 1) * k + j
         tris += [np.stack([a, b, c], 1), np.stack([a, c, d], 1)]
@@ -440,7 +440,7 @@ def power_lines(line: ReferenceLine, s0: float, s1: float, t_poles: Sequence[flo
     if wire_radius < 0.02:
         raise ValueError("wire_radius must be at least 0.02 m")
     h_wires = np.broadcast_to(np.asarray(heights, np.float64), (n_wires,)) + ground
-    offsets = (np.arange(n_wires) - (n_wires - 1) / 2) * wire_spacing
+    offsets: FloatArray = ((np.arange(n_wires) - (n_wires - 1) / 2) * wire_spacing).astype(np.float64)
     s_poles = _stations(s0, s1, pole_spacing)
     parts: list[Mesh] = []
     for t_row in t_poles:
@@ -483,6 +483,8 @@ def _poles(line: ReferenceLine, s_poles: FloatArray, t_row: float, ground: float
     """Wooden poles reaching above the highest wire (``column``), with a cross-arm holding the wires at offsets
     ``across`` the road (in t) or ``along`` it (in s); ``h_wires`` are heights above the road surface."""
     offsets = across if across is not None else along
+    if offsets is None:
+        raise ValueError("_poles needs the wire offsets across or along the road")
     reach = float(np.ptp(offsets)) + 0.6
     extents = (0.1, reach, 0.12) if across is not None else (reach, 0.1, 0.12)
     t_arm = t_row + float(offsets.mean()) if across is not None else t_row
@@ -492,7 +494,8 @@ def _poles(line: ReferenceLine, s_poles: FloatArray, t_row: float, ground: float
         return arms
     poses = road_poses(line, s_poles, t_row, ground - FOOTING_M)
     top = float(h_wires.max()) + 0.6 - ground
-    cylinder = trimesh.creation.cylinder(radius=0.13, segment=[[0, 0, 0], [0, 0, top + FOOTING_M]], sections=8)
+    segment = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, top + FOOTING_M]])
+    cylinder = trimesh.creation.cylinder(radius=0.13, segment=segment, sections=8)
     v_pole, f_pole = _instances(cylinder, poses)
     return merge([Mesh(v_pole, f_pole, np.asarray(POLE_WOOD, np.float32)), arms], name=name, kind="pole")
 

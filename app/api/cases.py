@@ -31,8 +31,9 @@ router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, respon
 
 LISTING_CATEGORIES = ("clean", *CATEGORIES)
 ENVELOPE_KEYS = frozenset({"id", "version", "case", "created_at", "updated_at", "origin"})
-CONFLICT = {409: {"model": ErrorBody, "description": "stale version (the message says the current one)"}}
-NOT_FOUND = {404: {"model": ErrorBody, "description": "no case with that id"}}
+CONFLICT: dict[int | str, dict[str, Any]] = {
+    409: {"model": ErrorBody, "description": "stale version (the message says the current one)"}}
+NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no case with that id"}}
 
 CaseBody = Annotated[dict[str, Any], Body(description="a case document, or an envelope {id?, version?, case}",
                                           openapi_examples={"case": {"value": {"title": "my case"}}})]

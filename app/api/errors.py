@@ -9,7 +9,7 @@ exceptions raised while a request is handled, so malformed input never becomes a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Coroutine, Sequence
+from collections.abc import Callable, Coroutine, Mapping, Sequence
 from typing import Any
 
 from fastapi import HTTPException, Request, Response, params
@@ -48,7 +48,7 @@ class ApiError(HTTPException):
 
 
 def error_response(status_code: int, detail: str, field: str | None = None,
-                   headers: dict[str, str] | None = None) -> JSONResponse:
+                   headers: Mapping[str, str] | None = None) -> JSONResponse:
     return JSONResponse(ErrorBody(detail=detail, field=field).model_dump(), status_code=status_code, headers=headers)
 
 

@@ -42,6 +42,7 @@ SELECT_RADIUS_M = 8.0  # a click this close to an illusion's handle selects it
 SUN_FIELDS = ("azimuth", "altitude", "intensity")
 # The 3D view's start pose: behind, beside and above the ego's start, looking down the road.
 CAMERA_BACK_M, CAMERA_SIDE_M, CAMERA_UP_M, CAMERA_AHEAD_M = 18.0, 6.0, 14.0, 35.0
+SELECT_FIRST = "select an illusion first (Illusions → Selected)"
 
 
 class EditError(Exception):
@@ -248,10 +249,12 @@ class Editor:
     def _illusion(self, index: int | None) -> Illusion:
         illusions = self.case.illusions
         if index is None or not 0 <= index < len(illusions):
-            raise EditError("select an illusion first (Illusions → Selected)")
+            raise EditError(SELECT_FIRST)
         return illusions[index]
 
-    def _edit_illusion(self, index: int, changes: dict[str, Any], label: str) -> None:
+    def _edit_illusion(self, index: int | None, changes: dict[str, Any], label: str) -> None:
+        if index is None:
+            raise EditError(SELECT_FIRST)
         data = self._data()
         data["illusions"][index] = {**data["illusions"][index], **changes}
         self._edit(data, label)
@@ -561,7 +564,7 @@ class Editor:
                 else:
                     note.title, note.body, note.loading = title, body, loading
                     if color is not None:
-                        note.color = color
+                        note.color = color  # type: ignore[assignment]  # one of viser's colour names
 
         frames = frames if frames is not None else range(self.case.ego.frames)
         job = export.start_sequence_export(self.state, session.case_id, self.case, fallback, frames,

@@ -7,6 +7,7 @@ severity table") a text box where empty means "use the table"; choices a dropdow
 
 from __future__ import annotations
 
+import functools
 import json
 import types
 from collections.abc import Callable
@@ -95,6 +96,7 @@ class ParamInputs:
         inner, optional = _unwrap_optional(info.annotation)
         hint = info.description or name
         label = name.replace("_", " ")
+        handle: Any  # a dropdown, checkbox, number or text input
         if get_origin(inner) is Literal:
             options = [str(option) for option in get_args(inner)]
             if optional:
@@ -121,7 +123,7 @@ class ParamInputs:
         else:
             hint = f"{hint} (empty = default)" if optional else hint
             handle = self.gui.add_text(label, format_text(value), hint=hint)
-            self._readers[name] = lambda raw, inner=inner: parse_text(raw, inner)
+            self._readers[name] = functools.partial(parse_text, inner=inner)
             self._writers[name] = format_text
         self.handles[name] = handle
 

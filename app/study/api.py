@@ -157,11 +157,14 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
                                                f"application/json (the spec alone), not {content_type or 'nothing'}"
                              ) from None
     form = await request.form(max_files=MAX_UPLOAD_FILES)
-    raw_spec = form.get("spec")
-    if isinstance(raw_spec, UploadFile):  # a JSON part, as /docs and generated clients send it
-        raw_spec = await raw_spec.read(state.settings.max_body_bytes + 1)
+    part = form.get("spec")
+    raw_spec: str | bytes | None
+    if isinstance(part, UploadFile):  # a JSON part, as /docs and generated clients send it
+        raw_spec = await part.read(state.settings.max_body_bytes + 1)
         if len(raw_spec) > state.settings.max_body_bytes:
             raise http_error(413, "spec", f"the spec is over {state.settings.max_body_bytes} bytes")
+    else:
+        raw_spec = part
     if not isinstance(raw_spec, str | bytes):
         raise http_error(422, "spec", "the form needs a field 'spec' holding the study spec as JSON")
     spec = _parse_spec(raw_spec)

@@ -14,9 +14,14 @@ import numpy as np
 
 
 class Ordered(Protocol):
-    id: int
-    role: str
-    position: int
+    @property
+    def id(self) -> int: ...
+
+    @property
+    def role(self) -> str: ...
+
+    @property
+    def position(self) -> int: ...
 
 
 def participant_seed(study_id: str, participant_id: str) -> int:

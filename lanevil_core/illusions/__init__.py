@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Union
+from typing import TYPE_CHECKING, Annotated, Union
 
 from pydantic import Field
 
@@ -12,12 +12,15 @@ from .base import CATEGORIES, REGISTRY, Category, CompileContext, Illusion, regi
 
 ILLUSION_TYPES: tuple[str, ...] = tuple(REGISTRY)
 
-# The ``illusions`` list of a case: a discriminated union on ``type``.
-if len(REGISTRY) >= 2:
+# The ``illusions`` list of a case: a discriminated union on ``type``. A type checker sees the base class, whose
+# interface every member of the union has.
+if TYPE_CHECKING:
+    IllusionSpec = Illusion
+elif len(REGISTRY) >= 2:
     # Union[...] over the registry's tuple of classes: X | Y has no spelling for a tuple built at run time.
-    IllusionSpec = Annotated[Union[tuple(REGISTRY.values())], Field(discriminator="type")]  # type: ignore[valid-type]  # noqa: UP007
+    IllusionSpec = Annotated[Union[tuple(REGISTRY.values())], Field(discriminator="type")]  # noqa: UP007
 else:  # while the registry is being filled
-    IllusionSpec = Illusion  # type: ignore[misc]
+    IllusionSpec = Illusion
 
 __all__ = [
     "CATEGORIES",

@@ -415,7 +415,8 @@ class GuardRail(Illusion):
             median = abs(t_rail) < main.half_width
             for a, b in _open_spans(s0, s1, [(g0, g1) for g0, g1, side in main.gaps if median or side * t_rail > 0]):
                 ctx.add_mesh(guard_rail(main.line, a, b, t_rail, ground_height(main, t_rail), self.post_spacing,
-                                        tuple(float(c) for c in color), name=f"guard rail {index + 1}"))
+                                        (float(color[0]), float(color[1]), float(color[2])),
+                                        name=f"guard rail {index + 1}"))
         shadow_m = _setting(self, "shadow_m")
         if shadow_m > 0:
             # The sun stands on the side of the main rail and throws its shadow over the lanes beside it; the same

@@ -19,7 +19,16 @@ from pydantic import Field
 
 from ..environment import sun_direction
 from ..primitives import pose_on_road, transformed
-from ..structures import clear_runs, fence, ground_height, outside_gaps, overhead_rail, power_lines, streetlight
+from ..structures import (
+    SlotDirection,
+    clear_runs,
+    fence,
+    ground_height,
+    outside_gaps,
+    overhead_rail,
+    power_lines,
+    streetlight,
+)
 from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
@@ -264,7 +273,7 @@ class RailShadowLevel(SunAheadLevel):
     """What one severity level of ``RailShadow`` sets."""
 
     deck_length: float
-    slots_along: str
+    slots_along: SlotDirection
     slot_width: float
     slot_pitch: float
     deck_depth: float

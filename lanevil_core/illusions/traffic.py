@@ -16,7 +16,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, cast
 
 import numpy as np
 import trimesh
@@ -183,8 +183,9 @@ class TrafficIllusion(Illusion):
         full = self.SEVERITY[-1]
         if not isinstance(full, CrowdLevel):
             raise TypeError(f"{type(self).__name__}'s table has no crowd (group, on_lines)")
-        group = self.group or int(full.group)
-        share = float(full.on_lines if self.on_lines is None else self.on_lines)
+        # group and on_lines are fields of the crowd types (Pedestrian, Bicycle) that call this
+        group = self.group or int(full.group)  # type: ignore[attr-defined]
+        share = float(full.on_lines if self.on_lines is None else self.on_lines)  # type: ignore[attr-defined]
         count = self.participants()
         slots = self.crowd_slots(ctx, rng, group, share, yaw_of, max(count, int(full.count)))
         # Take the groups' members in turn (the first of every group, then the second ...), so a thin crowd
@@ -477,7 +478,7 @@ def srgb_to_linear(rgb8: FloatArray) -> FloatArray:
 def _face_colors(geometry: trimesh.Trimesh) -> FloatArray:
     """(m, 3) linear albedo per face from a loaded mesh's visual: face or vertex colours, the texture
     sampled at the vertices, the material's base colour, else grey."""
-    visual = geometry.visual
+    visual: Any = geometry.visual  # one of several visual kinds, told apart by .kind
     faces = geometry.faces
     try:
         if visual.kind == "face":
@@ -507,7 +508,7 @@ def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: i
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"obstacle model not found: {path}")
-    scene = trimesh.load(str(path), force="scene")
+    scene = cast(trimesh.Scene, trimesh.load(str(path), force="scene"))
     parts = [g for g in scene.dump(concatenate=False) if isinstance(g, trimesh.Trimesh) and len(g.faces)]
     if not parts:
         raise ValueError(f"{path}: no triangles in the model")

@@ -55,5 +55,5 @@ _drop_stale_cache()
 
 def kernel(fn: Callable[..., Any] | None = None, *, inline: str = "never") -> Any:
     """``numba.njit`` with on-disk caching and the renderer's fast-math flags."""
-    decorator = nb.njit(cache=True, fastmath=FASTMATH, inline=inline)
+    decorator = nb.njit(cache=True, fastmath=FASTMATH, inline=inline)  # type: ignore[call-overload]  # a set is a valid fastmath
     return decorator if fn is None else decorator(fn)

@@ -34,7 +34,7 @@ def _rounded_box_distance(ds: FloatArray, dt: FloatArray, half: tuple[float, flo
     return outside + np.minimum(np.maximum(qs, qt), 0.0) - radius
 
 
-def _blob_distance(rng: np.random.Generator, ds: FloatArray, dt: FloatArray, radii: tuple[float, float]) -> FloatArray:
+def _blob_distance(rng: np.random.Generator, ds: np.ndarray, dt: np.ndarray, radii: tuple[float, float]) -> FloatArray:
     """Approximate signed distance (m) to an irregular blob (an ellipse whose radius wobbles with angle)."""
     rho = np.hypot(ds / radii[0], dt / radii[1])
     angle = np.arctan2(ds / radii[0], dt / radii[1])
@@ -59,9 +59,11 @@ def _patch_coverage(rng: np.random.Generator, shape: tuple[int, int], texel: flo
     """
     length_s, width_t = shape[0] * texel, shape[1] * texel
     if kind == "trench":
+        assert t_local is not None
         half = (0.5 * length_s * rng.uniform(0.35, 0.7), rng.uniform(0.3, 0.5) * size_scale)
         center = (half[0] + 0.1 * spot * (length_s - 2 * half[0]), float(t_local))
     elif kind == "across":
+        assert t_local is not None
         half = (rng.uniform(0.6, 2.0) * size_scale, rng.uniform(0.5, 1.2) * size_scale)
         center = (0.5 * spot * length_s, float(t_local) + rng.uniform(-0.3, 0.3))
     else:
@@ -135,11 +137,11 @@ def patches(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, r
     size_m = (shape[0] * texel, shape[1] * texel)
     canvas = _Canvas.empty(shape)
     fill_alpha = 0.35 + 0.6 * contrast
-    shapes: list[tuple[int, int, PatchKind, float | None]] = (
-        [(bases[0], k, "rectangle", None) for k in range(rectangles)]
-        + [(bases[1], k, "blob", None) for k in range(blobs)]
-        + [(bases[4], k, "trench", float(t)) for k, t in enumerate(trench_t)]
-        + [(bases[5], k, "across", float(t)) for k, t in enumerate(across_t)])
+    shapes: list[tuple[int, int, PatchKind, float | None]] = []
+    shapes += [(bases[0], k, "rectangle", None) for k in range(rectangles)]
+    shapes += [(bases[1], k, "blob", None) for k in range(blobs)]
+    shapes += [(bases[4], k, "trench", float(t)) for k, t in enumerate(trench_t)]
+    shapes += [(bases[5], k, "across", float(t)) for k, t in enumerate(across_t)]
     for base, k, kind, t_local in shapes:
         child = _child(base, k)
         fill, rim, window = _patch_coverage(child, shape, texel, size_scale, kind, _spot(base, k), t_local)

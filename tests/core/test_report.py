@@ -123,7 +123,8 @@ def test_end_to_end_detect_eval_report(tiny_split, tmp_path, capsys):
 
 
 def test_paint_free_control_and_several_detectors(tmp_path):
-    from lanevil_core.report_compare import Detector, markdown as compare_markdown, write_comparison
+    from lanevil_core.report_compare import Detector, write_comparison
+    from lanevil_core.report_compare import markdown as compare_markdown
 
     def images(clean: float, perturbed: float, no_paint: float) -> list[ScoredImage]:
         control = scored("Shadow", "Fence", 0, no_paint)
