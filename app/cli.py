@@ -33,8 +33,11 @@ def _serve_arguments(parser: argparse.ArgumentParser) -> None:
 def _run_serve(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
-    from .server import ListenError, serve
-    from .settings import Settings
+    try:
+        from .server import ListenError, serve
+        from .settings import Settings
+    except ImportError as error:  # the library installed without the web extra
+        raise UsageError(f"serve needs the web extra ({error.name} is missing): pip install 'lanevil[web]'") from None
 
     given = {"host": args.host, "port": args.port, "editor_port": args.editor_port, "data_dir": args.data,
              "scenes_dir": args.scenes}

@@ -12,7 +12,8 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-WEB_AND_DASK = ("fastapi", "starlette", "uvicorn", "viser", "dask", "distributed")
+WEB_AND_DASK = ("fastapi", "starlette", "uvicorn", "viser", "pydantic_settings", "fastapi_offline", "multipart", "dask",
+                "distributed")
 LAZY = ("matplotlib", "torch")  # imported inside the functions that need them, never at module level
 NEEDS_TORCH = "lanevil_core.learn"  # the training package needs torch by design
 
@@ -46,3 +47,14 @@ def test_every_module_imports_without_web_or_dask() -> None:
 def test_plots_and_torch_load_only_when_used() -> None:
     result = _import_all(skip=NEEDS_TORCH)
     assert [name for name in WEB_AND_DASK + LAZY if name in result["loaded"]] == []
+
+
+def test_serve_without_the_web_extra_says_what_to_install() -> None:
+    code = ("import sys\n"
+            "for name in ('fastapi', 'uvicorn', 'viser', 'pydantic_settings'):\n"
+            "    sys.modules[name] = None  # as if not installed\n"
+            "from app.cli import main\n"
+            "sys.exit(main(['serve', '--no-editor']))\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert result.returncode == 2, result.stderr
+    assert "needs the web extra" in result.stderr and "pip install 'lanevil[web]'" in result.stderr
