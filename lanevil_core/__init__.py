@@ -1,6 +1,6 @@
 """lanevil_core: editable 3D lane-detection robustness cases, a CPU renderer and exact lane ground truth."""
 
-from .camera import Intrinsics, PinholeCamera, VehiclePose, ego_camera, pose_camera
+from .camera import EgoPath, Intrinsics, PinholeCamera, VehiclePose, ego_camera, pose_camera
 from .case import (
     Camera,
     Case,
@@ -18,10 +18,12 @@ from .case import (
     save_case,
 )
 from .compile import compile_scene
+from .encode import jpeg_bytes, png_bytes
 from .export import export_case
 from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
 from .labels import culane_lines, tusimple_record
 from .overlay import draw_lanes
+from .paint import RoadPaint
 from .render import Frame, render_frame, render_view
 from .road_layout import RoadNetwork, build_network
 from .scene import CompiledScene
@@ -35,12 +37,14 @@ __all__ = [
     "CaseError",
     "CompiledScene",
     "Ego",
+    "EgoPath",
     "Frame",
     "Illusion",
     "Intrinsics",
     "Marking",
     "PinholeCamera",
     "Road",
+    "RoadPaint",
     "RoadNetwork",
     "Scene",
     "Sun",
@@ -54,8 +58,10 @@ __all__ = [
     "draw_lanes",
     "ego_camera",
     "export_case",
+    "jpeg_bytes",
     "load_case",
     "parse_case",
+    "png_bytes",
     "pose_camera",
     "render_frame",
     "render_view",
