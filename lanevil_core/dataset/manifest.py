@@ -41,7 +41,7 @@ def _module_file(package_dir: Path, dotted: str) -> Path | None:
 def _relative_imports(path: Path, package_dir: Path) -> set[Path]:
     """Files of the package imported by ``path`` through relative imports (``from .x import y``)."""
     here = path.parent.relative_to(package_dir).parts  # modules and packages both resolve against their folder
-    found = set()
+    found: set[Path] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if not isinstance(node, ast.ImportFrom) or node.level == 0:
             continue

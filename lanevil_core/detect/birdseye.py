@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 
 from ..labels import MAX_LANES, RANGE_M
-from ..typed import BoolArray, FloatArray, IntArray, UInt8Array
+from ..typed import BoolArray, FloatArray, IndexArray, UInt8Array
 from .common import GroundCamera, lane_columns, sample_rows, useful_lanes
 
 
@@ -93,7 +93,7 @@ def base_columns(mask: BoolArray, params: BirdseyeParams, rows_near: slice) -> l
     return peaks
 
 
-def follow_line(pixels: tuple[IntArray, IntArray], size: tuple[int, int], start_col: int, params: BirdseyeParams
+def follow_line(pixels: tuple[IndexArray, ...], size: tuple[int, int], start_col: int, params: BirdseyeParams
                 ) -> tuple[FloatArray, FloatArray]:
     """Sliding windows from the near edge outwards over the paint ``pixels`` (rows, cols) of a top view of
     ``size`` (width, height); returns the (cols, rows) of the pixels along the line."""
@@ -132,7 +132,8 @@ def detect_birdseye(rgb: UInt8Array, h_samples: list[int], camera: GroundCamera 
     height, width = rgb.shape[:2]
     camera = camera or GroundCamera.default((width, height))
     H_image_topview, size = topview_H(camera, params)
-    topview = cv2.warpPerspective(rgb, H_image_topview, size, flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+    topview = np.asarray(cv2.warpPerspective(rgb, H_image_topview, size, flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP),
+                         np.uint8)
     mask = paint_mask(topview, params)
     near_rows = int(round((params.base_range_m - z_near_m(camera)) / params.m_per_px_z))
     starts = base_columns(mask, params, slice(size[1] - max(near_rows, 1), size[1]))
@@ -145,7 +146,8 @@ def detect_birdseye(rgb: UInt8Array, h_samples: list[int], camera: GroundCamera 
         cols, rows = follow_line(pixels, size, start, params)
         if len(cols) < params.min_lane_pixels:
             continue
-        x_rows = np.polyval(fit_ground_lane(cols, rows, params), np.where(usable_rows, z_rows, 0.0))
+        x_rows = np.asarray(np.polyval(fit_ground_lane(cols, rows, params), np.where(usable_rows, z_rows, 0.0)),
+                            np.float64)
         uv_image = camera.project_ground(x_rows, np.where(usable_rows, z_rows, 1.0))
         lanes.append(lane_columns(np.where(usable_rows, uv_image[:, 0], np.nan), width))
     return useful_lanes(lanes)

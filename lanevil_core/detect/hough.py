@@ -44,10 +44,10 @@ def paint_edges(rgb: UInt8Array, horizon_row: float, params: HoughParams, scale:
     """(H, W) uint8 Canny edges of bright thin structures (white top-hat) below the horizon."""
     gray = (0.5 * (rgb[..., 0].astype(np.float32) + rgb[..., 1])).astype(np.uint8)
     blur = max(3, int(round(params.blur * min(scale, 2.0))) | 1)
-    gray = cv2.GaussianBlur(gray, (blur, blur), 0)
+    gray = np.asarray(cv2.GaussianBlur(gray, (blur, blur), 0), np.uint8)
     kernel = np.ones((1, max(3, int(round(params.tophat_px * scale)) | 1)), np.uint8)
     tophat = cv2.morphologyEx(gray, cv2.MORPH_TOPHAT, kernel)
-    edges = cv2.Canny(gray, params.canny_low, params.canny_high)
+    edges = np.asarray(cv2.Canny(gray, params.canny_low, params.canny_high), np.uint8)
     near_paint = cv2.dilate((tophat > params.min_tophat).astype(np.uint8), np.ones((3, 3), np.uint8))
     edges[near_paint == 0] = 0
     top = int(math.ceil(horizon_row + params.horizon_margin * rgb.shape[0]))
@@ -99,8 +99,8 @@ def detect_hough(rgb: UInt8Array, h_samples: list[int], camera: GroundCamera | N
     camera = camera or GroundCamera.default((width, height))
     # Larger frames are processed at WORK_WIDTH: continuous coordinates scale by `shrink` (corner origin).
     shrink = min(1.0, WORK_WIDTH / width)
-    work = rgb if shrink == 1.0 else cv2.resize(rgb, (round(width * shrink), round(height * shrink)),
-                                                 interpolation=cv2.INTER_AREA)
+    small = (round(width * shrink), round(height * shrink))
+    work = rgb if shrink == 1.0 else np.asarray(cv2.resize(rgb, small, interpolation=cv2.INTER_AREA), np.uint8)
     scale = work.shape[1] / 640.0
     horizon_work = camera.horizon_row * shrink
     seg = lane_segments(paint_edges(work, horizon_work, params, scale), horizon_work, params, scale)

@@ -23,7 +23,7 @@ import cv2
 import numpy as np
 
 from ..labels import NO_POINT, TUSIMPLE_H_SAMPLES, TUSIMPLE_SIZE
-from ..typed import FloatArray, IntArray
+from ..typed import FloatArray, Int64Array
 
 BOTTOM_FIT_POINTS = 8  # lowest points of a lane fitted to find where it meets the image bottom
 MIN_LANE_POINTS = 2
@@ -112,7 +112,7 @@ def anchor_rows(count: int) -> FloatArray:
     return np.linspace(first, last, count) / TUSIMPLE_SIZE[1]
 
 
-def encode_row_anchors(placed: list[LaneLine | None], anchors: FloatArray, grid: int) -> IntArray:
+def encode_row_anchors(placed: list[LaneLine | None], anchors: FloatArray, grid: int) -> Int64Array:
     """(slots, anchors) int64 class targets: the column cell ``floor(x_norm * grid)``, ``grid`` where no lane."""
     target = np.full((len(placed), len(anchors)), grid, np.int64)
     for slot, line in enumerate(placed):
@@ -148,7 +148,7 @@ def decode_row_anchors(probs: FloatArray, anchors: FloatArray, min_points: int =
 # ---------------------------------------------------------------------------------------------- lane masks
 
 
-def encode_lane_mask(placed: list[LaneLine | None], size: tuple[int, int], thickness: int = 2) -> IntArray:
+def encode_lane_mask(placed: list[LaneLine | None], size: tuple[int, int], thickness: int = 2) -> Int64Array:
     """(height, width) int64 mask: ``slot + 1`` on each slot's lane drawn ``thickness`` map pixels wide, else 0."""
     width, height = size
     mask = np.zeros((height, width), np.uint8)
@@ -232,7 +232,8 @@ def tusimple_lanes(lines: Sequence[LaneLine | None], h_samples: Sequence[float],
 
 
 def anchor_reach(anchors: FloatArray) -> float:
-    """A bit more than half the spacing of the anchor rows (normalised), how far a row-anchor lane may extend past its ends."""
+    """A bit more than half the spacing of the anchor rows (normalised): how far a row-anchor lane may extend past
+    its ends."""
     return 0.6 * float(np.diff(anchors).mean()) if len(anchors) > 1 else 0.0
 
 

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import functools
 import threading
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from ..typed import FloatArray, UInt8Array
+from ..typed import Float32Array, FloatArray, UInt8Array
 from .lane_slots import LaneLine, anchor_reach, decode_lane_masks, decode_row_anchors, tusimple_lanes
 from .model_spec import FAMILIES, ONNX_FILE, ModelSpec, ModelSpecError
 
@@ -32,12 +33,13 @@ def shipped_model_dir(family: str) -> Path:
     return SHIPPED_MODELS / family
 
 
-def network_input(rgb: UInt8Array, input_size: tuple[int, int]) -> FloatArray:
+def network_input(rgb: UInt8Array, input_size: tuple[int, int]) -> Float32Array:
     """(3, H, W) float32 in 0..1: the frame resized (area filter) to the network's input (width, height)."""
     width, height = input_size
     if rgb.shape[1] != width or rgb.shape[0] != height:
-        rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
-    return np.ascontiguousarray(rgb.transpose(2, 0, 1), dtype=np.float32) * np.float32(1.0 / 255.0)
+        rgb = np.asarray(cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA), np.uint8)
+    chw = np.ascontiguousarray(rgb.transpose(2, 0, 1), dtype=np.float32)
+    return np.multiply(chw, np.float32(1.0 / 255.0), dtype=np.float32)
 
 
 def providers() -> list[str]:
@@ -56,7 +58,7 @@ def decode_outputs(spec: ModelSpec, outputs: dict[str, FloatArray], index: int =
     return decode_lane_masks(outputs["mask_probs"][index], outputs["exist_probs"][index], rows)
 
 
-def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: list[int],
+def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: Sequence[float],
              size: tuple[int, int]) -> list[list[int]]:
     """TuSimple lanes at ``h_samples`` of an image of ``size`` from decoded lane slots."""
     reach = anchor_reach(spec.anchor_rows)

@@ -49,7 +49,7 @@ def hsv(image: UInt8Array, rng: np.random.Generator, other: UInt8Array) -> UInt8
     hsv_image[..., 0] = (hsv_image[..., 0] + rng.uniform(-10, 10)) % 180.0  # OpenCV hue is 0..180
     hsv_image[..., 1] *= rng.uniform(0.6, 1.4)
     hsv_image[..., 2] *= rng.uniform(0.6, 1.4)
-    return cv2.cvtColor(np.clip(hsv_image, 0, 255).astype(np.uint8), cv2.COLOR_HSV2RGB)
+    return np.asarray(cv2.cvtColor(np.clip(hsv_image, 0, 255).astype(np.uint8), cv2.COLOR_HSV2RGB), np.uint8)
 
 
 def copy_paste(image: UInt8Array, rng: np.random.Generator, other: UInt8Array) -> UInt8Array:

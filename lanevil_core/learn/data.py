@@ -58,7 +58,7 @@ def resized(rgb: UInt8Array, input_size: tuple[int, int]) -> UInt8Array:
     width, height = input_size
     if rgb.shape[:2] == (height, width):
         return rgb
-    return cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
+    return np.asarray(cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA), np.uint8)
 
 
 class _Frames(Dataset):

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import torch
 
-from .models import Deployed
+from .models import Deployed, LaneNet
 
 OPSET = 17
 
 
-def export_onnx(model: torch.nn.Module, path: str | Path) -> Path:
+def export_onnx(model: LaneNet, path: str | Path) -> Path:
     """Write ``model`` (an ``UFLDNet`` or ``SegNet``) as ONNX with input ``image`` (N, 3, H, W) float32 0..1."""
     import onnx
 

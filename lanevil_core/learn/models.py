@@ -26,6 +26,9 @@ STD = (0.229, 0.224, 0.225)
 
 
 class Normalize(nn.Module):
+    mean: torch.Tensor
+    std: torch.Tensor
+
     def __init__(self) -> None:
         super().__init__()
         self.register_buffer("mean", torch.tensor(MEAN).view(1, 3, 1, 1))
@@ -112,7 +115,10 @@ class SegNet(nn.Module):
         return {"mask_logits": self.head(c2, c3, c4), "exist_logits": self.exist(pooled)}
 
 
-def build_model(spec: ModelSpec) -> nn.Module:
+LaneNet = UFLDNet | SegNet  # the lane-detector networks (each carries its ``spec``)
+
+
+def build_model(spec: ModelSpec) -> LaneNet:
     """The network of a spec, freshly initialised."""
     return UFLDNet(spec) if spec.family == "ufld" else SegNet(spec)
 
@@ -120,7 +126,7 @@ def build_model(spec: ModelSpec) -> nn.Module:
 class Deployed(nn.Module):
     """A trained network in eval mode returning probabilities under the names ``detect.learned`` reads."""
 
-    def __init__(self, model: nn.Module) -> None:
+    def __init__(self, model: LaneNet) -> None:
         super().__init__()
         self.model = model.eval()
         self.family = model.spec.family

@@ -33,7 +33,7 @@ from .backbone import load_init
 from .data import LabelledFrames, file_sha256, read_records, split_indices
 from .export import export_onnx
 from .losses import detector_loss
-from .models import Deployed, build_model
+from .models import Deployed, LaneNet, build_model
 
 CHECKPOINT_FILE = "checkpoint.pt"
 AAM_BANK_FILE = "aam_bank.pt"
@@ -72,7 +72,7 @@ def pick_device(name: str) -> torch.device:
     return torch.device(name)
 
 
-def predict_on(model: torch.nn.Module, images: np.ndarray, records: list[dict[str, Any]],
+def predict_on(model: LaneNet, images: np.ndarray, records: list[dict[str, Any]],
                frame_sizes: list[tuple[int, int]], device: torch.device,
                batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
     """(predicted lanes, GT lanes, rows) for ``images`` ((N, H, W, 3) uint8 at the input size) with their TuSimple
@@ -94,7 +94,7 @@ def predict_on(model: torch.nn.Module, images: np.ndarray, records: list[dict[st
     return results
 
 
-def predict_lanes(model: torch.nn.Module, dataset: LabelledFrames, device: torch.device,
+def predict_lanes(model: LaneNet, dataset: LabelledFrames, device: torch.device,
                   batch: int = 32) -> list[tuple[list[list[int]], list[list[int]], list[float]]]:
     """(predicted lanes, GT lanes, rows) of every frame of ``dataset``, both on the 1280x720 grid."""
     return predict_on(model, dataset.images, dataset.records, dataset.frame_sizes, device, batch)
@@ -142,7 +142,7 @@ def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, A
     return patches
 
 
-def aam_batch(model: torch.nn.Module, images: torch.Tensor, hard: list, settings: TrainSettings, epoch: int,
+def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainSettings, epoch: int,
               step: int) -> torch.Tensor:
     """The batch with AAM applied to a share of its images (chosen by seed, epoch and step)."""
     rng = np.random.default_rng([settings.seed, epoch, step, 7])

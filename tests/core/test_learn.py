@@ -196,7 +196,7 @@ def test_aam_bank_never_holds_a_test_case():
     bank = [bank_case(clean, 0, index) for index in range(28)]
     hashes = {hashlib.sha256(case_json(case).encode()).hexdigest() for case in bank}
     assert len(hashes) == 28 and not hashes & stock
-    assert {case.illusions[0].type for case in bank} == {path.parent.name for path in SCENES.glob("[1-4]*/*/")}
+    assert {case.illusions[0].type for case in bank} == {path.name for path in SCENES.glob("[1-4]*/*/")}
 
 
 def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):

