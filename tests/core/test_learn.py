@@ -211,3 +211,17 @@ def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):
     bank = torch.load(tmp_path / AAM_BANK_FILE, weights_only=False)["patches"]
     assert bank and all(0.0 <= p.mask.min() and p.mask.max() <= 1.0 for p in bank)
     assert all(p.mask.mean() > 0 for p in bank)
+
+
+def test_rendered_frames_give_the_same_samples_as_files(tmp_path):
+    from lanevil_core.learn.data import RenderedFrames
+
+    spec = ModelSpec(family="ufld", **TINY_SPEC)
+    case = SCENES / "00_clean" / "00_straight_urban.json"
+    frames = RenderedFrames([(case, 0), (case, 10)], spec, render_size=(256, 144), train=False)
+    assert len(frames) == 2 and frames.frame_sizes == [(256, 144)] * 2
+    sample = frames[1]
+    assert sample["image"].shape == (3, 72, 128) and sample["rows"].shape == (spec.slots, spec.anchors)
+    lanes = frames.records[1]["lanes"]
+    assert int(sample["exist"].sum()) == sum(sum(x >= 0 for x in lane) >= 2 for lane in lanes)
+    assert (sample["rows"] < spec.grid).any()  # lanes were encoded
