@@ -34,7 +34,7 @@ EXPECTED_TEST = {  # case folder -> (category, type, severity, source file)
     "Shadow/Fence/01_level1": ("Shadow", "Fence", 1, CASE_FILES[1]),
     "RoadDamage/RoadCrack/03_level3": ("RoadDamage", "RoadCrack", 3, CASE_FILES[2]),
 }
-ARGS = ["--size", SIZE, "--frames-per-case", "2", "--train-frames", "3", "--quiet"]
+ARGS = ["--size", SIZE, "--frames-per-case", "2", "--sampling", "even", "--train-frames", "3", "--quiet"]
 
 
 def copy_cases(root: Path, files: tuple[str, ...] = CASE_FILES) -> Path:
@@ -92,6 +92,10 @@ def test_test_split_layout_and_labels(dataset: Path) -> None:
             assert (record["category"], record["type"], record["severity"], record["case"]) == (
                 category, type_folder, severity, folder)
             assert {"visibility", "line_types"} <= record.keys()
+            if severity:  # where the illusion shows, measured against the case without it
+                assert 0.0 <= record["illusion_share"] <= 1.0 and record["illusion_effect"] >= 0.0
+            else:
+                assert "illusion_share" not in record
         all_records += records
     # The split file holds the same lines as the case files (case folders sorted by source path).
     split_records = read_lines(split / "test_label.json")
@@ -180,7 +184,7 @@ def test_resume_repairs_exactly_the_damaged_frames(
 
 def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "interrupted"
-    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3)
+    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3, sampling="even")
 
     def interrupt_after_two_tasks(tasks: Sequence[RenderTask], on_done: TaskDone) -> None:
         done = []
