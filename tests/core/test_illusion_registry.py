@@ -10,6 +10,7 @@ import pytest
 
 from lanevil_core.case import Case, case_json, parse_case
 from lanevil_core.compile import compile_scene
+from lanevil_core.illusion_effect import band_change, lane_band
 from lanevil_core.illusions import CATEGORIES, REGISTRY
 from lanevil_core.labels import tusimple_record
 from lanevil_core.render import render_frame
@@ -18,8 +19,9 @@ from lanevil_core.stock import original_case, perturbed_case
 TYPES = list(REGISTRY)
 LEVELS = [1, 2, 3, 4, 5]
 SIZE = (320, 180)
-MIN_LEVEL5_EFFECT = 5.0  # mean grey-level change in the lane band that level 5 must exceed
-BAND_PX = 6  # half width of the band around the labelled lanes where the effect is measured
+# Level 5 on the stock case must visibly change the lane band: at least this share of its pixels changes by more
+# than illusion_effect.CHANGED_LEVEL (measured 0.08 for pedestrians up to 0.98 for the fence shadow).
+MIN_LEVEL5_SHARE = 0.05
 
 
 def test_registry_is_the_benchmark_taxonomy() -> None:
@@ -83,28 +85,18 @@ def _render(case: Case) -> tuple[np.ndarray, dict]:
     return frame.rgb, tusimple_record(scene, 0, frame, raw_file="000000.png")
 
 
-def _lane_band(record: dict, shape: tuple[int, int]) -> np.ndarray:
-    mask = np.zeros(shape, bool)
-    for lane in record["lanes"]:
-        for x, y in zip(lane, record["h_samples"]):
-            if x >= 0 and 0 <= y < shape[0]:
-                mask[y, max(x - BAND_PX, 0):x + BAND_PX + 1] = True
-    return mask
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("name", TYPES)
-def test_effect_is_deterministic_keeps_labels_and_grows_with_severity(name: str) -> None:
+def test_effect_is_deterministic_keeps_labels_and_changes_the_lane_band(name: str) -> None:
+    """Every level renders the same bytes twice and keeps the lane labels; level 5 changes the lane band. That
+    the change rises with the level is tests/core/test_severity_ladders.py's (on clean stock cases)."""
     original, record0 = _render(original_case(name))
-    band = _lane_band(record0, original.shape[:2])
+    band = lane_band(record0["lanes"], record0["h_samples"], (original.shape[1], original.shape[0]))
     assert band.sum() > 500
-    effects = []
     for level in LEVELS:
         rgb, record = _render(perturbed_case(name, level))
         again, _ = _render(perturbed_case(name, level))
         assert np.array_equal(rgb, again), f"{name} level {level} is not deterministic"
         assert record["lanes"] == record0["lanes"], f"{name} level {level} moved the lane labels"
-        diff = np.abs(rgb.astype(np.int16) - original.astype(np.int16)).mean(axis=-1)
-        effects.append(float(diff[band].mean()))
-    assert all(b > a for a, b in zip(effects, effects[1:])), f"{name}: effect {effects} does not grow strictly"
-    assert effects[-1] > MIN_LEVEL5_EFFECT, f"{name}: level 5 barely disturbs the lane region ({effects[-1]:.1f})"
+    share = band_change(original, rgb, band).share
+    assert share > MIN_LEVEL5_SHARE, f"{name}: level 5 barely changes the lane band ({share:.3f})"
