@@ -46,7 +46,7 @@ test-browser: $(STAMP)
 
 # The shipped learned detectors (lanevil_core/detect/models/ufld and seg): render a diversified clean train split
 # (4,000 frames at 640x360), train both families at 320x180 and copy each model folder's files into place.
-# About 12 min of rendering and 25-35 min of training on 2 idle cores; MODELS_DATA keeps the renders for reruns.
+# About 3 min of rendering and 13 min of training on 2 idle cores; MODELS_DATA keeps the renders for reruns.
 MODELS_DATA ?= out/models-data
 SHIPPED := lanevil_core/detect/models
 models: $(STAMP)
