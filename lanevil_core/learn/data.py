@@ -62,7 +62,8 @@ def resized(rgb: UInt8Array, input_size: tuple[int, int]) -> UInt8Array:
 
 
 class _Frames(Dataset):
-    """Shared sample assembly: subclasses provide ``image(index)``, ``records`` and ``frame_sizes``."""
+    """Shared sample assembly over ``images`` ((N, H, W, 3) uint8 at the input size), their TuSimple ``records``
+    and the ``frame_sizes`` the records refer to, which the subclasses fill."""
 
     def __init__(self, spec: ModelSpec, train: bool, augment: Augment | None, seed: int) -> None:
         self.spec = spec
@@ -72,9 +73,11 @@ class _Frames(Dataset):
         self.epoch = 0
         self.records: list[dict[str, Any]] = []
         self.frame_sizes: list[tuple[int, int]] = []
+        width, height = spec.input_size
+        self.images: UInt8Array = np.zeros((0, height, width, 3), np.uint8)
 
     def image(self, index: int) -> UInt8Array:
-        raise NotImplementedError
+        return self.images[index]
 
     def __len__(self) -> int:
         return len(self.records)
@@ -120,11 +123,8 @@ class LabelledFrames(_Frames):
             rgb = read_rgb(self.split_dir / record["raw_file"])
             self.frame_sizes.append((rgb.shape[1], rgb.shape[0]))
             images.append(resized(rgb, spec.input_size))
-        width, height = spec.input_size
-        self.images = np.stack(images) if images else np.zeros((0, height, width, 3), np.uint8)
-
-    def image(self, index: int) -> UInt8Array:
-        return self.images[index]
+        if images:
+            self.images = np.stack(images)
 
 
 class RenderedFrames(_Frames):
@@ -137,28 +137,25 @@ class RenderedFrames(_Frames):
         self.items = [(Path(path), int(frame)) for path, frame in items]
         self.render_size = render_size
         self._scenes: OrderedDict[Path, Any] = OrderedDict()
-        self._images: dict[int, UInt8Array] = {}
-        self.records = [self._render(i)[1] for i in range(len(self.items))]
+        rendered = [self._render(path, frame) for path, frame in self.items]
+        self.records = [record for _, record in rendered]
         self.frame_sizes = [render_size] * len(self.items)
+        if rendered:
+            self.images = np.stack([image for image, _ in rendered])
 
-    def _render(self, index: int) -> tuple[UInt8Array, dict[str, Any]]:
+    def _render(self, path: Path, frame_index: int) -> tuple[UInt8Array, dict[str, Any]]:
         from ..case import load_case
         from ..compile import compile_scene
         from ..labels import tusimple_record
         from ..render import render_frame
 
-        path, frame_index = self.items[index]
         scene = self._scenes.pop(path, None) or compile_scene(load_case(path))
         self._scenes[path] = scene
         while len(self._scenes) > 2:
             self._scenes.popitem(last=False)
         frame = render_frame(scene, frame_index, self.render_size)
         record = tusimple_record(scene, frame_index, frame, raw_file=f"{path.name}#{frame_index}")
-        self._images[index] = resized(frame.rgb, self.spec.input_size)
-        return self._images[index], record
-
-    def image(self, index: int) -> UInt8Array:
-        return self._images[index]
+        return resized(frame.rgb, self.spec.input_size), record
 
 
 def split_indices(count: int, groups: list[str], val_fraction: float, seed: int) -> tuple[list[int], list[int]]:

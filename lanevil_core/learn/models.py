@@ -73,23 +73,38 @@ def _stage_sizes(backbone: ResNet, input_size: tuple[int, int]) -> tuple[int, in
     return int(c4.shape[-2]), int(c4.shape[-1])
 
 
-class UFLDNet(nn.Module):
+class _LaneNet(nn.Module):
+    """What both families share: their spec, input normalisation, the backbone and the lane-mask head's shape."""
+
     def __init__(self, spec: ModelSpec) -> None:
         super().__init__()
         self.spec = spec
         self.normalize = Normalize()
         self.backbone = ResNet(spec.backbone, spec.width)
+
+    def stages(self, image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """The backbone's stages at strides 8, 16 and 32 for images in 0..1."""
+        return self.backbone(self.normalize(image))
+
+    def mask_head(self) -> MaskHead:
+        """A lane-mask head (background + one class per slot) on this backbone."""
+        channels = self.backbone.channels
+        return MaskHead(channels, max(16, channels[1]), self.spec.slots + 1, self.spec.mask_size)
+
+
+class UFLDNet(_LaneNet):
+    def __init__(self, spec: ModelSpec) -> None:
+        super().__init__(spec)
         h, w = _stage_sizes(self.backbone, spec.input_size)
         self.squeeze = nn.Conv2d(self.backbone.channels[-1], 8, 1)
         self.classifier = nn.Sequential(
             nn.Linear(8 * h * w, spec.hidden), nn.ReLU(inplace=True),
             nn.Linear(spec.hidden, spec.slots * spec.anchors * (spec.grid + 1)),
         )
-        mid = max(16, self.backbone.channels[1])
-        self.aux = MaskHead(self.backbone.channels, mid, spec.slots + 1, spec.mask_size)
+        self.aux = self.mask_head()
 
     def forward(self, image: torch.Tensor) -> dict[str, torch.Tensor]:
-        c2, c3, c4 = self.backbone(self.normalize(image))
+        c2, c3, c4 = self.stages(image)
         flat = torch.flatten(self.squeeze(c4), 1)
         logits = self.classifier(flat).view(-1, self.spec.slots, self.spec.anchors, self.spec.grid + 1)
         out = {"row_logits": logits}
@@ -98,19 +113,15 @@ class UFLDNet(nn.Module):
         return out
 
 
-class SegNet(nn.Module):
+class SegNet(_LaneNet):
     def __init__(self, spec: ModelSpec) -> None:
-        super().__init__()
-        self.spec = spec
-        self.normalize = Normalize()
-        self.backbone = ResNet(spec.backbone, spec.width)
-        mid = max(16, self.backbone.channels[1])
-        self.head = MaskHead(self.backbone.channels, mid, spec.slots + 1, spec.mask_size)
+        super().__init__(spec)
+        self.head = self.mask_head()
         self.exist = nn.Sequential(nn.Linear(self.backbone.channels[-1], 64), nn.ReLU(inplace=True),
                                    nn.Linear(64, spec.slots))
 
     def forward(self, image: torch.Tensor) -> dict[str, torch.Tensor]:
-        c2, c3, c4 = self.backbone(self.normalize(image))
+        c2, c3, c4 = self.stages(image)
         pooled = torch.flatten(F.adaptive_avg_pool2d(c4, 1), 1)
         return {"mask_logits": self.head(c2, c3, c4), "exist_logits": self.exist(pooled)}
 

@@ -8,6 +8,7 @@ is held out by seed; validation accuracy is TuSimple Accuracy on the 1280x720 gr
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
@@ -21,10 +22,10 @@ import numpy as np
 import torch
 from torch.utils.data import DataLoader
 
-from ..case import write_atomic
 from ..detect.lane_slots import on_tusimple_grid
 from ..detect.learned import decode_outputs, lanes_of
 from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
+from ..files import write_atomic
 from ..metrics.formats import split_labels
 from ..metrics.tusimple import score_image
 from .aam import AamSettings, attention, build_bank, hard_patches, mix, patch_tensors
@@ -108,9 +109,9 @@ def tusimple_accuracy(results: list[tuple[list[list[int]], list[list[int]], list
 
 
 def _save(obj: Any, path: Path) -> None:
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    torch.save(obj, tmp)
-    os.replace(tmp, path)
+    buffer = io.BytesIO()
+    torch.save(obj, buffer)
+    write_atomic(path, buffer.getvalue())
 
 
 def _lr_at(step: int, total: int, base: float) -> float:
