@@ -14,6 +14,7 @@ import uvicorn
 from fastapi import FastAPI
 from fastapi.testclient import TestClient
 
+from app.editor import Editor, launch_editor
 from app.main import create_app
 from app.server import bind
 from app.settings import Settings
@@ -119,3 +120,15 @@ def screenshot_dir() -> Path:
     """Where browser tests save what they saw (ignored by git; open the PNGs to look at them)."""
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     return SCREENSHOTS
+
+
+EDITOR_START_S = 120.0  # the first preview compiles the numba kernels on a cold cache
+
+
+@pytest.fixture
+def editor(state: AppState) -> Iterator[Editor]:
+    """The viser editor on the test store (a free port), its first preview rendered; stopped afterwards."""
+    editor = launch_editor(state, host="127.0.0.1", port=0)
+    assert editor.preview.wait_idle(EDITOR_START_S)
+    yield editor
+    editor.stop()

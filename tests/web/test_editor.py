@@ -8,13 +8,12 @@ import json
 import threading
 import time
 import zipfile
-from collections.abc import Iterator
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from app.editor import EditError, Editor, launch_editor
+from app.editor import EditError, Editor
 from app.editor.detection import rate_text
 from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
 from app.editor.session import CaseSession
@@ -29,14 +28,6 @@ from lanevil_core.illusions.shadow import roadside_t
 
 SHADOW = "fence_shadow-03_level3"
 WAIT_S = 120.0
-
-
-@pytest.fixture
-def editor(state: AppState) -> Iterator[Editor]:
-    editor = launch_editor(state, host="127.0.0.1", port=0)
-    assert editor.preview.wait_idle(WAIT_S)
-    yield editor
-    editor.stop()
 
 
 def settle(editor: Editor) -> np.ndarray:

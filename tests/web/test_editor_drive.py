@@ -3,22 +3,10 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
-import pytest
-
-from app.editor import Editor, launch_editor
-from app.state import AppState
+from app.editor import Editor
 
 WAIT_S = 120.0
-
-
-@pytest.fixture
-def editor(state: AppState) -> Iterator[Editor]:
-    editor = launch_editor(state, host="127.0.0.1", port=0)
-    assert editor.preview.wait_idle(WAIT_S)
-    yield editor
-    editor.stop()
 
 
 def test_drive_button_runs_the_open_case_and_plays_it(editor: Editor) -> None:
