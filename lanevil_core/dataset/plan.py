@@ -194,7 +194,10 @@ def evenly_spaced(total: int, count: int | None) -> tuple[int, ...]:
 def discover_cases(root: Path) -> list[SourceCase]:
     """Every ``**/*.json`` case under ``root``, sorted by relative path (a bad file raises ``CaseError``)."""
     paths = sorted(root.glob("**/*.json"))
-    return [SourceCase(PurePosixPath(path.relative_to(root).as_posix()), load_case(path)) for path in paths]
+    # A single type's folder (``--cases scenes/30_shadow/fence_shadow``) keeps its name in the relative paths, so
+    # its original is still known as that type's.
+    base = root.parent if root.name in REGISTRY else root
+    return [SourceCase(PurePosixPath(path.relative_to(base).as_posix()), load_case(path)) for path in paths]
 
 
 SAMPLINGS = ("in_view", "even")

@@ -96,8 +96,8 @@ class SunlightReflection(Illusion):
         SunlightReflectionLevel(sun_altitude=24.0, sun_intensity=1.0, wetness=0.35, puddles=0.08),
         SunlightReflectionLevel(sun_altitude=17.0, sun_intensity=1.15, wetness=0.5, puddles=0.16),
         SunlightReflectionLevel(sun_altitude=12.0, sun_intensity=1.3, wetness=0.65, puddles=0.25),
-        SunlightReflectionLevel(sun_altitude=8.0, sun_intensity=1.5, wetness=0.8, puddles=0.35),
-        SunlightReflectionLevel(sun_altitude=5.0, sun_intensity=1.8, wetness=0.95, puddles=0.45),
+        SunlightReflectionLevel(sun_altitude=10.0, sun_intensity=1.5, wetness=0.8, puddles=0.35),
+        SunlightReflectionLevel(sun_altitude=8.0, sun_intensity=2.0, wetness=0.95, puddles=0.45),
     )
 
     type: Literal["sunlight_reflection"] = "sunlight_reflection"

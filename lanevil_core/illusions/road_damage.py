@@ -124,29 +124,31 @@ class RoadCrackLevel(Level):
     alligator_share: float
     joints: int
     spall: float
+    paint_wear: float
 
 
 @register
 class RoadCrack(_SurfaceDamage):
     """Dark branching cracks in the asphalt: transverse, longitudinal and alligator, and at the higher levels
     failed paving joints under the lane lines. The stained, spalled rims lie under the paint; the open cracks
-    split the paint of the lines they cross."""
+    split the paint of the lines they cross, and the lines' paint flakes off the failing surface."""
 
     TEXEL: ClassVar[float] = 0.02
     # density: cracks per 100 m^2; width: core width of a main crack (1-3 cm); along_lines: long cracks right
     # beside the lane lines nearest the ego; joints: those lines whose paving joint has failed into a band of
-    # alligator cracking along the line; spall: broken-down crack edges (wider, darker stained rims).
+    # alligator cracking along the line; spall: broken-down crack edges (wider, darker stained rims);
+    # paint_wear: mean share of the lane lines' paint flaked off the failing surface (every line in the area).
     SEVERITY: ClassVar[tuple[RoadCrackLevel, ...]] = (
         RoadCrackLevel(density=0.8, width=0.010, darkness=0.60, along_lines=0, alligator_share=0.00,
-                       joints=0, spall=0.0),
+                       joints=0, spall=0.0, paint_wear=0.0),  # hairline cracks, paint intact
         RoadCrackLevel(density=1.5, width=0.014, darkness=0.70, along_lines=0, alligator_share=0.10,
-                       joints=0, spall=0.1),
+                       joints=0, spall=0.1, paint_wear=0.15),
         RoadCrackLevel(density=2.5, width=0.018, darkness=0.80, along_lines=1, alligator_share=0.15,
-                       joints=1, spall=0.25),
+                       joints=1, spall=0.25, paint_wear=0.3),  # a failed joint, the lines flaking
         RoadCrackLevel(density=4.0, width=0.024, darkness=0.90, along_lines=2, alligator_share=0.20,
-                       joints=2, spall=0.5),
+                       joints=2, spall=0.5, paint_wear=0.55),
         RoadCrackLevel(density=8.0, width=0.030, darkness=1.00, along_lines=6, alligator_share=0.25,
-                       joints=5, spall=1.0),
+                       joints=5, spall=1.0, paint_wear=0.85),  # failing pavement, most of the paint gone
     )
 
     type: Literal["road_crack"] = "road_crack"
@@ -157,6 +159,7 @@ class RoadCrack(_SurfaceDamage):
     darkness: float | None = Field(None, ge=0, le=1, description="opacity of the crack core")
     along_lines: int | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
     joints: int | None = Field(None, ge=0, le=12, description="lane lines with failed joints cracked along them")
+    paint_wear: float | None = Field(None, ge=0, le=1, description="mean share of the lines' paint flaked off")
 
     def level(self) -> RoadCrackLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -180,6 +183,13 @@ class RoadCrack(_SurfaceDamage):
                                   joint_t=joints, spall=self.level().spall)
         self._emit(ctx, area, layers.stains, None, over_paint=False, name="crack stains")
         self._emit(ctx, area, layers.cracks, layers.wet, over_paint=True, name="cracks")
+        wear = _setting(self, "paint_wear")
+        if wear > 0:
+            from ..paint import MATERIAL_ALBEDO  # paint -> case -> illusions: circular at import time
+
+            rgba, _ = tex.worn_paint(np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape, area.texel,
+                                     [area.local_t(t) for t in lines], wear, MATERIAL_ALBEDO[0])
+            self._emit(ctx, area, rgba, None, over_paint=True, name="worn paint")
 
     def _shares(self, alligator_share: float) -> dict[tex.CrackKind, float]:
         """Share of the density that goes to each crack kind."""
@@ -202,30 +212,35 @@ class RoadRepairLevel(Level):
     contrast: float
     strip_width: float
     bright_share: float
+    ghosts: int
+    ghost_opacity: float
 
 
 @register
 class RoadRepair(_SurfaceDamage):
     """Repair patches of fresher, darker asphalt, trench reinstatements along the lane lines, strips of crack
-    sealant, some running along the lines, and at the higher levels fresh patches across the lines whose paint
-    has not been restored yet."""
+    sealant, some running along the lines, ghosts of old lane lines ground off when the lanes were moved, and at
+    the higher levels fresh patches across the lines whose paint has not been restored yet."""
 
     # patches: rectangles and pothole fills; parallel: sealant strips beside lane lines; trenches: long narrow
     # reinstatements (joint inlays) along the lane lines nearest the ego, repainted: the line runs over them;
     # unpainted: patches laid across those lines after the paint, so the line breaks off there; size: patch
-    # size scale; contrast: fresh-asphalt darkness and opacity.
+    # size scale; contrast: fresh-asphalt darkness and opacity; ghosts: old lane lines (the ego's first) ground
+    # off when the lanes were moved, left as pale scoured stripes GHOST_SHIFT_LANES of a lane beside today's
+    # lines, each as opaque as ghost_opacity (the classic wrong line to follow at road works).
     SEVERITY: ClassVar[tuple[RoadRepairLevel, ...]] = (
         RoadRepairLevel(patches=2, strips=2, parallel=0, trenches=0, unpainted=0, size=0.80, contrast=0.35,
-                        strip_width=0.05, bright_share=0.00),
+                        strip_width=0.05, bright_share=0.00, ghosts=0, ghost_opacity=0.0),  # a few fresh patches
         RoadRepairLevel(patches=4, strips=3, parallel=0, trenches=0, unpainted=0, size=0.90, contrast=0.50,
-                        strip_width=0.06, bright_share=0.15),
+                        strip_width=0.06, bright_share=0.15, ghosts=1, ghost_opacity=0.30),  # one faint ghost
         RoadRepairLevel(patches=6, strips=5, parallel=1, trenches=1, unpainted=1, size=1.00, contrast=0.65,
-                        strip_width=0.07, bright_share=0.30),
+                        strip_width=0.07, bright_share=0.30, ghosts=2, ghost_opacity=0.45),  # trench, ego's ghosts
         RoadRepairLevel(patches=8, strips=7, parallel=2, trenches=2, unpainted=3, size=1.10, contrast=0.80,
-                        strip_width=0.09, bright_share=0.40),
+                        strip_width=0.09, bright_share=0.40, ghosts=4, ghost_opacity=0.75),
         RoadRepairLevel(patches=11, strips=9, parallel=4, trenches=5, unpainted=6, size=1.30, contrast=1.00,
-                        strip_width=0.12, bright_share=0.50),
+                        strip_width=0.12, bright_share=0.50, ghosts=6, ghost_opacity=0.95),  # the old layout
     )
+    GHOST_SHIFT_LANES: ClassVar[float] = 0.4  # the old lanes lay this share of a lane width to the right
 
     type: Literal["road_repair"] = "road_repair"
     patches: int | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
@@ -237,6 +252,8 @@ class RoadRepair(_SurfaceDamage):
     contrast: float | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
     strip_width: float | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
     bright_share: float | None = Field(None, ge=0, le=1, description="share of strips in bright weathered filler")
+    ghosts: int | None = Field(None, ge=0, le=12, description="old lane lines ground off beside today's lines")
+    ghost_opacity: float | None = Field(None, ge=0, le=1, description="how much of a ghost line's paler stone shows")
 
     def level(self) -> RoadRepairLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -268,6 +285,11 @@ class RoadRepair(_SurfaceDamage):
                               parallel_t=parallel_t, contrast=v.contrast, strip_width_m=v.strip_width,
                               bright_share=v.bright_share)
         self._emit(ctx, area, rgba, None, over_paint=True, name="sealant")
+        ghost_rng = np.random.default_rng(int(rng.integers(0, 2**63 - 1)))
+        shift = self.GHOST_SHIFT_LANES * ctx.network.lane_width
+        ghost_t = [area.local_t(lines[k % len(lines)] - shift) for k in range(v.ghosts)]
+        rgba, _ = tex.ghost_lines(ghost_rng, area.shape, area.texel, ghost_t, opacity=v.ghost_opacity)
+        self._emit(ctx, area, rgba, None, over_paint=False, name="ghost markings")
 
 
 @dataclass(frozen=True)

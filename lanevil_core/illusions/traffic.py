@@ -372,8 +372,8 @@ class Vehicle(TrafficIllusion):
         VehicleLevel(count=1, per_row=1, distance=16.0, large=0.0, lane_change=0.0),  # one car beside the ego
         VehicleLevel(count=2, per_row=1, distance=16.0, large=0.2, lane_change=0.0),  # a second row, vans
         VehicleLevel(count=4, per_row=2, distance=16.0, large=0.3, lane_change=0.2),  # pairs side by side
-        VehicleLevel(count=6, per_row=2, distance=16.0, large=0.4, lane_change=0.3),  # a queue with vans
-        VehicleLevel(count=9, per_row=3, distance=16.0, large=0.5, lane_change=0.4),  # dense traffic, trucks
+        VehicleLevel(count=8, per_row=2, distance=16.0, large=0.4, lane_change=0.3),  # a queue with vans
+        VehicleLevel(count=15, per_row=3, distance=16.0, large=0.6, lane_change=0.4),  # dense traffic, trucks
     )
     # Lanes relative to the ego's (+1 = next lane to its right, -1 = to its left), tried in this order.
     LANE_ORDER: ClassVar[tuple[int, ...]] = (1, -1, -2, 2, -3, 3, 0, -4, 4, -5, 5, -6, 6, -7, 7)

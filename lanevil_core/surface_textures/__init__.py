@@ -33,8 +33,9 @@ from ._canvas import (
     composite,
 )
 from .cracks import CrackLayers, crack_layers, crack_mix, crack_network
-from .repairs import PatchKind, patches
+from .repairs import PatchKind, ghost_lines, patches
 from .skid_marks import SkidKind, skid_marks
+from .wear import worn_paint
 
 __all__ = [
     "ALLIGATOR_HALO",
@@ -59,6 +60,8 @@ __all__ = [
     "crack_layers",
     "crack_mix",
     "crack_network",
+    "ghost_lines",
     "patches",
     "skid_marks",
+    "worn_paint",
 ]

@@ -1,4 +1,5 @@
-"""Repair patches of fresh asphalt and sealant strips, some running along the lane lines."""
+"""Repair patches of fresh asphalt, sealant strips (some running along the lane lines) and the ghosts of old
+lane markings ground off when the lanes were moved."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import numpy as np
 from ..typed import FloatArray
 from ._canvas import (
     FRESH_ASPHALT_RGB,
+    GROUND_OFF_RGB,
     SEALANT_BRIGHT_RGB,
     SEALANT_DARK_RGB,
     Texture,
@@ -166,3 +168,35 @@ def _paint_window(canvas: _Canvas, window: tuple[slice, slice], color: Sequence[
                   coverage: np.ndarray) -> None:
     """``_Canvas.paint`` restricted to a (rows, cols) window (the views write through to the canvas)."""
     _Canvas(canvas.premul[window], canvas.alpha[window]).paint(color, coverage)
+
+
+GHOST_STEP_M = 0.25
+GHOST_DASH_M = (3.0, 6.0)  # painted and gap length of the dashed lines the ghosts were
+
+
+def ghost_lines(rng: np.random.Generator, shape: tuple[int, int], texel: float, t_local: Sequence[float], *,
+                width_m: float = 0.15, opacity: float = 0.6, dashed_share: float = 0.5) -> Texture:
+    """Ghost markings: old lane lines ground off when the lanes were moved (road works, re-laning), left as pale
+    scoured stripes with paint residue, parallel to the lanes at ``t_local`` (m) over the texture's whole length.
+
+    Grinding never removes a line evenly, so each ghost's opacity wanders between 45 % and 100 % of ``opacity``;
+    a share ``dashed_share`` of them were dashed lines and keep their dashes.
+
+    Returns:
+        rgba (h, w, 4) float32, wet None.
+    """
+    base = _children(rng)[6]
+    cover = np.zeros(shape, np.float32)
+    length_s = shape[0] * texel
+    s = np.arange(0.0, length_s + GHOST_STEP_M, GHOST_STEP_M)
+    for k, t in enumerate(t_local):
+        child = _child(base, k)
+        pts = np.stack([s, t + _smooth_random(child, len(s), max(len(s) // 40, 2), -0.03, 0.03)], axis=1)
+        value = opacity * _smooth_random(child, len(s), max(len(s) // 12, 2), 0.45, 1.0)
+        if child.random() < dashed_share:
+            painted, gap = GHOST_DASH_M
+            value = value * (((s + child.uniform(0.0, painted + gap)) % (painted + gap)) < painted)
+        _stamp_polyline(cover, cover, pts, np.full(len(s), 0.5 * width_m), value, texel, 1.25 * texel, 0.0)
+    canvas = _Canvas.empty(shape)
+    canvas.paint(GROUND_OFF_RGB, cover)
+    return canvas.rgba(), None

@@ -96,3 +96,11 @@ def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[Source
     strongest = max(fence, key=lambda s: s.case.illusions[0].severity if s.case.illusions else 0).case
     changes = frame_changes(clean_of(strongest), strongest, next(iter(frames)), SHARE_SIZE)
     assert all(change.share >= IN_VIEW_SHARE for change in changes)
+
+
+def test_a_single_type_folder_keeps_its_original_as_that_type() -> None:
+    sources = discover_cases(SCENES / "30_shadow" / "fence_shadow")
+    assert [str(s.relative) for s in sources][:2] == ["fence_shadow/00_original.json", "fence_shadow/01_level1.json"]
+    assert {s.folder_type for s in sources} == {"fence_shadow"}
+    plan = build_plan(sources, Settings(frames_per_case=2, sampling="even"))
+    assert sorted(c.severity for c in plan.split_cases("test")) == [0, 1, 2, 3, 4, 5]

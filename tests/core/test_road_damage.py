@@ -131,12 +131,15 @@ def test_long_damage_is_split_into_layers_under_the_texel_budget() -> None:
 
 
 def test_crack_stains_lie_under_the_paint_and_cracks_sealant_and_rubber_over_it() -> None:
-    cracks = compiled({"type": "road_crack"}).layers
+    cracks = compiled({"type": "road_crack", "severity": 1}).layers
     assert {layer.name.rsplit(" ", 1)[0]: layer.over_paint for layer in cracks} == {"crack stains": False,
                                                                                     "cracks": True}
+    worn = compiled({"type": "road_crack", "severity": 4}).layers
+    assert {layer.name.rsplit(" ", 1)[0]: layer.over_paint for layer in worn} == {
+        "crack stains": False, "cracks": True, "worn paint": True}
     repair = compiled({"type": "road_repair", "severity": 4}).layers
     assert {layer.name.rsplit(" ", 1)[0]: layer.over_paint for layer in repair} == {
-        "repair patches": False, "unpainted patches": True, "sealant": True}
+        "repair patches": False, "unpainted patches": True, "sealant": True, "ghost markings": False}
     assert {layer.over_paint for layer in compiled({"type": "tire_marks"}).layers} == {True}
 
 

@@ -20,10 +20,15 @@ def generate(name: str, seed: int = 7, **kw) -> tex.Texture:
         return tex.crack_network(rng(seed), SHAPE, TEXEL, name, **{"density": 2.0, **kw})
     if name == "patches":
         return tex.patches(rng(seed), SHAPE, TEXEL, **{"strips": 3, "parallel_t": (4.5,), **kw})
+    if name == "ghost_lines":
+        return tex.ghost_lines(rng(seed), SHAPE, TEXEL, **{"t_local": (3.0, 6.0), **kw})
+    if name == "worn_paint":
+        return tex.worn_paint(rng(seed), SHAPE, TEXEL, **{"t_local": (4.5,), "wear": 0.5,
+                                                            "asphalt_rgb": (0.055, 0.055, 0.058), **kw})
     return tex.skid_marks(rng(seed), SHAPE, TEXEL, **{"straight": 1, "swerve": 1, "yaw": 1, **kw})
 
 
-GENERATORS = (*tex.CRACK_KINDS, "patches", "skid_marks")
+GENERATORS = (*tex.CRACK_KINDS, "patches", "skid_marks", "ghost_lines", "worn_paint")
 
 
 @pytest.mark.parametrize("name", GENERATORS)
@@ -200,3 +205,31 @@ def test_patch_across_a_line_covers_it_in_the_first_half() -> None:
     covered = np.flatnonzero(alpha[:, col] > 0.9)
     assert covered.size * TEXEL > 1.0  # at least a metre of the line lies under fresh asphalt
     assert covered.max() * TEXEL < 0.5 * SHAPE[0] * TEXEL + 2.5  # laid in the first half (plus its half length)
+
+
+def test_ghost_lines_are_pale_stripes_along_their_lines_only() -> None:
+    rgba, _ = tex.ghost_lines(rng(), SHAPE, TEXEL, (4.5,), width_m=0.15, opacity=0.8, dashed_share=0.0)
+    alpha = rgba[..., 3]
+    cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
+    band = np.abs(cols - 4.5) < 0.15
+    assert (alpha[:, band].max(axis=1) > 0.3).mean() > 0.95  # a solid ghost runs the whole length
+    assert alpha[:, ~band].max() == 0.0
+    assert alpha.max() <= 0.8 + 1e-6
+    assert rgba[..., :3][alpha > 0].min() > 0.2  # pale scoured stone, far above asphalt's 0.05
+
+
+def test_dashed_ghosts_keep_their_gaps() -> None:
+    rgba, _ = tex.ghost_lines(rng(), SHAPE, TEXEL, (4.5,), opacity=0.8, dashed_share=1.0)
+    painted = rgba[..., 3].max(axis=1) > 0.05
+    assert 0.2 < painted.mean() < 0.5  # 3 m painted in every 9 m
+
+
+def test_paint_wear_grows_with_wear_and_stays_on_the_lines() -> None:
+    def cover(wear: float) -> np.ndarray:
+        rgba, _ = tex.worn_paint(rng(), SHAPE, TEXEL, (4.5,), wear, (0.055, 0.055, 0.058))
+        return rgba[..., 3]
+
+    light, heavy = cover(0.2), cover(0.8)
+    assert heavy.mean() > light.mean() > 0.0
+    cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
+    assert heavy[:, np.abs(cols - 4.5) > 0.3].max() == 0.0
