@@ -9,7 +9,8 @@
    each frame against its labels); the ``hard_share`` lowest-scoring patches are the ones mixed in that epoch.
 3. **Mixing.** For a training image ``x`` (a share ``probability`` of each batch) the model's own attention ``A``
    (its lane probability, 1 - background, of the lane-mask head: the segmentation output of ``seg``, the
-   auxiliary head of ``ufld``; normalised to 0..1 per image) is computed on ``x``, and a random hard patch
+   auxiliary head of ``ufld``; widened to the area around the lanes by ``attention_spread_px`` and normalised to
+   0..1 per image) is computed on ``x``, and a random hard patch
    ``(h, M)`` is blended where the model looks: ``x' = x * (1 - A * M) + h * A * M``. Labels stay those of ``x``:
    illusions never move the lanes, and only masked pixels change.
 """
@@ -49,6 +50,7 @@ class AamSettings:
     hard_share: float = 0.35  # share of the bank kept as hard examples each epoch
     probability: float = 0.5  # share of training images mixed
     mask_blur_px: float = 1.0  # softening of the patch mask at the network's input size
+    attention_spread_px: int = 6  # the lanes' attention widened to the area around them (box radius, 2 passes)
 
 
 @dataclass
@@ -126,11 +128,15 @@ def hard_patches(patches: list[HardPatch], share: float) -> list[HardPatch]:
     return [patches[i] for i in order[:keep]]
 
 
-def attention(out: dict[str, torch.Tensor], size: tuple[int, int]) -> torch.Tensor:
+def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: int = 0) -> torch.Tensor:
     """(N, H, W) the model's lane attention at the input size: 1 - background probability of its lane-mask
-    head, normalised to 0..1 per image."""
+    head, widened by two box blurs of radius ``spread_px`` (the *area* the model attends to: the lines and the
+    road beside them, where a distractor competes with them), normalised to 0..1 per image."""
     lanes = 1.0 - torch.softmax(out["mask_logits"].detach(), dim=1)[:, 0]
-    lanes = F.interpolate(lanes[:, None], size=(size[1], size[0]), mode="bilinear", align_corners=False)[:, 0]
+    lanes = F.interpolate(lanes[:, None], size=(size[1], size[0]), mode="bilinear", align_corners=False)
+    for _ in range(2 if spread_px > 0 else 0):
+        lanes = F.avg_pool2d(lanes, 2 * spread_px + 1, stride=1, padding=spread_px, count_include_pad=False)
+    lanes = lanes[:, 0]
     peak = lanes.flatten(1).max(dim=1).values.clamp(min=1e-6)
     return lanes / peak[:, None, None]
 

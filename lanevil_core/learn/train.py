@@ -153,7 +153,7 @@ def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainS
     device = next(model.parameters()).device
     with torch.no_grad():
         out = model(images[chosen].to(device))
-    attention_map = attention(out, model.spec.input_size).cpu()
+    attention_map = attention(out, model.spec.input_size, settings.aam.attention_spread_px).cpu()
     patches, masks = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
     images = images.clone()
     images[chosen] = mix(images[chosen], attention_map, patches, masks)

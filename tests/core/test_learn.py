@@ -185,6 +185,19 @@ def test_aam_mixing_touches_only_masked_pixels():
     assert torch.allclose(half[:, :, 2:4, 3:6], images[:, :, 2:4, 3:6] * 0.5)
 
 
+def test_aam_attention_spreads_around_the_lanes_and_peaks_at_one():
+    from lanevil_core.learn.aam import attention
+
+    logits = torch.full((1, 2, 20, 40), -5.0)
+    logits[:, 0] = 5.0  # background everywhere ...
+    logits[0, 0, :, 20], logits[0, 1, :, 20] = -5.0, 5.0  # ... but one lane column
+    thin, wide = attention({"mask_logits": logits}, (40, 20)), attention({"mask_logits": logits}, (40, 20), 3)
+    assert thin.shape == wide.shape == (1, 20, 40)
+    assert abs(float(thin.max()) - 1.0) < 1e-5 and abs(float(wide.max()) - 1.0) < 1e-5
+    assert float(thin[0, 10, 24]) < 0.05 < float(wide[0, 10, 24])  # the road beside the lane joins the area
+    assert float(wide[0, 10, 0]) < 0.05  # far from the lane it stays out
+
+
 def test_aam_bank_never_holds_a_test_case():
     import hashlib
 
