@@ -2,7 +2,7 @@
 
 Lanes and rows are in the frame's own pixels (``labels.h_samples_for(height)``). The score is the official
 per-image TuSimple accuracy, FP and FN, computed after moving both sides to the 1280x720 grid
-(``detect.lane_slots.on_tusimple_grid``), where the metric's 20 px tolerance is defined. The metric's 200 ms
+(``labels.on_tusimple_grid``), where the metric's 20 px tolerance is defined. The metric's 200 ms
 run-time rule is left out: ``run_time_ms`` is wall-clock time on whatever machine ran it, and a busy machine must
 not turn a correct detection into a miss.
 """
@@ -14,8 +14,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from .detect.lane_slots import on_tusimple_grid
 from .detect.split import detector_for
+from .labels import on_tusimple_grid
 from .metrics.tusimple import ImageScore, score_image
 from .typed import UInt8Array
 

@@ -17,6 +17,7 @@ Row conventions (see docs/conventions.md):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -217,6 +218,18 @@ def h_samples_for(height: int) -> list[int]:
     return sorted({min(height - 1, int(round(y * height / TUSIMPLE_SIZE[1]))) for y in TUSIMPLE_H_SAMPLES})
 
 
+def on_tusimple_grid(lanes: Sequence[Sequence[float]], h_samples: Sequence[float],
+                     size: tuple[int, int]) -> tuple[list[list[int]], list[float]]:
+    """Lanes and rows of an image of ``size`` moved to the 1280x720 TuSimple grid, where the metric's 20 px
+    tolerance is defined: columns scaled (``floor``), rows as continuous 720-grid rows (``h + 0.5`` scaled, minus
+    0.5), so labels rendered at any size are scored as at 1280x720."""
+    width, height = size
+    sx, sy = TUSIMPLE_SIZE[0] / width, TUSIMPLE_SIZE[1] / height
+    rows = [(h + 0.5) * sy - 0.5 for h in h_samples]
+    scaled = [[int(np.floor((x + 0.5) * sx)) if x >= 0 else NO_POINT for x in lane] for lane in lanes]
+    return scaled, rows
+
+
 def tusimple_columns(label: LaneLabel) -> list[int]:
     """Pixel column of each point (``floor(x)``, the pixel whose centre is nearest), ``-2`` where none."""
     return [int(np.floor(x)) if np.isfinite(x) else NO_POINT for x in label.x_image]
@@ -236,7 +249,17 @@ def tusimple_record(
         "visibility": [[bool(flag) for flag in label.visible] for label in labels],
         "line_types": [label.boundary.line_type for label in labels],
         "frame": int(frame_index),
+        **image_size_field((camera.intrinsics.width, camera.intrinsics.height)),
     }
+
+
+IMAGE_SIZE_FIELD = "image_size"
+
+
+def image_size_field(size: tuple[int, int]) -> dict[str, list[int]]:
+    """``{"image_size": [w, h]}`` for a record of an image that is not 1280x720 (scorers move a 16:9 one to the
+    TuSimple grid, ``on_tusimple_grid``), else nothing: standard records stay standard."""
+    return {} if tuple(size) == TUSIMPLE_SIZE else {IMAGE_SIZE_FIELD: [int(size[0]), int(size[1])]}
 
 
 def culane_lines(scene: CompiledScene, frame: Frame, y_values: tuple[int, ...] = CULANE_Y) -> str:

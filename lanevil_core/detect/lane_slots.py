@@ -235,16 +235,3 @@ def anchor_reach(anchors: FloatArray) -> float:
     """A bit more than half the spacing of the anchor rows (normalised): how far a row-anchor lane may extend past
     its ends."""
     return 0.6 * float(np.diff(anchors).mean()) if len(anchors) > 1 else 0.0
-
-
-
-def on_tusimple_grid(lanes: Sequence[Sequence[float]], h_samples: Sequence[float],
-                     size: tuple[int, int]) -> tuple[list[list[int]], list[float]]:
-    """Lanes and rows of an image of ``size`` moved to the 1280x720 TuSimple grid, where the metric's 20 px
-    tolerance is defined: columns scaled (``floor``), rows as continuous 720-grid rows (``h + 0.5`` scaled, minus
-    0.5), so labels rendered at any size are scored as at 1280x720."""
-    width, height = size
-    sx, sy = TUSIMPLE_SIZE[0] / width, TUSIMPLE_SIZE[1] / height
-    rows = [(h + 0.5) * sy - 0.5 for h in h_samples]
-    scaled = [[int(np.floor((x + 0.5) * sx)) if x >= 0 else NO_POINT for x in lane] for lane in lanes]
-    return scaled, rows

@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from ..detect.lane_slots import on_tusimple_grid
 from ..detect.split import METHODS, detector_for
+from ..labels import on_tusimple_grid
 from ..metrics.tusimple import score_image
 from ..typed import UInt8Array
 

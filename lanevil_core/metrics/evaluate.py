@@ -6,11 +6,11 @@ Inputs are recognised by what they are: a file is TuSimple JSON lines, a folder 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from ..labels import CULANE_SIZE, TUSIMPLE_SIZE
+from ..labels import CULANE_SIZE, IMAGE_SIZE_FIELD, TUSIMPLE_SIZE, on_tusimple_grid
 from . import culane, tusimple
 from .formats import (
     CULANE_SUFFIX,
@@ -39,11 +39,34 @@ class ScoredImage:
 
 
 def score_tusimple_files(gt_path: Path, pred_path: Path) -> list[ScoredImage]:
-    """Per-image official TuSimple scores, in GT order."""
+    """Per-image official TuSimple scores, in GT order.
+
+    A GT record of a 16:9 image rendered at another size than 1280x720 (it carries ``image_size``) is scored with
+    both its lanes and the prediction's moved to the 1280x720 grid (``labels.on_tusimple_grid``), so the metric's
+    20 px tolerance means what it means at 1280x720 whatever size was rendered. Other cameras (a CULane-shaped
+    1640x590, say) are scored in their own pixels.
+    """
     gt = read_tusimple(gt_path, "gt")
-    pairs = pair_records(gt, read_tusimple(pred_path, "pred"), str(gt_path), str(pred_path))
+    pairs = [(_on_grid(g), _on_grid(p, g)) for g, p in
+             pair_records(gt, read_tusimple(pred_path, "pred"), str(gt_path), str(pred_path))]
     scores = tusimple.score_pairs(pairs)
     return [ScoredImage(g.raw_file, score, g.extra) for (g, _), score in zip(pairs, scores)]
+
+
+def _tusimple_shaped(size: list[int]) -> bool:
+    """Whether an image of ``size`` (w, h) is a scaled 1280x720 frame (16:9 within a pixel)."""
+    return abs(size[0] * TUSIMPLE_SIZE[1] / TUSIMPLE_SIZE[0] - size[1]) <= 1.0
+
+
+def _on_grid(record: LaneRecord, gt: LaneRecord | None = None) -> LaneRecord:
+    """``record`` on the 1280x720 grid when its GT (``gt``, else itself) names another ``image_size``."""
+    gt = gt if gt is not None else record
+    size = gt.extra.get(IMAGE_SIZE_FIELD)
+    if not size or tuple(size) == TUSIMPLE_SIZE or not _tusimple_shaped(size):
+        return record
+    lanes, rows = on_tusimple_grid(record.lanes, gt.h_samples, (int(size[0]), int(size[1])))
+    return replace(record, lanes=[[float(x) for x in lane] for lane in lanes],
+                   h_samples=rows if record is gt else record.h_samples)
 
 
 def _interpolated(lanes: list[Points], where: str) -> list[Points]:

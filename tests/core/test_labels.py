@@ -175,7 +175,8 @@ def test_tusimple_record_and_culane_lines_formats(make_case):
     frame = _fake_frame(camera, np.inf, ID_ROAD)
     record = L.tusimple_record(scene, 3, frame, "000003.png", h_samples=list(L.TUSIMPLE_H_SAMPLES[:43]))
     parsed = json.loads(json.dumps(record))
-    assert set(parsed) == {"raw_file", "lanes", "h_samples", "visibility", "line_types", "frame"}
+    assert set(parsed) == {"raw_file", "lanes", "h_samples", "visibility", "line_types", "frame", "image_size"}
+    assert parsed["image_size"] == [1640, 590]
     assert parsed["frame"] == 3 and len(parsed["lanes"]) == len(parsed["line_types"]) <= L.MAX_LANES
     assert parsed["line_types"] == ["white_solid", "white_dashed", "yellow_double_solid", "white_dashed",
                                     "white_solid"]

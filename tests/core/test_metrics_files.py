@@ -90,3 +90,25 @@ def test_culane_folder_errors(tmp_path, capsys):
     (pred / "b.lines.txt").write_text("10 500 20 400\n")
     assert main(["eval", "--gt", str(gt), "--pred", str(pred), "--metric", "culane"]) == 2
     assert "b.lines.txt: prediction for an image not in the ground truth" in error_line(capsys)
+
+
+def test_records_of_smaller_renders_are_scored_on_the_1280_grid(tmp_path):
+    from lanevil_core.labels import h_samples_for
+    from lanevil_core.metrics import score_tusimple_files
+
+    rows = h_samples_for(360)
+    gt, pred = tmp_path / "gt.json", tmp_path / "pred.json"
+    for size, name in ((None, "native"), ([640, 360], "grid")):
+        extra = {"image_size": size} if size else {}
+        gt.write_text(json.dumps({"raw_file": "a.png", "lanes": [[300] * len(rows)], "h_samples": rows, **extra}))
+        # 15 px off at 640 wide: inside 20 px at the render's own size, 30 px (outside) on the 1280x720 grid
+        pred.write_text(json.dumps({"raw_file": "a.png", "lanes": [[315] * len(rows)], "run_time": 1}))
+        accuracy = score_tusimple_files(gt, pred)[0].score.accuracy
+        assert accuracy == (1.0 if name == "native" else 0.0), name
+
+
+def test_a_640_render_records_its_size_and_a_1280_render_stays_standard():
+    from lanevil_core.labels import image_size_field
+
+    assert image_size_field((640, 360)) == {"image_size": [640, 360]}
+    assert image_size_field((1280, 720)) == {}
