@@ -299,12 +299,13 @@ class LlvmpipeScene:
         self.depth_program = ctx.program(vertex_shader=DEPTH_VERTEX, fragment_shader=DEPTH_FRAGMENT)
         self.id_program = ctx.program(vertex_shader=ID_VERTEX, fragment_shader=ID_FRAGMENT)
         ambient = env.ambient * (0.5 * env.sky_horizon + 0.5 * env.sky_zenith) * 2.2
-        uniforms = {"sun_dir": tuple(env.sun_dir_world), "sun_rgb": tuple(SUN_SCALE * env.sun_intensity
-                                                                           * env.sun_color),
-                    "ambient_rgb": tuple(ambient), "exposure": env.exposure, "inv_white2": 1.0 / WHITE_POINT**2,
-                    "shadow_map": 0}
-        for name, value in uniforms.items():
-            self.camera_program[name].value = tuple(float(x) for x in value) if isinstance(value, tuple) else value
+        vectors = {"sun_dir": env.sun_dir_world, "sun_rgb": SUN_SCALE * env.sun_intensity * env.sun_color,
+                   "ambient_rgb": ambient}
+        for name, vector in vectors.items():
+            self.camera_program[name].value = tuple(float(x) for x in vector)
+        self.camera_program["exposure"].value = float(env.exposure)
+        self.camera_program["inv_white2"].value = 1.0 / WHITE_POINT**2
+        self.camera_program["shadow_map"].value = 0  # texture unit
         self.sky_rgb = tone_map(SKY_SCALE * env.sky_horizon, env.exposure) / 255.0
 
     def _buffers(self, packed: PackedScene, v_shifted: FloatArray) -> None:
@@ -382,11 +383,10 @@ def our_renderer(threads: int | None) -> Callable[[CompiledScene, int, tuple[int
     takes_threads = "threads" in inspect.signature(render_frame).parameters
     if threads is not None and not takes_threads:
         print(f"note: render_frame takes no threads argument here; --threads {threads} is ignored")
+    options: dict[str, Any] = {"threads": threads} if threads is not None and takes_threads else {}
 
     def draw(scene: CompiledScene, frame: int, size: tuple[int, int]) -> UInt8Array:
-        if threads is not None and takes_threads:
-            return render_frame(scene, frame, size, threads=threads).rgb  # type: ignore[call-arg]
-        return render_frame(scene, frame, size).rgb
+        return render_frame(scene, frame, size, **options).rgb
 
     return draw
 
