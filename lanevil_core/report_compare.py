@@ -73,6 +73,7 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
         lines.append("")
     if baseline is not None:
         lines += defence_table(sorted(detectors, key=lambda d: d.name != baseline))
+    lines += type_table(detectors)
     lines += ["## Accuracy drop by severity (all categories)", "",
               "| Detector | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
               "|---|---:|" + "---:|" * len(LEVELS)]
@@ -82,6 +83,42 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
         cells += [_pct(row.gap("accuracy", level), signed=True) for level in LEVELS]
         lines.append(f"| {detector.name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def grows_with_level(row: Row) -> bool:
+    """Whether the accuracy drop against the originals never shrinks from level 1 to level 5."""
+    drops = [row.gap("accuracy", level) for level in LEVELS]
+    known = [d for d in drops if d is not None]
+    return len(known) == len(drops) and all(b <= a + 1e-12 for a, b in zip(known, known[1:]))
+
+
+def type_table(detectors: list[Detector]) -> list[str]:
+    """Markdown lines: per illusion type, each detector's level-5 accuracy drop, marked ``↑`` where the drop grows
+    with the level (never shrinks from level 1 to 5); the last row is the level-5 drop averaged over the types."""
+    keyed = [{(row.category, row.type): row for row in d.report.rows if ALL not in (row.category, row.type)}
+             for d in detectors]
+    types = list(keyed[0]) + [key for rows in keyed[1:] for key in rows if key not in keyed[0]]
+    if not types:
+        return []
+    lines = ["## Level-5 drop by type", "",
+             "Accuracy at level 5 minus the originals', per type; `↑` = the drop grows with the level (levels 1-5). "
+             "The last row averages the types (each type counts once).", "",
+             "| Category | Type | " + " | ".join(d.name for d in detectors) + " |",
+             "|---|---|" + "---:|" * len(detectors)]
+    for category, type_name in types:
+        cells = []
+        for rows in keyed:
+            row = rows.get((category, type_name))
+            gap = None if row is None else row.gap("accuracy", LEVELS[-1])
+            cells.append(_pct(gap, signed=True) + (" ↑" if row is not None and grows_with_level(row) else ""))
+        lines.append(f"| {category} | {type_name} | " + " | ".join(cells) + " |")
+    means = []
+    for rows in keyed:
+        gaps = [g for g in (row.gap("accuracy", LEVELS[-1]) for row in rows.values()) if g is not None]
+        growing = sum(grows_with_level(row) for row in rows.values())
+        means.append(f"{_pct(sum(gaps) / len(gaps), signed=True)} ({growing}/{len(rows)} ↑)" if gaps else "-")
+    lines += ["| **Mean over types** | | " + " | ".join(means) + " |", ""]
+    return lines
 
 
 def defence_table(detectors: list[Detector]) -> list[str]:

@@ -144,3 +144,18 @@ def test_paint_free_control_and_several_detectors(tmp_path):
     paths = write_comparison(detectors, tmp_path, "ganet", "vanilla")
     assert (tmp_path / "compare.png").read_bytes()[:4] == b"\x89PNG" and (tmp_path / "aam" / "report.md").is_file()
     assert len(paths) == 3 + 2 * 4
+
+
+def test_level5_drop_by_type_marks_drops_that_grow_with_the_level():
+    from lanevil_core.report_compare import Detector, grows_with_level, type_table
+
+    def ladder(type_name: str, accuracies: list[float]) -> list[ScoredImage]:
+        return [scored("Shadow", type_name, level, acc) for level, acc in enumerate(accuracies)]
+
+    report = build_report(ladder("Fence", [0.9, 0.9, 0.85, 0.85, 0.7, 0.5])
+                          + ladder("Wire", [0.9, 0.8, 0.85, 0.8, 0.8, 0.8]), "ganet")
+    rows = {row.type: row for row in report.rows}
+    assert grows_with_level(rows["Fence"]) and not grows_with_level(rows["Wire"])
+    lines = type_table([Detector("a", report)])
+    assert "| Shadow | Fence | -40.00 ↑ |" in lines and "| Shadow | Wire | -10.00 |" in lines
+    assert "| **Mean over types** | | -25.00 (1/2 ↑) |" in lines
