@@ -50,7 +50,7 @@ class AamSettings:
     hard_share: float = 0.35  # share of the bank kept as hard examples each epoch
     probability: float = 0.5  # share of training images mixed
     mask_blur_px: float = 1.0  # softening of the patch mask at the network's input size
-    attention_spread_px: int = 6  # the lanes' attention widened to the area around them (box radius, 2 passes)
+    attention_spread_px: int = 0  # widen the lanes' attention to the area around them (box radius px, 2 passes)
 
 
 @dataclass

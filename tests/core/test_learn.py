@@ -21,12 +21,11 @@ from lanevil_core.detect.lane_slots import (  # noqa: E402
     encode_row_anchors,
     lane_lines,
     mirror_slots,
-    on_tusimple_grid,
 )
 from lanevil_core.detect.learned import LearnedDetector, lanes_of, shipped_model_dir  # noqa: E402
 from lanevil_core.detect.model_spec import ModelSpec  # noqa: E402
 from lanevil_core.detect.split import detect_split  # noqa: E402
-from lanevil_core.labels import TUSIMPLE_H_SAMPLES  # noqa: E402
+from lanevil_core.labels import TUSIMPLE_H_SAMPLES, on_tusimple_grid  # noqa: E402
 from lanevil_core.metrics.tusimple import score_image  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
