@@ -6,7 +6,8 @@
    the illusion's own pixels: the pixels of its meshes (object ids) and every pixel whose luminance it changes by
    more than ``illusion_effect.CHANGED_LEVEL`` (its shadows, streaks, surface layers), softened by a small blur.
 2. **Hard examples.** Before every epoch after the first, the current model scores the bank (TuSimple accuracy of
-   each frame against its labels); the ``hard_share`` lowest-scoring patches are the ones mixed in that epoch.
+   each frame against its labels); the ``hard_share`` lowest-scoring patches of each illusion type are the ones
+   mixed in that epoch.
 3. **Mixing.** For a training image ``x`` (a share ``probability`` of each batch) the model's own attention ``A``
    (its lane probability, 1 - background, of the lane-mask head: the segmentation output of ``seg``, the
    auxiliary head of ``ufld``; widened to the area around the lanes by ``attention_spread_px`` and normalised to
@@ -122,10 +123,18 @@ def build_bank(clean_cases: list[Path], input_size: tuple[int, int], seed: int,
 
 
 def hard_patches(patches: list[HardPatch], share: float) -> list[HardPatch]:
-    """The ``share`` of the bank with the lowest accuracy (ties in bank order)."""
-    keep = max(1, int(round(len(patches) * share)))
-    order = sorted(range(len(patches)), key=lambda i: (patches[i].accuracy, i))
-    return [patches[i] for i in order[:keep]]
+    """The ``share`` of each illusion type's bank patches with the lowest accuracy (at least one per type; ties in
+    bank order), in bank order.
+
+    Taken per type, not over the whole bank: the night-time street-light reflections score lowest of all, and a
+    bank-wide cut would keep little else, teaching the model one illusion while it forgets the daytime scenes.
+    """
+    chosen: set[int] = set()
+    for illusion_type in sorted({p.illusion_type for p in patches}):
+        members = [i for i, p in enumerate(patches) if p.illusion_type == illusion_type]
+        keep = max(1, int(round(len(members) * share)))
+        chosen.update(sorted(members, key=lambda i: (patches[i].accuracy, i))[:keep])
+    return [patches[i] for i in sorted(chosen)]
 
 
 def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: int = 0) -> torch.Tensor:

@@ -197,6 +197,18 @@ def test_aam_attention_spreads_around_the_lanes_and_peaks_at_one():
     assert float(wide[0, 10, 0]) < 0.05  # far from the lane it stays out
 
 
+def test_hard_examples_are_the_hardest_of_every_illusion_type():
+    from lanevil_core.learn.aam import HardPatch, hard_patches
+
+    def patch(kind: str, accuracy: float) -> HardPatch:
+        return HardPatch(np.zeros((2, 2, 3), np.uint8), np.zeros((2, 2), np.float32), {}, (2, 2), "", kind, accuracy)
+
+    bank = [patch("streetlight_reflection", 0.1), patch("streetlight_reflection", 0.2),
+            patch("streetlight_reflection", 0.3), patch("road_crack", 0.9), patch("road_crack", 0.8)]
+    hard = hard_patches(bank, 0.34)
+    assert [(p.illusion_type, p.accuracy) for p in hard] == [("streetlight_reflection", 0.1), ("road_crack", 0.8)]
+
+
 def test_aam_bank_never_holds_a_test_case():
     import hashlib
 
