@@ -165,22 +165,23 @@ class StreetlightShadowLevel(SunAheadLevel):
 
 @register
 class StreetlightShadow(SunShadowIllusion):
-    """Rows of street lamps whose long low-sun shadows stripe the lanes."""
+    """Rows of street lamps whose shadows, poles and arms, stripe the lanes."""
 
-    # One low, hard sun from the same bearing at every level (the scene's light does not change between levels);
-    # the level makes the lamps taller, thicker and closer, so their shadows reach further across the lanes and
-    # stripe more of them.
+    # One high, hard sun from the lamps' side, nearly square-on, at every level (the scene's light does not change
+    # between levels): high enough that the buildings of a street canyon leave the carriageway lit, so the lamps'
+    # shadows, not the buildings', fall on the lanes. The level makes the lamps taller, thicker, with longer arms
+    # and closer together, so their shadows reach further across the lanes and stripe more of them.
     SEVERITY: ClassVar[tuple[StreetlightShadowLevel, ...]] = (
-        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=50.0,
+        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=50.0,
                                pole_height=6.0, pole_radius=0.08, arm=0.6),  # a few thin lamps, short shadows
-        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=38.0,
-                               pole_height=7.0, pole_radius=0.11, arm=1.0),
-        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=29.0,
-                               pole_height=8.0, pole_radius=0.14, arm=1.4),
-        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=22.0,
-                               pole_height=9.0, pole_radius=0.17, arm=1.8),
-        StreetlightShadowLevel(sun_altitude=40.0, sun_ahead=50.0, sun_intensity=1.2, penumbra=0.008, spacing=17.0,
-                               pole_height=10.0, pole_radius=0.20,
+        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=38.0,
+                               pole_height=7.5, pole_radius=0.11, arm=1.0),
+        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=29.0,
+                               pole_height=9.0, pole_radius=0.14, arm=1.4),
+        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=22.0,
+                               pole_height=10.5, pole_radius=0.17, arm=1.8),
+        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=17.0,
+                               pole_height=12.0, pole_radius=0.20,
                                arm=2.2),  # tall, thick, dense: shadows over every lane
     )
 
