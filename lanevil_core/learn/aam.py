@@ -126,8 +126,9 @@ def hard_patches(patches: list[HardPatch], share: float) -> list[HardPatch]:
     """The ``share`` of each illusion type's bank patches with the lowest accuracy (at least one per type; ties in
     bank order), in bank order.
 
-    Taken per type, not over the whole bank: the night-time street-light reflections score lowest of all, and a
-    bank-wide cut would keep little else, teaching the model one illusion while it forgets the daytime scenes.
+    Taken per type, not over the whole bank: a bank-wide cut keeps every patch of the types that fool the model
+    most (all the night-time street-light reflections) and almost none of the others, so the model would train
+    against a few illusions only.
     """
     chosen: set[int] = set()
     for illusion_type in sorted({p.illusion_type for p in patches}):
