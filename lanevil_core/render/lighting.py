@@ -133,28 +133,3 @@ def glossy_lobe(n_dot_h: float, exponent: float, normalisation: float, cutoff: f
     if n_dot_h <= cutoff:
         return 0.0
     return normalisation * np.exp(exponent * np.log(n_dot_h))
-
-
-@kernel
-def min_pool(maps: np.ndarray, shift: int) -> np.ndarray:
-    """(C, S >> shift, S >> shift): the nearest caster depth in each 2**shift square of every cascade and its
-    eight neighbours (so one lookup answers "is any caster near enough to shade this point?")."""
-    cascades, size, _ = maps.shape
-    cells = size >> shift
-    pooled = np.full((cascades, cells, cells), np.inf, np.float32)
-    for c in range(cascades):
-        for y in range(size):
-            for x in range(size):
-                v = maps[c, y, x]
-                if v < pooled[c, y >> shift, x >> shift]:
-                    pooled[c, y >> shift, x >> shift] = v
-    out = np.full((cascades, cells, cells), np.inf, np.float32)
-    for c in range(cascades):
-        for y in range(cells):
-            for x in range(cells):
-                nearest = np.inf
-                for j in range(max(y - 1, 0), min(y + 2, cells)):
-                    for i in range(max(x - 1, 0), min(x + 2, cells)):
-                        nearest = min(nearest, pooled[c, j, i])
-                out[c, y, x] = nearest
-    return out

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..typed import Float32Array, IntArray
 from ._jit import kernel
+from .bands import band_rows, in_band, run_bands
 
 
 @dataclass(frozen=True)
@@ -39,9 +40,9 @@ def _edge(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> f
 def _fill(
     sx: np.ndarray, sy: np.ndarray, sw: np.ndarray, b1: np.ndarray, b2: np.ndarray, depth_v: np.ndarray,
     face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool,
-    attributes: bool = True,
+    attributes: bool, band: int, bands: int,
 ) -> None:
-    """Scan-convert one screen-space triangle (vertices 0, 1, 2 of the small arrays).
+    """Scan-convert the rows of band ``band`` of one screen-space triangle (vertices 0, 1, 2 of the small arrays).
 
     With ``attributes`` False only the depth buffer is written (shadow maps).
     """
@@ -55,6 +56,8 @@ def _fill(
     x_lo_f = min(sx[0], sx[1], sx[2])
     x_hi_f = max(sx[0], sx[1], sx[2])
     for row in range(y_min, y_max + 1):
+        if not in_band(row, band, bands):
+            continue
         py = row + 0.5
         # Solve the three edge inequalities for the covered x interval of this row.
         lo, hi = x_lo_f - 0.5, x_hi_f + 0.5
@@ -101,7 +104,7 @@ def _fill(
 @kernel
 def _raster_perspective(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, fx: float, fy: float, cx: float, cy: float,
-    near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+    near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
 ) -> None:
     height, width = depth_buf.shape
     # Clipped polygon: up to 4 vertices, each with position and its weights of the original vertices 1 and 2.
@@ -164,13 +167,13 @@ def _raster_perspective(
                 sw[m] = inv
                 tb1[m], tb2[m] = pb1[q], pb2[q]
                 dz[m] = pz[q]
-            _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, True)
+            _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, True, True, band, bands)
 
 
 @kernel
 def _raster_orthographic(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float,
-    face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+    face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
 ) -> None:
     height, width = depth_buf.shape
     sx = np.empty(3)
@@ -190,7 +193,7 @@ def _raster_orthographic(
             continue
         if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
             continue
-        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False)
+        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False, band, bands)
 
 
 def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Array]:
@@ -200,25 +203,50 @@ def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Ar
 
 def rasterize_perspective(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
-    fx: float, fy: float, cx: float, cy: float, near: float,
+    fx: float, fy: float, cx: float, cy: float, near: float, threads: int = 1,
 ) -> Fragments:
     """Rasterize faces ``face_ids`` of a mesh whose vertices (n, 3) are in an OpenCV camera frame.
 
-    Faces crossing the near plane are clipped; depth is camera z.
+    Faces crossing the near plane are clipped; depth is camera z. Each of ``threads`` row bands walks every face
+    in order, so the depth test resolves ties as one thread would.
     """
     width, height = size
     face_buf, depth_buf, bary_buf = _buffers(height, width)
-    _raster_perspective(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), fx, fy, cx, cy,
-                        near, face_buf, depth_buf, bary_buf)
+    v_camera = np.ascontiguousarray(v_view, np.float64)
+    ids = face_ids.astype(np.int32)
+    run_bands(lambda band, bands: _raster_perspective(v_camera, faces, ids, fx, fy, cx, cy, near, face_buf,
+                                                      depth_buf, bary_buf, band, bands), threads)
     return Fragments(face_buf, depth_buf, bary_buf)
 
 
 def depth_orthographic(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
+    threads: int = 1,
 ) -> Float32Array:
     """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping)."""
     width, height = size
     depth_buf = np.full((height, width), np.inf, np.float32)
-    _raster_orthographic(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), scale, u0, v0,
-                         np.empty((1, 1), np.int32), depth_buf, np.empty((1, 1, 2), np.float32))
+    v_view = np.ascontiguousarray(v_view, np.float64)
+    ids = face_ids.astype(np.int32)
+    no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)
+    run_bands(lambda band, bands: _raster_orthographic(v_view, faces, ids, scale, u0, v0, no_faces, depth_buf,
+                                                       no_bary, band, bands), threads)
     return depth_buf
+
+
+@kernel
+def _lookup_rows(face_buf: np.ndarray, per_face: np.ndarray, empty: int, out: np.ndarray, band: int,
+                 bands: int) -> None:
+    height, width = face_buf.shape
+    for row in band_rows(height, band, bands):
+        for col in range(width):
+            f = face_buf[row, col]
+            out[row, col] = per_face[max(f, 0)] if f >= 0 else empty
+
+
+def per_pixel(face_buf: IntArray, per_face: IntArray, empty: int, threads: int = 1) -> IntArray:
+    """(H, W) int32 ``per_face[face]`` of every pixel's face, ``empty`` where nothing was drawn."""
+    out = np.empty(face_buf.shape, np.int32)
+    table = np.ascontiguousarray(per_face, np.int32)
+    run_bands(lambda band, bands: _lookup_rows(face_buf, table, empty, out, band, bands), threads)
+    return out

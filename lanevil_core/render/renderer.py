@@ -11,11 +11,12 @@ from ..camera import PinholeCamera
 from ..paint import MATERIAL_ALBEDO
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
+from .bands import run_bands
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
-from .raster import rasterize_perspective
-from .shading import shade, shade_mirror
-from .shadow_map import ShadowMaps, build_shadow_maps
+from .raster import per_pixel, rasterize_perspective
+from .shading import FOG_DENSITY, FOG_DISTANCE, fog_table, shade, shade_mirror
+from .shadow_map import CascadeCache, ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
 MIRROR_BLUR_PX_AT_1280 = 10
@@ -52,7 +53,8 @@ def _no_shadows() -> ShadowMaps:
                       np.array([[0.0, 0.0, 1.0]]), np.eye(3))
 
 
-def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera) -> tuple[np.ndarray, np.ndarray]:
+def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera,
+                 threads: int) -> tuple[np.ndarray, np.ndarray]:
     """Objects mirrored about the ground under them, rasterized and flat-shaded, blurred along columns."""
     k = camera.intrinsics
     env = scene.env
@@ -63,13 +65,16 @@ def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamer
     v_world = packed.vertices.copy()
     v_world[:, 2] = 2.0 * ground - v_world[:, 2]
     frags = rasterize_perspective(camera.world_to_camera(v_world), packed.faces, packed.mirror_faces,
-                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near, threads)
     img = np.zeros((k.height, k.width, 3), np.float64)
     lamp = 0.05 * len(scene.lights) if env.night else 0.0
-    shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission, packed.face_normal,
-                 env.sun_dir_world, env.sun_color.astype(np.float64), _env_vector(env),
-                 env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64), lamp, img)
-    blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)))
+    env_f = _env_vector(env)
+    sun_color, zenith, horizon = (env.sun_color.astype(np.float64), env.sky_zenith.astype(np.float64),
+                                  env.sky_horizon.astype(np.float64))
+    run_bands(lambda band, bands: shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission,
+                                               packed.face_normal, env.sun_dir_world, sun_color, env_f, zenith,
+                                               horizon, lamp, img, band, bands), threads)
+    blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)), threads)
     return img, frags.depth
 
 
@@ -112,12 +117,23 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
     return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
 
 
-def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None) -> Frame:
-    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV)."""
-    return render_view(scene, scene.ego.camera(frame, size))
+def _cascade_cache(scene: CompiledScene) -> CascadeCache:
+    """The scene's cache of drawn shadow cascades (its casters never change once packed)."""
+    cache = scene.cache.get("shadow_cascades")
+    if cache is None:
+        cache = scene.cache.setdefault("shadow_cascades", CascadeCache())
+    return cache
 
 
-def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:
+def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None, threads: int = 1) -> Frame:
+    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV).
+
+    ``threads`` row bands of every stage run in parallel; the bytes are those of one thread.
+    """
+    return render_view(scene, scene.ego.camera(frame, size), threads)
+
+
+def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -> Frame:
     """Render ``scene`` from any camera (e.g. ``camera.pose_camera`` of a vehicle driven in closed loop)."""
     timings: dict[str, float] = {}
     clock = time.perf_counter()
@@ -133,32 +149,39 @@ def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:
     env = scene.env
     lap("setup")
     frags = rasterize_perspective(camera.world_to_camera(packed.vertices), packed.faces, packed.camera_faces,
-                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near, threads)
     lap("raster")
-    shadows = (build_shadow_maps(packed, camera, env.sun_dir_world)
+    shadows = (build_shadow_maps(packed, camera, env.sun_dir_world, threads=threads, cache=_cascade_cache(scene))
                if env.sun_intensity > 0 and packed.shadow_faces.size else _no_shadows())
     lap("shadow_map")
     if _needs_mirror(scene, packed):
-        refl_rgb, refl_depth = _mirror_pass(packed, scene, camera)
+        refl_rgb, refl_depth = _mirror_pass(packed, scene, camera, threads)
     else:
         refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
     lap("mirror")
     hdr = np.empty((k.height, k.width, 3), np.float32)
     fine, coarse = noise_textures()
-    shade(frags.face, frags.depth, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
-          packed.face_grad_st, camera.R_world_camera, camera.p_world_camera,
-          k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
-          packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
-          float(scene.network.lanes_per_direction), scene.network.lane_width,
-          packed.layers.texels, packed.layers.table, packed.layers.first_level, _frame_lights(packed, camera, env),
-          fine, coarse,
-          _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
-          env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
-          shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world,
-          packed.overhead, packed.overhead_params, refl_rgb, refl_depth, hdr)
+    env_f = _env_vector(env)
+    lights = _frame_lights(packed, camera, env)
+    sun_color, zenith, horizon = (env.sun_color.astype(np.float64), env.sky_zenith.astype(np.float64),
+                                  env.sky_horizon.astype(np.float64))
+    fog_lut = fog_table(env_f[FOG_DENSITY], env_f[FOG_DISTANCE])
+    lanes = float(scene.network.lanes_per_direction)
+
+    def shade_band(band: int, bands: int) -> None:
+        shade(frags.face, frags.depth, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
+              packed.face_grad_st, camera.R_world_camera, camera.p_world_camera,
+              k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission,
+              packed.face_gloss, packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
+              lanes, scene.network.lane_width, packed.layers.texels, packed.layers.table, packed.layers.first_level,
+              lights, fine, coarse, env_f, env.sun_dir_world, sun_color, zenith, horizon,
+              shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world,
+              packed.overhead, packed.overhead_params, refl_rgb, refl_depth, fog_lut, hdr, band, bands)
+
+    run_bands(shade_band, threads)
     lap("shade")
-    object_id = np.where(frags.face >= 0, packed.face_object[np.maximum(frags.face, 0)], ID_SKY).astype(np.int32)
+    object_id = per_pixel(frags.face, packed.face_object, ID_SKY, threads)
     rgb = np.empty((k.height, k.width, 3), np.uint8)
-    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb)
+    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb, threads)
     lap("post")
     return Frame(rgb, frags.depth, object_id, camera, timings)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import kernel
+from .bands import band_rows
 from .lighting import (
     SUN_SCALE,
     fresnel_schlick,
@@ -31,6 +32,12 @@ FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 
 
+def fog_table(density: float, start_m: float) -> np.ndarray:
+    """(FOG_LUT_SIZE,) float64 share of fog at distance (i + 0.5) / FOG_LUT_PER_M metres."""
+    distance_m = (np.arange(FOG_LUT_SIZE) + 0.5) / FOG_LUT_PER_M
+    return 1.0 - np.exp(-density * np.maximum(distance_m - start_m, 0.0))
+
+
 @kernel(inline="always")
 def coordinate_step(gx: float, gy: float, gz: float, ux: float, uy: float, uz: float, vx: float, vy: float,
                     vz: float) -> float:
@@ -44,9 +51,10 @@ def shade(
     face_material, face_color, face_emission, face_gloss, face_normal, material_albedo,
     stripes, stripe_index, lanes, lane_width, layer_texels, layer_table, layer_first, lights,
     noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
-    shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, out,
+    shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, fog_lut,
+    out, band, bands,
 ):
-    """Linear radiance of every pixel into ``out`` (H, W, 3). Per-pixel state lives in scalars (registers)."""
+    """Linear radiance of the pixels of one row band into ``out`` (H, W, 3). Per-pixel state lives in scalars."""
     height, width = face_buf.shape
     amb_r = env_f[AMBIENT] * (0.5 * horizon[0] + 0.5 * zenith[0]) * 2.2
     amb_g = env_f[AMBIENT] * (0.5 * horizon[1] + 0.5 * zenith[1]) * 2.2
@@ -58,11 +66,8 @@ def shade(
     sun_r, sun_g, sun_b = (SUN_SCALE * sun_i * sun_color[0], SUN_SCALE * sun_i * sun_color[1],
                            SUN_SCALE * sun_i * sun_color[2])
     wetness, puddles, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[CLOUD], env_f[PENUMBRA]
-    fog_lut = np.empty(FOG_LUT_SIZE)
-    for i in range(FOG_LUT_SIZE):
-        fog_lut[i] = 1.0 - np.exp(-env_f[FOG_DENSITY] * max((i + 0.5) / FOG_LUT_PER_M - env_f[FOG_DISTANCE], 0.0))
     last_fog = FOG_LUT_SIZE - 1
-    for row in range(height):
+    for row in band_rows(height, band, bands):
         y_cam = (row + 0.5 - cy) / fy
         for col in range(width):
             x_cam = (col + 0.5 - cx) / fx
@@ -232,10 +237,10 @@ def shade(
 
 @kernel
 def shade_mirror(face_buf, depth_buf, face_color, face_emission, face_normal, sun_dir, sun_color, env_f,
-                 zenith, horizon, lights_rgb_scale, out):
-    """Flat-shade the mirrored objects (no shadows): what a wet road reflects."""
+                 zenith, horizon, lights_rgb_scale, out, band, bands):
+    """Flat-shade the mirrored objects (no shadows) of one row band: what a wet road reflects."""
     height, width = face_buf.shape
-    for row in range(height):
+    for row in band_rows(height, band, bands):
         for col in range(width):
             f = face_buf[row, col]
             if f < 0:

@@ -6,19 +6,24 @@ the ground part of one slice of the camera frustum, snapped to whole texels so s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
-from .lighting import COARSE_SHIFT, min_pool
+from ._jit import kernel
+from .bands import band_rows, run_bands
+from .lighting import COARSE_SHIFT
 from .packed import PackedScene
 from .raster import depth_orthographic
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)
 CASCADE_SIZE = 1024  # at 1280 pixels wide
 GROUND_BAND_M = (-4.0, 14.0)  # heights around the camera's ground that receive shadows worth mapping
+CACHED_CASCADES = 6  # two frames' worth: a cascade whose snapped origin stays put is not drawn again
 
 
 @dataclass(frozen=True)
@@ -63,23 +68,115 @@ def cascade_size(image_width: int) -> int:
     return int(min(max(2 ** round(np.log2(image_width * CASCADE_SIZE / 1280)), 256), 2048))
 
 
+@kernel
+def _pool_cells(depth: np.ndarray, shift: int, pooled: np.ndarray, band: int, bands: int) -> None:
+    """The nearest caster depth of every 2**shift square of one map, for the cell rows of one band."""
+    size = depth.shape[0]
+    cells = size >> shift
+    for cell_y in band_rows(cells, band, bands):
+        for y in range(cell_y << shift, (cell_y + 1) << shift):
+            for x in range(size):
+                v = depth[y, x]
+                if v < pooled[cell_y, x >> shift]:
+                    pooled[cell_y, x >> shift] = v
+
+
+@kernel
+def _dilate_cells(pooled: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
+    """Every cell's minimum over itself and its eight neighbours, for the cell rows of one band."""
+    cells = pooled.shape[0]
+    for y in band_rows(cells, band, bands):
+        for x in range(cells):
+            nearest = np.inf
+            for j in range(max(y - 1, 0), min(y + 2, cells)):
+                for i in range(max(x - 1, 0), min(x + 2, cells)):
+                    nearest = min(nearest, pooled[j, i])
+            out[y, x] = nearest
+
+
+def min_pool(depth: Float32Array, shift: int, threads: int = 1) -> Float32Array:
+    """(S >> shift, S >> shift): the nearest caster depth in each 2**shift square of a map and its eight
+    neighbours (so one lookup answers "is any caster near enough to shade this point?")."""
+    cells = depth.shape[0] >> shift
+    pooled = np.full((cells, cells), np.inf, np.float32)
+    run_bands(lambda band, bands: _pool_cells(depth, shift, pooled, band, bands), threads)
+    out = np.empty((cells, cells), np.float32)
+    run_bands(lambda band, bands: _dilate_cells(pooled, out, band, bands), threads)
+    return out
+
+
+CascadeKey = tuple[bytes, int, float, float, float]
+
+
+@dataclass
+class CascadeCache:
+    """Rasterized cascades of one caster set (a packed scene's), most recent last.
+
+    A cascade is fully determined by the sun direction, its size and its snapped origin and texel, so a key of
+    those finds a map that is byte-identical to drawing it again. The casters of a packed scene never change;
+    a scene whose objects change is compiled and packed anew and gets a new cache.
+    """
+
+    entries: OrderedDict[CascadeKey, tuple[Float32Array, Float32Array]] = field(default_factory=OrderedDict)
+    lock: threading.Lock = field(default_factory=threading.Lock)
+    hits: int = 0
+
+    def get(self, key: CascadeKey) -> tuple[Float32Array, Float32Array] | None:
+        with self.lock:
+            found = self.entries.get(key)
+            if found is not None:
+                self.entries.move_to_end(key)
+                self.hits += 1
+            return found
+
+    def put(self, key: CascadeKey, maps: tuple[Float32Array, Float32Array]) -> None:
+        with self.lock:
+            self.entries[key] = maps
+            while len(self.entries) > CACHED_CASCADES:
+                self.entries.popitem(last=False)
+
+
+def _cascade_frame(camera: PinholeCamera, R_light_world: FloatArray, near: float, far: float,
+                   size: int) -> tuple[float, float, float]:
+    """(u0, v0, texel) of the cascade covering the frustum slice [near, far]: light-frame origin of its corner
+    texel and the texel's size in metres, snapped to whole power-of-two texels."""
+    p_light = _slice_points_world(camera, near, far) @ R_light_world.T
+    lo, hi = p_light[:, :2].min(axis=0), p_light[:, :2].max(axis=0)
+    extent = float(max(hi - lo)) * 1.05 + 1.0
+    texel = float(2.0 ** np.ceil(np.log2(extent / size)))  # power-of-two texels keep snapping stable
+    u0 = float(np.floor((0.5 * (lo[0] + hi[0]) - 0.5 * size * texel) / texel) * texel)
+    v0 = float(np.floor((0.5 * (lo[1] + hi[1]) - 0.5 * size * texel) / texel) * texel)
+    return u0, v0, texel
+
+
 def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world: FloatArray,
-                      size: int | None = None) -> ShadowMaps:
-    """Rasterize every shadow-casting face into each cascade (``size`` texels a side; default from the image)."""
+                      size: int | None = None, threads: int = 1, cache: CascadeCache | None = None) -> ShadowMaps:
+    """Rasterize every shadow-casting face into each cascade (``size`` texels a side; default from the image).
+
+    With a ``cache`` (of this packed scene's casters), a cascade already drawn for the same sun and snapped
+    origin is reused.
+    """
     size = size if size is not None else cascade_size(camera.intrinsics.width)
     R_light_world = light_rotation(sun_dir_world)
-    v_light = packed.vertices @ R_light_world.T
+    sun_key = np.asarray(sun_dir_world, np.float64).tobytes()
+    v_light: FloatArray | None = None
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
+    coarse = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT), np.float32)
     params = np.zeros((len(CASCADE_FAR_M), 3))
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
-        p_light = _slice_points_world(camera, near, far) @ R_light_world.T
-        lo, hi = p_light[:, :2].min(axis=0), p_light[:, :2].max(axis=0)
-        extent = float(max(hi - lo)) * 1.05 + 1.0
-        texel = 2.0 ** np.ceil(np.log2(extent / size))  # power-of-two texels keep snapping stable
-        u0 = np.floor((0.5 * (lo[0] + hi[0]) - 0.5 * size * texel) / texel) * texel
-        v0 = np.floor((0.5 * (lo[1] + hi[1]) - 0.5 * size * texel) / texel) * texel
-        depth[c] = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0)
+        u0, v0, texel = _cascade_frame(camera, R_light_world, near, far, size)
+        key: CascadeKey = (sun_key, size, u0, v0, texel)
+        maps = cache.get(key) if cache is not None else None
+        if maps is None:
+            if v_light is None:
+                v_light = packed.vertices @ R_light_world.T
+            cascade = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0,
+                                         v0, threads)
+            maps = cascade, min_pool(cascade, COARSE_SHIFT, threads)
+            if cache is not None:
+                cache.put(key, maps)
+        depth[c], coarse[c] = maps
         params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
-    return ShadowMaps(depth, min_pool(depth, COARSE_SHIFT), params, R_light_world)
+    return ShadowMaps(depth, coarse, params, R_light_world)
