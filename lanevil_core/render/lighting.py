@@ -62,11 +62,13 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
 
 @kernel(inline="always")
 def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, n_dot_l: float,
-                   maps: np.ndarray, coarse: np.ndarray, params: np.ndarray, R_light: np.ndarray,
-                   penumbra: float) -> float:
+                   maps: np.ndarray, coarse: np.ndarray, farthest: np.ndarray, params: np.ndarray,
+                   R_light: np.ndarray, penumbra: float) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges.
 
     The depth bias grows with the slope of the surface to the light, so grazing-lit faces do not self-shadow.
+    The soft edge's taps reach less than 2**COARSE_SHIFT texels, so the point's dilated coarse cell answers
+    "all lit" (its nearest caster is behind the point) and "all shaded" (its farthest one is in front) exactly.
     """
     slope = min(np.sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 0.05), 8.0)
     # Normal offset: move the lookup off the surface, more so where the light grazes it.
@@ -86,9 +88,12 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
             continue
         bias = (1.5 + 1.5 * slope) / scale
         # Nearest caster within the point's coarse cell and its neighbours (pre-dilated): none -> fully lit.
-        nearest = coarse[c, int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT]
+        cell_y, cell_x = int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT
+        nearest = coarse[c, cell_y, cell_x]
         if nearest >= d - bias:
             return 1.0
+        if farthest[c, cell_y, cell_x] < d - bias:
+            return 0.0
         # The caster right above the point (else the nearest one around) sets the penumbra width.
         z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
         blocker = z_center if z_center < d - bias else nearest

@@ -86,25 +86,37 @@ def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, o
 
 @kernel
 def _blur_column_band(img: np.ndarray, depth: np.ndarray, radius: int, band: int, bands: int) -> None:
+    """Running box sums down each column of one band: O(height) per column whatever the radius."""
     height, width, _ = img.shape
     column = np.empty((height, 3))
     for col in band_rows(width, band, bands):
         for row in range(height):
             for c in range(3):
                 column[row, c] = img[row, col, c]
+        acc0 = acc1 = acc2 = 0.0
+        cnt = 0
+        for row in range(min(radius, height)):  # the window of row -1: rows 0 .. radius - 1
+            if depth[row, col] < np.inf:
+                acc0 += column[row, 0]
+                acc1 += column[row, 1]
+                acc2 += column[row, 2]
+                cnt += 1
         for row in range(height):
-            if depth[row, col] == np.inf:
-                continue
-            lo = max(row - radius, 0)
-            hi = min(row + radius, height - 1)
-            for c in range(3):
-                acc = 0.0
-                cnt = 0
-                for r in range(lo, hi + 1):
-                    if depth[r, col] < np.inf:
-                        acc += column[r, c]
-                        cnt += 1
-                img[row, col, c] = acc / cnt
+            enter, leave = row + radius, row - radius - 1
+            if enter < height and depth[enter, col] < np.inf:
+                acc0 += column[enter, 0]
+                acc1 += column[enter, 1]
+                acc2 += column[enter, 2]
+                cnt += 1
+            if leave >= 0 and depth[leave, col] < np.inf:
+                acc0 -= column[leave, 0]
+                acc1 -= column[leave, 1]
+                acc2 -= column[leave, 2]
+                cnt -= 1
+            if depth[row, col] < np.inf:
+                img[row, col, 0] = acc0 / cnt
+                img[row, col, 1] = acc1 / cnt
+                img[row, col, 2] = acc2 / cnt
 
 
 def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int, threads: int = 1) -> None:

@@ -15,10 +15,21 @@ from .bands import run_bands
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
 from .raster import per_pixel, rasterize_perspective
-from .shading import FOG_DENSITY, FOG_DISTANCE, fog_table, shade, shade_mirror
+from .shading import (
+    Geometry,
+    Reflection,
+    RoadLook,
+    SunShadow,
+    View,
+    frame_lighting,
+    shade,
+    shade_mirror,
+    surface_table,
+)
 from .shadow_map import CascadeCache, ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
+SURFACE_TABLE = surface_table(MATERIAL_ALBEDO)
 MIRROR_BLUR_PX_AT_1280 = 10
 LAMP_RANGE_M = 75.0
 LAMP_BEHIND_M = 12.0
@@ -50,7 +61,7 @@ def _env_vector(env: Environment) -> np.ndarray:
 
 def _no_shadows() -> ShadowMaps:
     return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1), np.inf, np.float32),
-                      np.array([[0.0, 0.0, 1.0]]), np.eye(3))
+                      np.full((1, 1, 1), np.inf, np.float32), np.array([[0.0, 0.0, 1.0]]), np.eye(3))
 
 
 def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera,
@@ -117,6 +128,18 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
     return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
 
 
+def _geometry(packed: PackedScene) -> Geometry:
+    return Geometry(packed.faces, packed.vertex_st, packed.vertex_piece, packed.face_grad_st, packed.face_normal,
+                    packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss)
+
+
+def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
+    fine, coarse = noise_textures()
+    return RoadLook(SURFACE_TABLE, packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
+                    float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
+                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params)
+
+
 def _cascade_cache(scene: CompiledScene) -> CascadeCache:
     """The scene's cache of drawn shadow cascades (its casters never change once packed)."""
     cache = scene.cache.get("shadow_cascades")
@@ -160,25 +183,15 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
         refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
     lap("mirror")
     hdr = np.empty((k.height, k.width, 3), np.float32)
-    fine, coarse = noise_textures()
-    env_f = _env_vector(env)
-    lights = _frame_lights(packed, camera, env)
-    sun_color, zenith, horizon = (env.sun_color.astype(np.float64), env.sky_zenith.astype(np.float64),
-                                  env.sky_horizon.astype(np.float64))
-    fog_lut = fog_table(env_f[FOG_DENSITY], env_f[FOG_DISTANCE])
-    lanes = float(scene.network.lanes_per_direction)
-
-    def shade_band(band: int, bands: int) -> None:
-        shade(frags.face, frags.depth, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
-              packed.face_grad_st, camera.R_world_camera, camera.p_world_camera,
-              k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission,
-              packed.face_gloss, packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
-              lanes, scene.network.lane_width, packed.layers.texels, packed.layers.table, packed.layers.first_level,
-              lights, fine, coarse, env_f, env.sun_dir_world, sun_color, zenith, horizon,
-              shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world,
-              packed.overhead, packed.overhead_params, refl_rgb, refl_depth, fog_lut, hdr, band, bands)
-
-    run_bands(shade_band, threads)
+    view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)
+    lighting = frame_lighting(_env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
+                              env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
+                              _frame_lights(packed, camera, env))
+    geometry, road = _geometry(packed), _road_look(scene, packed)
+    sun_shadow = SunShadow(shadows.depth, shadows.coarse, shadows.farthest, shadows.params, shadows.R_light_world)
+    reflection = Reflection(refl_rgb, refl_depth)
+    run_bands(lambda band, bands: shade(frags.face, frags.depth, frags.bary, view, geometry, road, lighting,
+                                        sun_shadow, reflection, hdr, band, bands), threads)
     lap("shade")
     object_id = per_pixel(frags.face, packed.face_object, ID_SKY, threads)
     rgb = np.empty((k.height, k.width, 3), np.uint8)

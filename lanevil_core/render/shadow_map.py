@@ -35,7 +35,8 @@ class ShadowMaps:
     """
 
     depth: Float32Array
-    coarse: Float32Array  # (C, S/8, S/8) nearest caster depth per 8x8 texels, for a quick "fully lit" test
+    coarse: Float32Array  # (C, S/8, S/8) nearest caster depth per 8x8 texels and neighbours: "fully lit" test
+    farthest: Float32Array  # (C, S/8, S/8) the farthest (inf: a texel without caster): "fully shaded" test
     params: FloatArray
     R_light_world: FloatArray
 
@@ -69,43 +70,51 @@ def cascade_size(image_width: int) -> int:
 
 
 @kernel
-def _pool_cells(depth: np.ndarray, shift: int, pooled: np.ndarray, band: int, bands: int) -> None:
-    """The nearest caster depth of every 2**shift square of one map, for the cell rows of one band."""
+def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np.ndarray, band: int,
+                bands: int) -> None:
+    """The nearest and the farthest caster depth of every 2**shift square of one map, for one band's cell rows."""
     size = depth.shape[0]
     cells = size >> shift
     for cell_y in band_rows(cells, band, bands):
         for y in range(cell_y << shift, (cell_y + 1) << shift):
             for x in range(size):
                 v = depth[y, x]
-                if v < pooled[cell_y, x >> shift]:
-                    pooled[cell_y, x >> shift] = v
+                nearest[cell_y, x >> shift] = min(nearest[cell_y, x >> shift], v)
+                farthest[cell_y, x >> shift] = max(farthest[cell_y, x >> shift], v)
 
 
 @kernel
-def _dilate_cells(pooled: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
-    """Every cell's minimum over itself and its eight neighbours, for the cell rows of one band."""
-    cells = pooled.shape[0]
+def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, near_out: np.ndarray, far_out: np.ndarray, band: int,
+                  bands: int) -> None:
+    """Every cell's minimum (maximum) over itself and its eight neighbours, for the cell rows of one band."""
+    cells = nearest.shape[0]
     for y in band_rows(cells, band, bands):
         for x in range(cells):
-            nearest = np.inf
+            low = np.inf
+            high = -np.inf
             for j in range(max(y - 1, 0), min(y + 2, cells)):
                 for i in range(max(x - 1, 0), min(x + 2, cells)):
-                    nearest = min(nearest, pooled[j, i])
-            out[y, x] = nearest
+                    low = min(low, nearest[j, i])
+                    high = max(high, farthest[j, i])
+            near_out[y, x] = low
+            far_out[y, x] = high
 
 
-def min_pool(depth: Float32Array, shift: int, threads: int = 1) -> Float32Array:
-    """(S >> shift, S >> shift): the nearest caster depth in each 2**shift square of a map and its eight
-    neighbours (so one lookup answers "is any caster near enough to shade this point?")."""
+def pool_extremes(depth: Float32Array, shift: int, threads: int = 1) -> tuple[Float32Array, Float32Array]:
+    """(nearest, farthest), each (S >> shift, S >> shift): the nearest and the farthest caster depth in each
+    2**shift square of a map and its eight neighbours. One lookup answers "is any caster near enough to shade
+    this point?" and "does every texel around it shade it?" for any filter reaching less than 2**shift texels."""
     cells = depth.shape[0] >> shift
-    pooled = np.full((cells, cells), np.inf, np.float32)
-    run_bands(lambda band, bands: _pool_cells(depth, shift, pooled, band, bands), threads)
-    out = np.empty((cells, cells), np.float32)
-    run_bands(lambda band, bands: _dilate_cells(pooled, out, band, bands), threads)
-    return out
+    nearest = np.full((cells, cells), np.inf, np.float32)
+    farthest = np.full((cells, cells), -np.inf, np.float32)
+    run_bands(lambda band, bands: _pool_cells(depth, shift, nearest, farthest, band, bands), threads)
+    near_out, far_out = np.empty((cells, cells), np.float32), np.empty((cells, cells), np.float32)
+    run_bands(lambda band, bands: _dilate_cells(nearest, farthest, near_out, far_out, band, bands), threads)
+    return near_out, far_out
 
 
 CascadeKey = tuple[bytes, int, float, float, float]
+CascadeMaps = tuple[Float32Array, Float32Array, Float32Array]  # depth, nearest and farthest per coarse cell
 
 
 @dataclass
@@ -117,11 +126,11 @@ class CascadeCache:
     a scene whose objects change is compiled and packed anew and gets a new cache.
     """
 
-    entries: OrderedDict[CascadeKey, tuple[Float32Array, Float32Array]] = field(default_factory=OrderedDict)
+    entries: OrderedDict[CascadeKey, CascadeMaps] = field(default_factory=OrderedDict)
     lock: threading.Lock = field(default_factory=threading.Lock)
     hits: int = 0
 
-    def get(self, key: CascadeKey) -> tuple[Float32Array, Float32Array] | None:
+    def get(self, key: CascadeKey) -> CascadeMaps | None:
         with self.lock:
             found = self.entries.get(key)
             if found is not None:
@@ -129,7 +138,7 @@ class CascadeCache:
                 self.hits += 1
             return found
 
-    def put(self, key: CascadeKey, maps: tuple[Float32Array, Float32Array]) -> None:
+    def put(self, key: CascadeKey, maps: CascadeMaps) -> None:
         with self.lock:
             self.entries[key] = maps
             while len(self.entries) > CACHED_CASCADES:
@@ -162,6 +171,7 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
     v_light: FloatArray | None = None
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
     coarse = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT), np.float32)
+    farthest = np.empty_like(coarse)
     params = np.zeros((len(CASCADE_FAR_M), 3))
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
@@ -173,10 +183,10 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
                 v_light = packed.vertices @ R_light_world.T
             cascade = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0,
                                          v0, threads)
-            maps = cascade, min_pool(cascade, COARSE_SHIFT, threads)
+            maps = (cascade, *pool_extremes(cascade, COARSE_SHIFT, threads))
             if cache is not None:
                 cache.put(key, maps)
-        depth[c], coarse[c] = maps
+        depth[c], coarse[c], farthest[c] = maps
         params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
-    return ShadowMaps(depth, coarse, params, R_light_world)
+    return ShadowMaps(depth, coarse, farthest, params, R_light_world)
