@@ -60,8 +60,8 @@ def _env_vector(env: Environment) -> np.ndarray:
 
 
 def _no_shadows() -> ShadowMaps:
-    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1), np.inf, np.float32),
-                      np.full((1, 1, 1), np.inf, np.float32), np.array([[0.0, 0.0, 1.0]]), np.eye(3))
+    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1, 4), np.inf, np.float32),
+                      np.array([[0.0, 0.0, 1.0]]), np.eye(3))
 
 
 def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera,
@@ -188,7 +188,7 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
                               env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
                               _frame_lights(packed, camera, env))
     geometry, road = _geometry(packed), _road_look(scene, packed)
-    sun_shadow = SunShadow(shadows.depth, shadows.coarse, shadows.farthest, shadows.params, shadows.R_light_world)
+    sun_shadow = SunShadow(shadows.depth, shadows.cells, shadows.params, shadows.R_light_world)
     reflection = Reflection(refl_rgb, refl_depth)
     run_bands(lambda band, bands: shade(frags.face, frags.depth, frags.bary, view, geometry, road, lighting,
                                         sun_shadow, reflection, hdr, band, bands), threads)

@@ -16,7 +16,7 @@ from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
 from ._jit import kernel
 from .bands import band_rows, run_bands
-from .lighting import COARSE_SHIFT
+from .lighting import CELL_FAR, CELL_NEAR, COARSE_SHIFT, FAR_AROUND, NEAR_AROUND
 from .packed import PackedScene
 from .raster import depth_orthographic
 
@@ -35,8 +35,7 @@ class ShadowMaps:
     """
 
     depth: Float32Array
-    coarse: Float32Array  # (C, S/8, S/8) nearest caster depth per 8x8 texels and neighbours: "fully lit" test
-    farthest: Float32Array  # (C, S/8, S/8) the farthest (inf: a texel without caster): "fully shaded" test
+    cells: Float32Array  # (C, S/8, S/8, 4) per 8x8 texels, see lighting.NEAR_AROUND .. CELL_FAR
     params: FloatArray
     R_light_world: FloatArray
 
@@ -84,9 +83,8 @@ def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np
 
 
 @kernel
-def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, near_out: np.ndarray, far_out: np.ndarray, band: int,
-                  bands: int) -> None:
-    """Every cell's minimum (maximum) over itself and its eight neighbours, for the cell rows of one band."""
+def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
+    """Every cell's own extremes and those over itself and its eight neighbours, for the cell rows of one band."""
     cells = nearest.shape[0]
     for y in band_rows(cells, band, bands):
         for x in range(cells):
@@ -96,25 +94,28 @@ def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, near_out: np.ndarra
                 for i in range(max(x - 1, 0), min(x + 2, cells)):
                     low = min(low, nearest[j, i])
                     high = max(high, farthest[j, i])
-            near_out[y, x] = low
-            far_out[y, x] = high
+            out[y, x, NEAR_AROUND] = low
+            out[y, x, FAR_AROUND] = high
+            out[y, x, CELL_NEAR] = nearest[y, x]
+            out[y, x, CELL_FAR] = farthest[y, x]
 
 
-def pool_extremes(depth: Float32Array, shift: int, threads: int = 1) -> tuple[Float32Array, Float32Array]:
-    """(nearest, farthest), each (S >> shift, S >> shift): the nearest and the farthest caster depth in each
-    2**shift square of a map and its eight neighbours. One lookup answers "is any caster near enough to shade
-    this point?" and "does every texel around it shade it?" for any filter reaching less than 2**shift texels."""
+def pool_extremes(depth: Float32Array, shift: int, threads: int = 1) -> Float32Array:
+    """(S >> shift, S >> shift, 4): the nearest and the farthest caster depth in each 2**shift square of a map and
+    its eight neighbours, then in the square alone (see lighting.NEAR_AROUND .. CELL_FAR). One lookup answers "is
+    any caster near enough to shade this point?" and "does every texel around it shade it?" for any filter
+    reaching less than 2**shift texels; the squares alone answer it for a filter's own footprint."""
     cells = depth.shape[0] >> shift
     nearest = np.full((cells, cells), np.inf, np.float32)
     farthest = np.full((cells, cells), -np.inf, np.float32)
     run_bands(lambda band, bands: _pool_cells(depth, shift, nearest, farthest, band, bands), threads)
-    near_out, far_out = np.empty((cells, cells), np.float32), np.empty((cells, cells), np.float32)
-    run_bands(lambda band, bands: _dilate_cells(nearest, farthest, near_out, far_out, band, bands), threads)
-    return near_out, far_out
+    out = np.empty((cells, cells, 4), np.float32)
+    run_bands(lambda band, bands: _dilate_cells(nearest, farthest, out, band, bands), threads)
+    return out
 
 
 CascadeKey = tuple[bytes, int, float, float, float]
-CascadeMaps = tuple[Float32Array, Float32Array, Float32Array]  # depth, nearest and farthest per coarse cell
+CascadeMaps = tuple[Float32Array, Float32Array]  # depth, extremes per coarse cell
 
 
 @dataclass
@@ -170,8 +171,7 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
     sun_key = np.asarray(sun_dir_world, np.float64).tobytes()
     v_light: FloatArray | None = None
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
-    coarse = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT), np.float32)
-    farthest = np.empty_like(coarse)
+    cells = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT, 4), np.float32)
     params = np.zeros((len(CASCADE_FAR_M), 3))
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
@@ -183,10 +183,10 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
                 v_light = packed.vertices @ R_light_world.T
             cascade = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0,
                                          v0, threads)
-            maps = (cascade, *pool_extremes(cascade, COARSE_SHIFT, threads))
+            maps = cascade, pool_extremes(cascade, COARSE_SHIFT, threads)
             if cache is not None:
                 cache.put(key, maps)
-        depth[c], coarse[c], farthest[c] = maps
+        depth[c], cells[c] = maps
         params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
-    return ShadowMaps(depth, coarse, farthest, params, R_light_world)
+    return ShadowMaps(depth, cells, params, R_light_world)
