@@ -101,12 +101,26 @@ def _fill(
                 bary_buf[row, col, 1] = p0 * b2[0] + p1 * b2[1] + p2 * b2[2]
 
 
+@kernel(inline="always")
+def _clear_band(face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, attributes: bool, band: int,
+                bands: int) -> None:
+    """Empty the band's rows (its own thread touches them first: they stay in its cache)."""
+    for row in band_rows(depth_buf.shape[0], band, bands):
+        for col in range(depth_buf.shape[1]):
+            depth_buf[row, col] = np.inf
+            if attributes:
+                face_buf[row, col] = -1
+                bary_buf[row, col, 0] = 0.0
+                bary_buf[row, col, 1] = 0.0
+
+
 @kernel
 def _raster_perspective(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, fx: float, fy: float, cx: float, cy: float,
     near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
 ) -> None:
     height, width = depth_buf.shape
+    _clear_band(face_buf, depth_buf, bary_buf, True, band, bands)
     # Clipped polygon: up to 4 vertices, each with position and its weights of the original vertices 1 and 2.
     px = np.empty(4)
     py = np.empty(4)
@@ -176,6 +190,7 @@ def _raster_orthographic(
     face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
 ) -> None:
     height, width = depth_buf.shape
+    _clear_band(face_buf, depth_buf, bary_buf, False, band, bands)
     sx = np.empty(3)
     sy = np.empty(3)
     sw = np.ones(3)
@@ -196,11 +211,6 @@ def _raster_orthographic(
         _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False, band, bands)
 
 
-def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Array]:
-    return (np.full((height, width), -1, np.int32), np.full((height, width), np.inf, np.float32),
-            np.zeros((height, width, 2), np.float32))
-
-
 def rasterize_perspective(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
     fx: float, fy: float, cx: float, cy: float, near: float, threads: int = 1,
@@ -211,7 +221,8 @@ def rasterize_perspective(
     in order, so the depth test resolves ties as one thread would.
     """
     width, height = size
-    face_buf, depth_buf, bary_buf = _buffers(height, width)
+    face_buf, depth_buf = np.empty((height, width), np.int32), np.empty((height, width), np.float32)
+    bary_buf = np.empty((height, width, 2), np.float32)
     v_camera = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
     run_bands(lambda band, bands: _raster_perspective(v_camera, faces, ids, fx, fy, cx, cy, near, face_buf,
@@ -221,11 +232,12 @@ def rasterize_perspective(
 
 def depth_orthographic(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
-    threads: int = 1,
+    threads: int = 1, out: Float32Array | None = None,
 ) -> Float32Array:
-    """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping)."""
+    """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping);
+    into ``out`` when given (a C-contiguous (H, W) float32 array)."""
     width, height = size
-    depth_buf = np.full((height, width), np.inf, np.float32)
+    depth_buf = out if out is not None else np.empty((height, width), np.float32)
     v_view = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
     no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -128,6 +129,12 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
     return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
 
 
+@lru_cache(maxsize=4)
+def _nothing_mirrored(height: int, width: int) -> Float32Array:
+    """(H, W) float32 all inf: the mirror depth of a dry frame (shared; the renderer never writes to it)."""
+    return np.full((height, width), np.inf, np.float32)
+
+
 def _geometry(packed: PackedScene) -> Geometry:
     return Geometry(packed.faces, packed.vertex_st, packed.vertex_piece, packed.face_grad_st, packed.face_normal,
                     packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss)
@@ -180,7 +187,7 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
     if _needs_mirror(scene, packed):
         refl_rgb, refl_depth = _mirror_pass(packed, scene, camera, threads)
     else:
-        refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
+        refl_rgb, refl_depth = np.zeros((1, 1, 3)), _nothing_mirrored(k.height, k.width)
     lap("mirror")
     hdr = np.empty((k.height, k.width, 3), np.float32)
     view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)

@@ -181,12 +181,13 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
         if maps is None:
             if v_light is None:
                 v_light = packed.vertices @ R_light_world.T
-            cascade = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0,
-                                         v0, threads)
-            maps = cascade, pool_extremes(cascade, COARSE_SHIFT, threads)
+            depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0,
+                               threads, out=depth[c])
+            cells[c] = pool_extremes(depth[c], COARSE_SHIFT, threads)
             if cache is not None:
-                cache.put(key, maps)
-        depth[c], cells[c] = maps
+                cache.put(key, (depth[c], cells[c]))  # views of this frame's maps, never written again
+        else:
+            depth[c], cells[c] = maps
         params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
     return ShadowMaps(depth, cells, params, R_light_world)
