@@ -28,6 +28,19 @@ def in_band(row: int, band: int, bands: int) -> bool:
 
 
 @kernel(inline="always")
+def overlaps_band(first: int, last: int, band: int, bands: int) -> bool:
+    """Whether any of the rows ``first`` .. ``last`` belongs to band ``band`` of ``bands``."""
+    if first > last:
+        return False
+    if last - first + 1 >= BAND_ROWS * bands:
+        return True
+    for run in range(first // BAND_ROWS, last // BAND_ROWS + 1):
+        if run % bands == band:
+            return True
+    return False
+
+
+@kernel(inline="always")
 def band_rows(count: int, band: int, bands: int) -> np.ndarray:
     """(k,) int64 the rows (or columns) among ``count`` that belong to band ``band`` of ``bands``, in order."""
     rows = np.empty(count, np.int64)

@@ -7,13 +7,14 @@ pixel, the nearest face id, its depth and perspective-correct barycentric weight
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..typed import Float32Array, IntArray
 from ._jit import kernel
-from .bands import band_rows, in_band, run_bands
+from .bands import band_rows, in_band, overlaps_band, run_bands
 
 
 @dataclass(frozen=True)
@@ -114,28 +115,37 @@ def _clear_band(face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarra
                 bary_buf[row, col, 1] = 0.0
 
 
+# A screen triangle: rows SX, SY, SW (1 / camera z, perspective) of its vertices, then their weights of the
+# source face's 2nd and 3rd vertex (B1, B2) and their view depth (DZ).
+SX, SY, SW, B1, B2, DZ = range(6)
+
+
+@kernel(inline="always")
+def _store(tris: np.ndarray, rows: np.ndarray, slot: int, height: int) -> None:
+    """Record the rows a stored triangle can cover (the same range ``_fill`` scans)."""
+    sy = tris[slot, SY]
+    rows[slot, 0] = max(int(np.floor(min(sy[0], sy[1], sy[2]) - 0.5)) + 1, 0)
+    rows[slot, 1] = min(int(np.floor(max(sy[0], sy[1], sy[2]) - 0.5)), height - 1)
+
+
 @kernel
-def _raster_perspective(
+def _setup_perspective(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, fx: float, fy: float, cx: float, cy: float,
-    near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
+    near: float, width: int, height: int, tris: np.ndarray, rows: np.ndarray, band: int, bands: int,
 ) -> None:
-    height, width = depth_buf.shape
-    _clear_band(face_buf, depth_buf, bary_buf, True, band, bands)
+    """Cull, clip at the near plane and project the band's share of the faces (a contiguous run of them): face k
+    becomes screen triangles in slots 2k and 2k + 1 (an empty slot gets no rows)."""
     # Clipped polygon: up to 4 vertices, each with position and its weights of the original vertices 1 and 2.
     px = np.empty(4)
     py = np.empty(4)
     pz = np.empty(4)
     pb1 = np.empty(4)
     pb2 = np.empty(4)
-    sx = np.empty(3)
-    sy = np.empty(3)
-    sw = np.empty(3)
-    tb1 = np.empty(3)
-    tb2 = np.empty(3)
-    dz = np.empty(3)
     ref_b1 = (0.0, 1.0, 0.0)
     ref_b2 = (0.0, 0.0, 1.0)
-    for k in range(face_ids.size):
+    for k in range(band * face_ids.size // bands, (band + 1) * face_ids.size // bands):
+        rows[2 * k, 0] = rows[2 * k + 1, 0] = 1
+        rows[2 * k, 1] = rows[2 * k + 1, 1] = 0
         f = face_ids[k]
         i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
         z0, z1, z2 = v_view[i0, 2], v_view[i1, 2], v_view[i2, 2]
@@ -174,41 +184,65 @@ def _raster_perspective(
                 pb2[n] = ref_b2[e] + u * (ref_b2[e1] - ref_b2[e])
                 n += 1
         for t in range(1, n - 1):
+            slot = 2 * k + t - 1
             for m, q in enumerate((0, t, t + 1)):
                 inv = 1.0 / pz[q]
-                sx[m] = fx * px[q] * inv + cx
-                sy[m] = fy * py[q] * inv + cy
-                sw[m] = inv
-                tb1[m], tb2[m] = pb1[q], pb2[q]
-                dz[m] = pz[q]
-            _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, True, True, band, bands)
+                tris[slot, SX, m] = fx * px[q] * inv + cx
+                tris[slot, SY, m] = fy * py[q] * inv + cy
+                tris[slot, SW, m] = inv
+                tris[slot, B1, m], tris[slot, B2, m] = pb1[q], pb2[q]
+                tris[slot, DZ, m] = pz[q]
+            _store(tris, rows, slot, height)
 
 
 @kernel
-def _raster_orthographic(
-    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float,
-    face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, band: int, bands: int,
+def _setup_orthographic(
+    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float, width: int,
+    height: int, tris: np.ndarray, rows: np.ndarray, band: int, bands: int,
 ) -> None:
-    height, width = depth_buf.shape
-    _clear_band(face_buf, depth_buf, bary_buf, False, band, bands)
-    sx = np.empty(3)
-    sy = np.empty(3)
-    sw = np.ones(3)
-    tb1 = np.array([0.0, 1.0, 0.0])
-    tb2 = np.array([0.0, 0.0, 1.0])
-    dz = np.empty(3)
-    for k in range(face_ids.size):
+    """Scale the band's share of the faces (a contiguous run) to map texels: face k in slot k."""
+    for k in range(band * face_ids.size // bands, (band + 1) * face_ids.size // bands):
+        rows[k, 0], rows[k, 1] = 1, 0
         f = face_ids[k]
         for m in range(3):
             i = faces[f, m]
-            sx[m] = (v_view[i, 0] - u0) * scale
-            sy[m] = (v_view[i, 1] - v0) * scale
-            dz[m] = v_view[i, 2]
+            tris[k, SX, m] = (v_view[i, 0] - u0) * scale
+            tris[k, SY, m] = (v_view[i, 1] - v0) * scale
+            tris[k, SW, m] = 1.0
+            tris[k, DZ, m] = v_view[i, 2]
+        sx, sy = tris[k, SX], tris[k, SY]
         if max(sx[0], sx[1], sx[2]) < 0 or min(sx[0], sx[1], sx[2]) > width:
             continue
         if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
             continue
-        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False, band, bands)
+        _store(tris, rows, k, height)
+
+
+@kernel
+def _fill_band(
+    tris: np.ndarray, rows: np.ndarray, per_slot: int, face_ids: np.ndarray, face_buf: np.ndarray,
+    depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool, attributes: bool, band: int, bands: int,
+) -> None:
+    """Clear the band's rows, then draw every stored triangle, in face order, into them."""
+    _clear_band(face_buf, depth_buf, bary_buf, attributes, band, bands)
+    for slot in range(rows.shape[0]):
+        if not overlaps_band(rows[slot, 0], rows[slot, 1], band, bands):
+            continue
+        tri = tris[slot]
+        _fill(tri[SX], tri[SY], tri[SW], tri[B1], tri[B2], tri[DZ], face_ids[slot // per_slot], face_buf, depth_buf,
+              bary_buf, perspective, attributes, band, bands)
+
+
+def _draw(setup: Callable[[np.ndarray, np.ndarray, int, int], None], slots: int, per_slot: int, face_ids: IntArray,
+          buffers: tuple[IntArray, Float32Array, Float32Array], perspective: bool, attributes: bool,
+          threads: int) -> None:
+    """Set up every face's screen triangles (bands take runs of faces), then fill (bands take rows)."""
+    tris = np.empty((slots, 6, 3))
+    rows = np.empty((slots, 2), np.int64)
+    run_bands(lambda band, bands: setup(tris, rows, band, bands), threads)
+    face_buf, depth_buf, bary_buf = buffers
+    run_bands(lambda band, bands: _fill_band(tris, rows, per_slot, face_ids, face_buf, depth_buf, bary_buf,
+                                             perspective, attributes, band, bands), threads)
 
 
 def rasterize_perspective(
@@ -225,8 +259,9 @@ def rasterize_perspective(
     bary_buf = np.empty((height, width, 2), np.float32)
     v_camera = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
-    run_bands(lambda band, bands: _raster_perspective(v_camera, faces, ids, fx, fy, cx, cy, near, face_buf,
-                                                      depth_buf, bary_buf, band, bands), threads)
+    _draw(lambda tris, rows, band, bands: _setup_perspective(v_camera, faces, ids, fx, fy, cx, cy, near, width,
+                                                             height, tris, rows, band, bands),
+          2 * ids.size, 2, ids, (face_buf, depth_buf, bary_buf), True, True, threads)
     return Fragments(face_buf, depth_buf, bary_buf)
 
 
@@ -241,8 +276,9 @@ def depth_orthographic(
     v_view = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
     no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)
-    run_bands(lambda band, bands: _raster_orthographic(v_view, faces, ids, scale, u0, v0, no_faces, depth_buf,
-                                                       no_bary, band, bands), threads)
+    _draw(lambda tris, rows, band, bands: _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height,
+                                                              tris, rows, band, bands),
+          ids.size, 1, ids, (no_faces, depth_buf, no_bary), False, False, threads)
     return depth_buf
 
 
