@@ -13,6 +13,7 @@ from ..paint import MATERIAL_ALBEDO
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
 from .bands import run_bands
+from .lighting import face_sun_terms
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
 from .raster import per_pixel, rasterize_perspective
@@ -147,6 +148,16 @@ def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
                     packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params)
 
 
+def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:
+    """The packed faces' ``face_sun_terms`` for the scene's sun (kept while the sun stays)."""
+    key = np.asarray(scene.env.sun_dir_world, np.float64).tobytes()
+    cached = scene.cache.get("sun_terms")
+    if cached is None or cached[0] != key:
+        cached = key, face_sun_terms(packed.face_normal, scene.env.sun_dir_world)
+        scene.cache["sun_terms"] = cached
+    return cached[1]
+
+
 def _cascade_cache(scene: CompiledScene) -> CascadeCache:
     """The scene's cache of drawn shadow cascades (its casters never change once packed)."""
     cache = scene.cache.get("shadow_cascades")
@@ -195,7 +206,8 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
                               env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
                               _frame_lights(packed, camera, env))
     geometry, road = _geometry(packed), _road_look(scene, packed)
-    sun_shadow = SunShadow(shadows.depth, shadows.cells, shadows.params, shadows.R_light_world)
+    sun_shadow = SunShadow(shadows.depth, shadows.cells, shadows.params, shadows.R_light_world,
+                           _sun_terms(scene, packed))
     reflection = Reflection(refl_rgb, refl_depth)
     run_bands(lambda band, bands: shade(frags.face, frags.depth, frags.bary, view, geometry, road, lighting,
                                         sun_shadow, reflection, hdr, band, bands), threads)

@@ -22,6 +22,8 @@ from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from ._jit import kernel
 from .bands import band_rows
 from .lighting import (
+    SUN_BIAS,
+    SUN_OFFSET,
     SUN_SCALE,
     fresnel_schlick,
     glossy_lobe,
@@ -112,6 +114,7 @@ class SunShadow(NamedTuple):
     cells: Float32Array
     params: FloatArray
     R_light_world: FloatArray
+    face_terms: FloatArray  # (m, 2) lighting.face_sun_terms
 
 
 class Reflection(NamedTuple):
@@ -360,7 +363,7 @@ def surface_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view:
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
         overhead_params = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
-    maps, cells, shadow_params, R_light = shadow
+    maps, cells, shadow_params, R_light, sun_terms = shadow
     refl_rgb, refl_depth = reflection
     wetness, puddles, sun_i, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[SUN_I], env_f[CLOUD], \
         env_f[PENUMBRA]
@@ -409,7 +412,8 @@ def surface_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view:
         n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if sun_i > 0.0 and n_dot_l > 0.0:
-            vis = sun_visibility(px, py, pz, nx, ny, nz, n_dot_l, maps, cells, shadow_params, R_light, penumbra)
+            vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
+                                 cells, shadow_params, R_light, penumbra)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
