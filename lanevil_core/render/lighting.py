@@ -12,8 +12,8 @@ NORMAL_OFFSET_M = 0.03
 LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
-# Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours, then over it alone.
-NEAR_AROUND, FAR_AROUND, CELL_NEAR, CELL_FAR = range(4)
+# Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
+NEAR_AROUND, FAR_AROUND = range(2)
 
 
 @kernel(inline="always")
@@ -76,24 +76,6 @@ def face_sun_terms(face_normal: np.ndarray, sun_dir_world: np.ndarray) -> np.nda
 
 
 @kernel(inline="always")
-def _footprint_extremes(cells: np.ndarray, c: int, x: float, y: float, radius: float,
-                        size: int) -> tuple[float, float]:
-    """(nearest, farthest) caster depth over the coarse cells holding every texel that taps of ``radius`` around
-    map point (x, y) read (bilinear: one texel past each side)."""
-    x_lo = max(int(x - radius - 0.5), 0) >> COARSE_SHIFT
-    y_lo = max(int(y - radius - 0.5), 0) >> COARSE_SHIFT
-    x_hi = min(int(x + radius - 0.5) + 1, size - 1) >> COARSE_SHIFT
-    y_hi = min(int(y + radius - 0.5) + 1, size - 1) >> COARSE_SHIFT
-    low = np.inf
-    high = -np.inf
-    for cell_y in range(y_lo, y_hi + 1):
-        for cell_x in range(x_lo, x_hi + 1):
-            low = min(low, cells[c, cell_y, cell_x, CELL_NEAR])
-            high = max(high, cells[c, cell_y, cell_x, CELL_FAR])
-    return low, high
-
-
-@kernel(inline="always")
 def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
                    bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray, R_light: np.ndarray,
                    penumbra: float) -> float:
@@ -101,8 +83,8 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
 
     ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``.
     The soft edge's taps reach less than 2**COARSE_SHIFT texels, so the point's dilated coarse cell answers
-    "all lit" (its nearest caster is behind the point) and "all shaded" (its farthest one is in front); failing
-    that, the cells under the taps' own footprint may. Only then are the taps read.
+    "all lit" (its nearest caster is behind the point) and "all shaded" (its farthest one is in front); only
+    between the two are the taps read.
     """
     q0 = px + nx * offset
     q1 = py + ny * offset
@@ -129,11 +111,6 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
         z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
         blocker = z_center if z_center < d - bias else nearest
         radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
-        low, high = _footprint_extremes(cells, c, x, y, radius, size)
-        if low >= d - bias:
-            return 1.0
-        if high < d - bias:
-            return 0.0
         lit = 0.0
         for j in range(-1, 2):
             for i in range(-1, 2):

@@ -62,7 +62,7 @@ def _env_vector(env: Environment) -> np.ndarray:
 
 
 def _no_shadows() -> ShadowMaps:
-    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1, 4), np.inf, np.float32),
+    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1, 2), np.inf, np.float32),
                       np.array([[0.0, 0.0, 1.0]]), np.eye(3))
 
 

@@ -16,7 +16,7 @@ from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
 from ._jit import kernel
 from .bands import band_rows, run_bands
-from .lighting import CELL_FAR, CELL_NEAR, COARSE_SHIFT, FAR_AROUND, NEAR_AROUND
+from .lighting import COARSE_SHIFT, FAR_AROUND, NEAR_AROUND
 from .packed import PackedScene
 from .raster import depth_orthographic
 
@@ -35,7 +35,7 @@ class ShadowMaps:
     """
 
     depth: Float32Array
-    cells: Float32Array  # (C, S/8, S/8, 4) per 8x8 texels, see lighting.NEAR_AROUND .. CELL_FAR
+    cells: Float32Array  # (C, S/8, S/8, 2) per 8x8 texels, see lighting.NEAR_AROUND, FAR_AROUND
     params: FloatArray
     R_light_world: FloatArray
 
@@ -84,7 +84,7 @@ def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np
 
 @kernel
 def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
-    """Every cell's own extremes and those over itself and its eight neighbours, for the cell rows of one band."""
+    """Every cell's extremes over itself and its eight neighbours, for the cell rows of one band."""
     cells = nearest.shape[0]
     for y in band_rows(cells, band, bands):
         for x in range(cells):
@@ -96,20 +96,18 @@ def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, ba
                     high = max(high, farthest[j, i])
             out[y, x, NEAR_AROUND] = low
             out[y, x, FAR_AROUND] = high
-            out[y, x, CELL_NEAR] = nearest[y, x]
-            out[y, x, CELL_FAR] = farthest[y, x]
 
 
 def pool_extremes(depth: Float32Array, shift: int, threads: int = 1) -> Float32Array:
-    """(S >> shift, S >> shift, 4): the nearest and the farthest caster depth in each 2**shift square of a map and
-    its eight neighbours, then in the square alone (see lighting.NEAR_AROUND .. CELL_FAR). One lookup answers "is
-    any caster near enough to shade this point?" and "does every texel around it shade it?" for any filter
-    reaching less than 2**shift texels; the squares alone answer it for a filter's own footprint."""
+    """(S >> shift, S >> shift, 2): the nearest and the farthest caster depth in each 2**shift square of a map and
+    its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is any caster near enough to
+    shade this point?" and "does every texel around it shade it?" for any filter reaching less than 2**shift
+    texels."""
     cells = depth.shape[0] >> shift
     nearest = np.full((cells, cells), np.inf, np.float32)
     farthest = np.full((cells, cells), -np.inf, np.float32)
     run_bands(lambda band, bands: _pool_cells(depth, shift, nearest, farthest, band, bands), threads)
-    out = np.empty((cells, cells, 4), np.float32)
+    out = np.empty((cells, cells, 2), np.float32)
     run_bands(lambda band, bands: _dilate_cells(nearest, farthest, out, band, bands), threads)
     return out
 
@@ -171,7 +169,7 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
     sun_key = np.asarray(sun_dir_world, np.float64).tobytes()
     v_light: FloatArray | None = None
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
-    cells = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT, 4), np.float32)
+    cells = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT, 2), np.float32)
     params = np.zeros((len(CASCADE_FAR_M), 3))
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
