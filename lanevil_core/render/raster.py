@@ -7,6 +7,7 @@ pixel, the nearest face id, its depth and perspective-correct barycentric weight
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -39,15 +40,21 @@ def _edge(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> f
 
 @kernel
 def _fill(
-    sx: np.ndarray, sy: np.ndarray, sw: np.ndarray, b1: np.ndarray, b2: np.ndarray, depth_v: np.ndarray,
-    face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool,
-    attributes: bool, band: int, bands: int,
+    tris: np.ndarray, slot: int, face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+    perspective: bool, attributes: bool, band: int, bands: int,
 ) -> None:
-    """Scan-convert the rows of band ``band`` of one screen-space triangle (vertices 0, 1, 2 of the small arrays).
+    """Scan-convert the rows of band ``band`` of the screen-space triangle ``tris[slot]`` (see SX .. DZ).
 
     With ``attributes`` False only the depth buffer is written (shadow maps).
     """
     height, width = depth_buf.shape
+    tri = tris[slot]
+    sx = (tri[SX, 0], tri[SX, 1], tri[SX, 2])
+    sy = (tri[SY, 0], tri[SY, 1], tri[SY, 2])
+    sw = (tri[SW, 0], tri[SW, 1], tri[SW, 2])
+    b1 = (tri[B1, 0], tri[B1, 1], tri[B1, 2])
+    b2 = (tri[B2, 0], tri[B2, 1], tri[B2, 2])
+    depth_v = (tri[DZ, 0], tri[DZ, 1], tri[DZ, 2])
     area = _edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2])
     if area == 0.0 or not np.isfinite(area):
         return
@@ -107,12 +114,10 @@ def _clear_band(face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarra
                 bands: int) -> None:
     """Empty the band's rows (its own thread touches them first: they stay in its cache)."""
     for row in band_rows(depth_buf.shape[0], band, bands):
-        for col in range(depth_buf.shape[1]):
-            depth_buf[row, col] = np.inf
-            if attributes:
-                face_buf[row, col] = -1
-                bary_buf[row, col, 0] = 0.0
-                bary_buf[row, col, 1] = 0.0
+        depth_buf[row, :] = np.inf
+        if attributes:
+            face_buf[row, :] = -1
+            bary_buf[row, :, :] = 0.0
 
 
 # A screen triangle: rows SX, SY, SW (1 / camera z, perspective) of its vertices, then their weights of the
@@ -228,17 +233,29 @@ def _fill_band(
     for slot in range(rows.shape[0]):
         if not overlaps_band(rows[slot, 0], rows[slot, 1], band, bands):
             continue
-        tri = tris[slot]
-        _fill(tri[SX], tri[SY], tri[SW], tri[B1], tri[B2], tri[DZ], face_ids[slot // per_slot], face_buf, depth_buf,
-              bary_buf, perspective, attributes, band, bands)
+        _fill(tris, slot, face_ids[slot // per_slot], face_buf, depth_buf, bary_buf, perspective, attributes, band,
+              bands)
+
+
+_per_thread = threading.local()
+
+
+def _scratch(slots: int) -> tuple[np.ndarray, np.ndarray]:
+    """(slots, 6, 3) float64 triangles and (slots, 2) int64 row ranges, reused by the calling thread's draws
+    (fresh large arrays cost page faults every frame)."""
+    tris: np.ndarray | None = getattr(_per_thread, "tris", None)
+    rows: np.ndarray | None = getattr(_per_thread, "rows", None)
+    if tris is None or rows is None or tris.shape[0] < slots:
+        tris, rows = np.empty((slots, 6, 3)), np.empty((slots, 2), np.int64)
+        _per_thread.tris, _per_thread.rows = tris, rows
+    return tris[:slots], rows[:slots]
 
 
 def _draw(setup: Callable[[np.ndarray, np.ndarray, int, int], None], slots: int, per_slot: int, face_ids: IntArray,
           buffers: tuple[IntArray, Float32Array, Float32Array], perspective: bool, attributes: bool,
           threads: int) -> None:
     """Set up every face's screen triangles (bands take runs of faces), then fill (bands take rows)."""
-    tris = np.empty((slots, 6, 3))
-    rows = np.empty((slots, 2), np.int64)
+    tris, rows = _scratch(slots)
     run_bands(lambda band, bands: setup(tris, rows, band, bands), threads)
     face_buf, depth_buf, bary_buf = buffers
     run_bands(lambda band, bands: _fill_band(tris, rows, per_slot, face_ids, face_buf, depth_buf, bary_buf,

@@ -72,14 +72,17 @@ def cascade_size(image_width: int) -> int:
 def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np.ndarray, band: int,
                 bands: int) -> None:
     """The nearest and the farthest caster depth of every 2**shift square of one map, for one band's cell rows."""
-    size = depth.shape[0]
-    cells = size >> shift
+    cells = depth.shape[0] >> shift
     for cell_y in band_rows(cells, band, bands):
-        for y in range(cell_y << shift, (cell_y + 1) << shift):
-            for x in range(size):
-                v = depth[y, x]
-                nearest[cell_y, x >> shift] = min(nearest[cell_y, x >> shift], v)
-                farthest[cell_y, x >> shift] = max(farthest[cell_y, x >> shift], v)
+        for cell_x in range(cells):
+            low = np.inf
+            high = -np.inf
+            for y in range(cell_y << shift, (cell_y + 1) << shift):
+                for x in range(cell_x << shift, (cell_x + 1) << shift):
+                    low = min(low, depth[y, x])
+                    high = max(high, depth[y, x])
+            nearest[cell_y, cell_x] = low
+            farthest[cell_y, cell_x] = high
 
 
 @kernel
