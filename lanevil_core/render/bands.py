@@ -1,14 +1,15 @@
 """Splitting one frame's kernels across threads with output byte-identical to one thread.
 
 Every per-pixel kernel takes ``(band, bands)`` and touches only the rows of its band: rows are grouped in runs
-of BAND_ROWS and the runs are dealt round-robin to the bands, so the cheap sky rows at the top and the busy road
-rows at the bottom are shared evenly. A pixel's value never depends on which band computed it (each band walks
-all of its inputs in the same order and loops over whole rows), hence the same bytes for any thread count.
-The kernels release the GIL, so a plain thread pool runs them in parallel.
+of BAND_ROWS and the runs are dealt round-robin to the bands (a few per thread), so the cheap sky rows at the
+top and the busy road rows at the bottom are shared evenly. A pixel's value never depends on which band computed
+it (each band walks all of its inputs in the same order and loops over whole rows), hence the same bytes for any
+thread count. The kernels release the GIL, so a plain thread pool runs them in parallel.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import threading
 from collections.abc import Callable
@@ -19,6 +20,7 @@ import numpy as np
 from ._jit import kernel
 
 BAND_ROWS = 8
+BANDS_PER_THREAD = 3
 
 
 @kernel(inline="always")
@@ -78,17 +80,29 @@ def _workers(count: int) -> ThreadPoolExecutor:
 
 
 def run_bands(work: Callable[[int, int], None], threads: int) -> None:
-    """Call ``work(band, bands)`` for every band of ``threads`` bands, in parallel; the caller runs band 0.
+    """Call ``work(band, bands)`` for every one of BANDS_PER_THREAD * ``threads`` bands on ``threads`` threads
+    (the caller is one of them), each thread taking the next band not yet taken.
 
-    Bands never wait on each other, so renders on several threads at once share the pool without deadlock.
+    Taking bands as they come keeps both cores busy when another process holds one of them for a while; which
+    thread draws a band does not change its bytes. Bands never wait on each other, so renders on several threads
+    at once share the pool without deadlock.
     """
     if threads <= 1:
         work(0, 1)
         return
+    bands = BANDS_PER_THREAD * threads
+    taken = itertools.count()  # next() on it is atomic under the GIL
+
+    def take_bands() -> None:
+        for band in iter(taken.__next__, None):
+            if band >= bands:
+                return
+            work(band, bands)
+
     pool = _workers(threads - 1)
-    futures = [pool.submit(work, band, threads) for band in range(1, threads)]
+    futures = [pool.submit(take_bands) for _ in range(threads - 1)]
     try:
-        work(0, threads)
+        take_bands()
     finally:
         for future in futures:
             future.result()
