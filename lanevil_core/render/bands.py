@@ -1,7 +1,7 @@
 """Splitting one frame's kernels across threads with output byte-identical to one thread.
 
 Every per-pixel kernel takes ``(band, bands)`` and touches only the rows of its band: rows are grouped in runs
-of BAND_ROWS and the runs are dealt round-robin to the bands (a few per thread), so the cheap sky rows at the
+of BAND_ROWS and the runs are dealt round-robin to the bands, so the cheap sky rows at the
 top and the busy road rows at the bottom are shared evenly. A pixel's value never depends on which band computed
 it (each band walks all of its inputs in the same order and loops over whole rows), hence the same bytes for any
 thread count. The kernels release the GIL, so a plain thread pool runs them in parallel.
@@ -20,7 +20,7 @@ import numpy as np
 from ._jit import kernel
 
 BAND_ROWS = 8
-BANDS_PER_THREAD = 3
+BANDS_PER_THREAD = 1  # more bands balance a loaded machine better but repeat per-band work: +7 % CPU at 640x360 for 3
 
 
 @kernel(inline="always")
@@ -83,8 +83,8 @@ def run_bands(work: Callable[[int, int], None], threads: int) -> None:
     """Call ``work(band, bands)`` for every one of BANDS_PER_THREAD * ``threads`` bands on ``threads`` threads
     (the caller is one of them), each thread taking the next band not yet taken.
 
-    Taking bands as they come keeps both cores busy when another process holds one of them for a while; which
-    thread draws a band does not change its bytes. Bands never wait on each other, so renders on several threads
+    Taking bands as they come lets the caller draw a band whose thread has not started yet; which thread draws a
+    band does not change its bytes. Bands never wait on each other, so renders on several threads
     at once share the pool without deadlock.
     """
     if threads <= 1:
