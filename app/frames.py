@@ -154,8 +154,8 @@ class EncodedImage:
 class FrameService:
     """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
 
-    def __init__(self, cache_bytes: int = 256_000_000, threads: int | None = None) -> None:
-        self.threads = threads or all_cores()  # one frame's row bands on every core: a request waits on one frame
+    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0) -> None:
+        self.threads = threads or all_cores()  # one frame's row bands on every core (0): a request waits on one frame
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.roadsides: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
