@@ -42,9 +42,9 @@ PAVED = ("asphalt", "concrete", "kerb")  # hold a water film; grass, gravel and 
 # surface_table columns; its rows are the road MATERIALS, then one for every object
 ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0 = range(7)
 OBJECT_ROW = len(MATERIALS)
-WET_FILM_MIRROR = 0.45
+WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
 FOOTPRINT_SCALE = 0.75  # box-filter width in pixels' worth of road coordinate
-MAX_FOOTPRINT_M = 50.0  # a wet film mirrors less than standing water
+MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 STANDING_WATER_ROUGHNESS = 0.03
@@ -302,13 +302,13 @@ def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, n
 
 
 @kernel(inline="always")
-def shade_lit(albedo: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
+def shade_lit(color: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
               sun: tuple[float, float, float, float, float, float],
               lamps: tuple[float, float, float, float, float, float]) -> tuple[float, float, float]:
-    """Albedo under the sun, the lamps and the sky's ambient (scaled by ``up``), plus specular and emission."""
-    return (albedo[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0],
-            albedo[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1],
-            albedo[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2])
+    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and emission."""
+    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0],
+            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1],
+            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2])
 
 
 @kernel(inline="always")
@@ -433,8 +433,10 @@ def shade(face: np.ndarray, depth: np.ndarray, bary: np.ndarray, view: View, geo
 
 
 @kernel
-def shade_mirror(face_buf, depth_buf, face_color, face_emission, face_normal, sun_dir, sun_color, env_f,
-                 zenith, horizon, lights_rgb_scale, out, band, bands):
+def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.ndarray, face_emission: np.ndarray,
+                 face_normal: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, env_f: np.ndarray,
+                 zenith: np.ndarray, horizon: np.ndarray, lights_rgb_scale: float, out: np.ndarray, band: int,
+                 bands: int) -> None:
     """Flat-shade the mirrored objects (no shadows) of one row band: what a wet road reflects."""
     height, width = face_buf.shape
     for row in band_rows(height, band, bands):
