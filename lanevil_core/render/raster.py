@@ -8,7 +8,7 @@ pixel, the nearest face id, its depth and perspective-correct barycentric weight
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -282,20 +282,39 @@ def rasterize_perspective(
     return Fragments(face_buf, depth_buf, bary_buf)
 
 
-def depth_orthographic(
-    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
-    threads: int = 1, out: Float32Array | None = None,
-) -> Float32Array:
-    """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping);
-    into ``out`` when given (a C-contiguous (H, W) float32 array)."""
+def depth_orthographic_views(
+    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
+    views: Sequence[tuple[float, float, float]], outs: Sequence[Float32Array], threads: int = 1,
+) -> None:
+    """Nearest depth along +z of a view frame into each of ``outs`` ((H, W) float32, C-contiguous) for the
+    orthographic ``views`` (scale, u0, v0): pixel = (x - u0, y - v0) * scale (no clipping). All views are set up
+    in one parallel step and filled in another, so threads are handed work twice, not twice per view."""
     width, height = size
-    depth_buf = out if out is not None else np.empty((height, width), np.float32)
     v_view = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
     no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)
-    _draw(lambda tris, rows, band, bands: _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height,
-                                                              tris, rows, band, bands),
-          ids.size, 1, ids, (no_faces, depth_buf, no_bary), False, False, threads)
+    stored = [(np.empty((ids.size, 6, 3)), np.empty((ids.size, 2), np.int64)) for _ in views]
+
+    def set_up(band: int, bands: int) -> None:
+        for (scale, u0, v0), (tris, rows) in zip(views, stored):
+            _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height, tris, rows, band, bands)
+
+    def fill(band: int, bands: int) -> None:
+        for depth_buf, (tris, rows) in zip(outs, stored):
+            _fill_band(tris, rows, 1, ids, no_faces, depth_buf, no_bary, False, False, band, bands)
+
+    run_bands(set_up, threads)
+    run_bands(fill, threads)
+
+
+def depth_orthographic(
+    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
+    threads: int = 1,
+) -> Float32Array:
+    """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping)."""
+    width, height = size
+    depth_buf = np.empty((height, width), np.float32)
+    depth_orthographic_views(v_view, faces, face_ids, size, [(scale, u0, v0)], [depth_buf], threads)
     return depth_buf
 
 

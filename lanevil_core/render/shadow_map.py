@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,7 +19,7 @@ from ._jit import kernel
 from .bands import band_rows, run_bands
 from .lighting import COARSE_SHIFT, FAR_AROUND, NEAR_AROUND
 from .packed import PackedScene
-from .raster import depth_orthographic
+from .raster import depth_orthographic_views
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)
 CASCADE_SIZE = 1024  # at 1280 pixels wide
@@ -101,18 +102,26 @@ def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, ba
             out[y, x, FAR_AROUND] = high
 
 
-def pool_extremes(depth: Float32Array, shift: int, threads: int = 1) -> Float32Array:
-    """(S >> shift, S >> shift, 2): the nearest and the farthest caster depth in each 2**shift square of a map and
-    its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is any caster near enough to
-    shade this point?" and "does every texel around it shade it?" for any filter reaching less than 2**shift
-    texels."""
-    cells = depth.shape[0] >> shift
-    nearest = np.full((cells, cells), np.inf, np.float32)
-    farthest = np.full((cells, cells), -np.inf, np.float32)
-    run_bands(lambda band, bands: _pool_cells(depth, shift, nearest, farthest, band, bands), threads)
-    out = np.empty((cells, cells, 2), np.float32)
-    run_bands(lambda band, bands: _dilate_cells(nearest, farthest, out, band, bands), threads)
-    return out
+def pool_extremes(depths: Sequence[Float32Array], shift: int, threads: int = 1) -> list[Float32Array]:
+    """Per map of ``depths``, (S >> shift, S >> shift, 2): the nearest and the farthest caster depth in each
+    2**shift square and its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is any
+    caster near enough to shade this point?" and "does every texel around it shade it?" for any filter reaching
+    less than 2**shift texels. All maps are pooled in one parallel step and dilated in another."""
+    cells = [depth.shape[0] >> shift for depth in depths]
+    pooled = [(np.full((n, n), np.inf, np.float32), np.full((n, n), -np.inf, np.float32)) for n in cells]
+    outs = [np.empty((n, n, 2), np.float32) for n in cells]
+
+    def pool(band: int, bands: int) -> None:
+        for depth, (nearest, farthest) in zip(depths, pooled):
+            _pool_cells(depth, shift, nearest, farthest, band, bands)
+
+    def dilate(band: int, bands: int) -> None:
+        for (nearest, farthest), out in zip(pooled, outs):
+            _dilate_cells(nearest, farthest, out, band, bands)
+
+    run_bands(pool, threads)
+    run_bands(dilate, threads)
+    return outs
 
 
 CascadeKey = tuple[bytes, int, float, float, float]
@@ -170,25 +179,28 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
     size = size if size is not None else cascade_size(camera.intrinsics.width)
     R_light_world = light_rotation(sun_dir_world)
     sun_key = np.asarray(sun_dir_world, np.float64).tobytes()
-    v_light: FloatArray | None = None
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
     cells = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT, 2), np.float32)
     params = np.zeros((len(CASCADE_FAR_M), 3))
+    missing: list[tuple[int, CascadeKey]] = []
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
         u0, v0, texel = _cascade_frame(camera, R_light_world, near, far, size)
         key: CascadeKey = (sun_key, size, u0, v0, texel)
+        params[c] = (u0, v0, 1.0 / texel)
         maps = cache.get(key) if cache is not None else None
         if maps is None:
-            if v_light is None:
-                v_light = packed.vertices @ R_light_world.T
-            depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0,
-                               threads, out=depth[c])
-            cells[c] = pool_extremes(depth[c], COARSE_SHIFT, threads)
-            if cache is not None:
-                cache.put(key, (depth[c], cells[c]))  # views of this frame's maps, never written again
+            missing.append((c, key))
         else:
             depth[c], cells[c] = maps
-        params[c] = (u0, v0, 1.0 / texel)
         near = far * 0.9
+    if missing:
+        v_light = packed.vertices @ R_light_world.T
+        views = [(params[c, 2], params[c, 0], params[c, 1]) for c, _ in missing]
+        depth_orthographic_views(v_light, packed.faces, packed.shadow_faces, (size, size), views,
+                                 [depth[c] for c, _ in missing], threads)
+        for (c, key), extremes in zip(missing, pool_extremes([depth[c] for c, _ in missing], COARSE_SHIFT, threads)):
+            cells[c] = extremes
+            if cache is not None:
+                cache.put(key, (depth[c], cells[c]))  # views of this frame's maps, never written again
     return ShadowMaps(depth, cells, params, R_light_world)
