@@ -28,7 +28,7 @@ from lanevil_core.frame_detection import FrameDetection, detect_frame
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
 from lanevil_core.overlay import draw_detections, draw_lanes
-from lanevil_core.render import render_frame
+from lanevil_core.render import all_cores, render_frame
 from lanevil_core.scene import CompiledScene
 
 ImageFormat = Literal["png", "jpg"]
@@ -154,7 +154,8 @@ class EncodedImage:
 class FrameService:
     """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
 
-    def __init__(self, cache_bytes: int = 256_000_000) -> None:
+    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0) -> None:
+        self.threads = threads or all_cores()  # one frame's row bands on every core (0): a request waits on one frame
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.roadsides: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
@@ -259,7 +260,7 @@ class FrameService:
             plain = self.frame(case, index, size, overlay=False)
             return RenderedFrame(draw_lanes(plain.rgb, plain.record), plain.record, key)
         scene = self.scene(case)
-        frame = render_frame(scene, index, size)
+        frame = render_frame(scene, index, size, threads=self.threads)
         self.renders += 1
         record = tusimple_record(scene, index, frame, raw_file=frame_file(index))
         rgb = np.ascontiguousarray(frame.rgb)
@@ -286,7 +287,7 @@ class FrameService:
         lines = self.culane.get(key)
         if lines is None:
             scene = self.scene(case)
-            lines = culane_lines(scene, render_frame(scene, index, CULANE_SIZE))
+            lines = culane_lines(scene, render_frame(scene, index, CULANE_SIZE, threads=self.threads))
             self.renders += 1
             self.culane.put(key, lines)
         return lines

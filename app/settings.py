@@ -26,4 +26,5 @@ class Settings(BaseSettings):
     max_jobs: int = Field(16, ge=1, description="export jobs queued or running before clients get 429")
     max_jobs_per_client: int = Field(4, ge=1, description="export jobs one client may have queued or running")
     frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
+    render_threads: int = Field(0, ge=0, description="threads per rendered frame (0 = every core this process may use)")
     editor: bool = Field(True, description="start the viser editor beside the API")

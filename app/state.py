@@ -30,7 +30,8 @@ class AppState:
         store = CaseStore(data_dir)
         if len(store) == 0 and Path(settings.scenes_dir).is_dir():
             store.seed_from(Path(settings.scenes_dir))
-        return cls(settings=settings, store=store, frames=FrameService(settings.frame_cache_bytes),
+        frames = FrameService(settings.frame_cache_bytes, settings.render_threads)
+        return cls(settings=settings, store=store, frames=frames,
                    jobs=JobManager(data_dir, max_unfinished=settings.max_jobs,
                                    max_per_client=settings.max_jobs_per_client))
 

@@ -10,9 +10,14 @@ import statistics
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from .case import Case, load_case
+
+if TYPE_CHECKING:
+    from .render import Frame
 
 BENCH_SIZES: tuple[tuple[int, int], ...] = ((1280, 720), (640, 360))
 
@@ -34,11 +39,25 @@ def _median(values: list[float]) -> float:
     return round(float(statistics.median(values)), 3) if values else 0.0
 
 
+def _same_bytes(a: Frame, b: Frame) -> bool:
+    return (np.array_equal(a.rgb, b.rgb) and np.array_equal(a.depth, b.depth)
+            and np.array_equal(a.object_id, b.object_id))
+
+
+def _row_key(size: tuple[int, int], threads: int, thread_counts: Sequence[int]) -> str:
+    width, height = size
+    return f"{width}x{height}" if len(thread_counts) == 1 else f"{width}x{height} t{threads}"
+
+
 def run_benchmark(
     cases: Sequence[Case], sizes: Sequence[tuple[int, int]] = BENCH_SIZES, frames_per_case: int = 2,
+    threads: Sequence[int] = (1,),
 ) -> dict[str, dict[str, Any]]:
     """``{"WxH": {"median_ms": float, "stages": {stage: median ms}}}`` for every size.
 
+    With several thread counts every frame is rendered with each count in turn (so load on the machine hits
+    them alike), rows are keyed ``"WxH tN"`` and each row after the first count's also holds ``speedup`` (the
+    first count's median over its own) and ``identical`` (every frame's bytes equal the first count's).
     Cases are compiled one at a time (and dropped after timing) so memory stays that of one scene.
     """
     from .compile import compile_scene
@@ -48,32 +67,48 @@ def run_benchmark(
     warm = compile_scene(cases[0])
     for size in sizes:  # warm-up: numba compilation
         render_frame(warm, 0, size)
-    totals: dict[tuple[int, int], list[float]] = {size: [] for size in sizes}
-    stages: dict[tuple[int, int], dict[str, list[float]]] = {size: {} for size in sizes}
+    runs = [(size, n) for size in sizes for n in threads]
+    totals: dict[tuple[tuple[int, int], int], list[float]] = {run: [] for run in runs}
+    stages: dict[tuple[tuple[int, int], int], dict[str, list[float]]] = {run: {} for run in runs}
+    identical = {run: True for run in runs}
     for case in cases:
         scene = compile_scene(case)
         pack_scene(scene)  # once per scene, cached on it: not a per-frame cost
         for size in sizes:
             for frame_index in frames_to_time(case, frames_per_case):
-                start = time.perf_counter()
-                frame = render_frame(scene, frame_index, size)
-                totals[size].append((time.perf_counter() - start) * 1000.0)
-                for stage, ms in frame.timings.items():
-                    stages[size].setdefault(stage, []).append(float(ms))
-    return {
-        f"{width}x{height}": {
-            "median_ms": _median(totals[(width, height)]),
-            "stages": {stage: _median(values) for stage, values in stages[(width, height)].items()},
+                first: Frame | None = None
+                for n in threads:
+                    scene.cache.pop("shadow_cascades", None)  # frames spread over a drive share no cascade
+                    start = time.perf_counter()
+                    frame = render_frame(scene, frame_index, size, threads=n)
+                    totals[(size, n)].append((time.perf_counter() - start) * 1000.0)
+                    for stage, ms in frame.timings.items():
+                        stages[(size, n)].setdefault(stage, []).append(float(ms))
+                    if first is None:
+                        first = frame
+                    identical[(size, n)] &= _same_bytes(first, frame)
+    result: dict[str, dict[str, Any]] = {}
+    for size, n in runs:
+        row: dict[str, Any] = {
+            "median_ms": _median(totals[(size, n)]),
+            "stages": {stage: _median(values) for stage, values in stages[(size, n)].items()},
         }
-        for width, height in sizes
-    }
+        if len(threads) > 1:
+            base = _median(totals[(size, threads[0])])
+            row.update(threads=n, speedup=round(base / max(row["median_ms"], 1e-9), 2),
+                       identical=identical[(size, n)])
+        result[_row_key(size, n, threads)] = row
+    return result
 
 
 def format_table(result: dict[str, dict[str, Any]]) -> str:
-    """A plain-text table: one row per size, total then every stage (median ms)."""
+    """A plain-text table: one row per size (and thread count), total then every stage (median ms), then the
+    speed-up over the first thread count and whether the bytes matched it, when several were timed."""
     stages = sorted({stage for row in result.values() for stage in row["stages"]})
-    header = ["size", "ms/frame", *stages]
-    rows = [[size, f"{row['median_ms']:.1f}", *(f"{row['stages'].get(stage, 0.0):.1f}" for stage in stages)]
+    extra = ["speedup", "identical"] if any("speedup" in row for row in result.values()) else []
+    header = ["size", "ms/frame", *stages, *extra]
+    rows = [[size, f"{row['median_ms']:.1f}", *(f"{row['stages'].get(stage, 0.0):.1f}" for stage in stages),
+             *(str(row[key]) for key in extra)]
             for size, row in result.items()]
     widths = [max(len(line[i]) for line in [header, *rows]) for i in range(len(header))]
     return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths)) for line in [header, *rows])

@@ -153,6 +153,9 @@ def _bench_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"time every stock case (default: the clean cases in {CLEAN_DIR})")
     parser.add_argument("--illusions", action="store_true",
                         help="instead: per illusion type, its original and level-5 case at 1280x720")
+    parser.add_argument("--threads", type=int, nargs="+", default=[1], metavar="N",
+                        help="threads per frame (default 1); several counts (e.g. --threads 1 2) are timed frame by "
+                             "frame side by side, with the speed-up over the first and a byte-identity check")
 
 
 def _run_bench(args: argparse.Namespace) -> int:
@@ -160,12 +163,14 @@ def _run_bench(args: argparse.Namespace) -> int:
 
     if args.frames_per_case < 1:
         raise UsageError("--frames-per-case must be at least 1")
+    if min(args.threads) < 1:
+        raise UsageError("--threads must be at least 1")
     if args.illusions:
         rows = illusion_benchmark(frames=args.frames_per_case)
         print(json.dumps(rows) if args.json else format_rows(rows))
         return 0
     result = run_benchmark(bench_cases(stock_scenes() if args.all else stock_scenes(CLEAN_DIR)),
-                           frames_per_case=args.frames_per_case)
+                           frames_per_case=args.frames_per_case, threads=args.threads)
     print(json.dumps(result) if args.json else format_table(result))
     return 0
 

@@ -54,6 +54,7 @@ _drop_stale_cache()
 
 
 def kernel(fn: Callable[..., Any] | None = None, *, inline: str = "never") -> Any:
-    """``numba.njit`` with on-disk caching and the renderer's fast-math flags."""
-    decorator = nb.njit(cache=True, fastmath=FASTMATH, inline=inline)  # type: ignore[call-overload]  # a set is a valid fastmath
+    """``numba.njit`` with on-disk caching, the renderer's fast-math flags and the GIL released (so row bands of
+    one frame run on several threads, see ``bands``)."""
+    decorator = nb.njit(cache=True, fastmath=FASTMATH, inline=inline, nogil=True)  # type: ignore[call-overload]  # a set is a valid fastmath
     return decorator if fn is None else decorator(fn)

@@ -12,6 +12,8 @@ NORMAL_OFFSET_M = 0.03
 LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
+# Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
+NEAR_AROUND, FAR_AROUND = range(2)
 
 
 @kernel(inline="always")
@@ -60,17 +62,30 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
     return lit
 
 
+SUN_OFFSET, SUN_BIAS = range(2)  # face_sun_terms columns
+
+
+def face_sun_terms(face_normal: np.ndarray, sun_dir_world: np.ndarray) -> np.ndarray:
+    """(m, 2) float64 per face, for the sun lighting its front or back: the normal offset of shadow lookups (m)
+    and the depth bias in texels. Both grow with the slope of the face to the light, so grazing-lit faces do not
+    self-shadow (the offset moves the lookup off the surface, the bias tolerates the depth change across a
+    texel)."""
+    n_dot_l = np.abs(np.asarray(face_normal, np.float64) @ np.asarray(sun_dir_world, np.float64))
+    slope = np.minimum(np.sqrt(np.maximum(1.0 - n_dot_l * n_dot_l, 0.0)) / np.maximum(n_dot_l, 0.05), 8.0)
+    return np.stack([NORMAL_OFFSET_M * (1.0 + np.minimum(slope, 4.0)), 1.5 + 1.5 * slope], axis=-1)
+
+
 @kernel(inline="always")
-def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, n_dot_l: float,
-                   maps: np.ndarray, coarse: np.ndarray, params: np.ndarray, R_light: np.ndarray,
+def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
+                   bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray, R_light: np.ndarray,
                    penumbra: float) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges.
 
-    The depth bias grows with the slope of the surface to the light, so grazing-lit faces do not self-shadow.
+    ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``.
+    The soft edge's taps reach less than 2**COARSE_SHIFT texels, so the point's dilated coarse cell answers
+    "all lit" (its nearest caster is behind the point) and "all shaded" (its farthest one is in front); only
+    between the two are the taps read.
     """
-    slope = min(np.sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0)) / max(n_dot_l, 0.05), 8.0)
-    # Normal offset: move the lookup off the surface, more so where the light grazes it.
-    offset = NORMAL_OFFSET_M * (1.0 + min(slope, 4.0))
     q0 = px + nx * offset
     q1 = py + ny * offset
     q2 = pz + nz * offset
@@ -84,11 +99,14 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
         y = (v - params[c, 1]) * scale
         if x < 2 or y < 2 or x > size - 2 or y > size - 2:
             continue
-        bias = (1.5 + 1.5 * slope) / scale
+        bias = bias_texels / scale
         # Nearest caster within the point's coarse cell and its neighbours (pre-dilated): none -> fully lit.
-        nearest = coarse[c, int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT]
+        cell_y, cell_x = int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT
+        nearest = cells[c, cell_y, cell_x, NEAR_AROUND]
         if nearest >= d - bias:
             return 1.0
+        if cells[c, cell_y, cell_x, FAR_AROUND] < d - bias:
+            return 0.0
         # The caster right above the point (else the nearest one around) sets the penumbra width.
         z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
         blocker = z_center if z_center < d - bias else nearest
@@ -133,28 +151,3 @@ def glossy_lobe(n_dot_h: float, exponent: float, normalisation: float, cutoff: f
     if n_dot_h <= cutoff:
         return 0.0
     return normalisation * np.exp(exponent * np.log(n_dot_h))
-
-
-@kernel
-def min_pool(maps: np.ndarray, shift: int) -> np.ndarray:
-    """(C, S >> shift, S >> shift): the nearest caster depth in each 2**shift square of every cascade and its
-    eight neighbours (so one lookup answers "is any caster near enough to shade this point?")."""
-    cascades, size, _ = maps.shape
-    cells = size >> shift
-    pooled = np.full((cascades, cells, cells), np.inf, np.float32)
-    for c in range(cascades):
-        for y in range(size):
-            for x in range(size):
-                v = maps[c, y, x]
-                if v < pooled[c, y >> shift, x >> shift]:
-                    pooled[c, y >> shift, x >> shift] = v
-    out = np.full((cascades, cells, cells), np.inf, np.float32)
-    for c in range(cascades):
-        for y in range(cells):
-            for x in range(cells):
-                nearest = np.inf
-                for j in range(max(y - 1, 0), min(y + 2, cells)):
-                    for i in range(max(x - 1, 0), min(x + 2, cells)):
-                        nearest = min(nearest, pooled[c, j, i])
-                out[c, y, x] = nearest
-    return out

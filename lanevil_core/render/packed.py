@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 import numpy as np
 
 from ..paint import MATERIAL_ALBEDO, stripe_index
+from ..road_layout import RoadNetwork
 from ..road_mesh import RoadSurface, road_surface
 from ..scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
@@ -139,12 +145,47 @@ def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_fa
     return grads
 
 
+REUSED_ENTRIES = 8  # road surfaces and sky-openness maps kept for scenes recompiled from the same road
+_reused: OrderedDict[tuple[str, Any], tuple[Any, Any]] = OrderedDict()
+_reused_lock = threading.Lock()
+T = TypeVar("T")
+
+
+def _reuse(key: tuple[str, Any], owner: Any, build: Callable[[], T]) -> T:
+    """``build()``, or what it returned for the same key and the same ``owner`` object (kept alive meanwhile).
+
+    An edited case is compiled again around the same road network (``compile_scene(case, reuse=...)``); what
+    depends only on the network, or on geometry whose digest is the key, need not be built again.
+    """
+    with _reused_lock:
+        found = _reused.get(key)
+        if found is not None and found[0] is owner:
+            _reused.move_to_end(key)
+            return found[1]
+    value = build()
+    with _reused_lock:
+        _reused[key] = (owner, value)
+        while len(_reused) > REUSED_ENTRIES:
+            _reused.popitem(last=False)
+    return value
+
+
+def _road_surface(network: RoadNetwork) -> RoadSurface:
+    return _reuse(("road", id(network)), network, lambda: road_surface(network))
+
+
+def _casters_digest(packed: PackedScene) -> str:
+    """Digest of the shadow casters' triangles (world coordinates, in order)."""
+    corners = packed.vertices[packed.faces[packed.shadow_faces]]
+    return hashlib.blake2b(np.ascontiguousarray(corners).tobytes(), digest_size=16).hexdigest()
+
+
 def pack_scene(scene: CompiledScene) -> PackedScene:
     """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
     cached = scene.cache.get("packed")
     if cached is not None:
         return cached
-    road = road_surface(scene.network)
+    road = _road_surface(scene.network)
     verts, faces, st, piece = [road.vertices], [road.faces], [road.st], [road.piece]
     mat = [road.material]
     obj = [np.where(road.carriageway, ID_ROAD, ID_ROADSIDE).astype(np.int32)]
@@ -188,7 +229,8 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         layers=layer_atlas(scene), lights=lights,
         overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )
-    packed.overhead, packed.overhead_params = overhead_map(packed, road)
+    packed.overhead, packed.overhead_params = _reuse(("overhead", (id(scene.network), _casters_digest(packed))),
+                                                     scene.network, lambda: overhead_map(packed, road))
     scene.cache["packed"] = packed
     return packed
 

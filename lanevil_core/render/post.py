@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import kernel
+from .bands import band_rows, run_bands
 
 LUT_SIZE = 4096
 WHITE_POINT = 4.0
@@ -29,75 +30,96 @@ def _encode(x: float, inv_w2: float, lut: np.ndarray) -> np.uint8:
     return lut[min(int(y * top + 0.5), top)]
 
 
-@kernel
-def _encode_all(hdr: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
-    inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
-    flat_in = hdr.reshape(-1)
-    flat_out = out.reshape(-1)
-    for i in range(flat_in.size):
-        flat_out[i] = _encode(flat_in[i] * exposure, inv_w2, lut)
+@kernel(inline="always")
+def _on_edge(ids: np.ndarray, row: int, col: int) -> bool:
+    """Whether the pixel's object id differs from one of its 4-neighbours'."""
+    height, width = ids.shape
+    here = ids[row, col]
+    return ((col + 1 < width and ids[row, col + 1] != here) or (col > 0 and ids[row, col - 1] != here)
+            or (row + 1 < height and ids[row + 1, col] != here) or (row > 0 and ids[row - 1, col] != here))
+
+
+@kernel(inline="always")
+def _edge_blend(hdr: np.ndarray, row: int, col: int, c: int) -> float:
+    """Half the pixel's clamped radiance plus half its 4-neighbourhood's mean."""
+    height, width, _ = hdr.shape
+    acc = 0.0
+    cnt = 0.0
+    if col + 1 < width:
+        acc += min(hdr[row, col + 1, c], CLAMP)
+        cnt += 1.0
+    if col > 0:
+        acc += min(hdr[row, col - 1, c], CLAMP)
+        cnt += 1.0
+    if row + 1 < height:
+        acc += min(hdr[row + 1, col, c], CLAMP)
+        cnt += 1.0
+    if row > 0:
+        acc += min(hdr[row - 1, col, c], CLAMP)
+        cnt += 1.0
+    return 0.5 * min(hdr[row, col, c], CLAMP) + 0.5 * acc / cnt
 
 
 @kernel
-def _smooth_edges(hdr: np.ndarray, edges: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+def _finish_rows(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray, band: int,
+                 bands: int) -> None:
     height, width, _ = hdr.shape
     inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
-    for k in range(edges.size):
-        row = edges[k] // width
-        col = edges[k] % width
-        for c in range(3):
-            acc = 0.0
-            cnt = 0.0
-            if col + 1 < width:
-                acc += min(hdr[row, col + 1, c], CLAMP)
-                cnt += 1.0
-            if col > 0:
-                acc += min(hdr[row, col - 1, c], CLAMP)
-                cnt += 1.0
-            if row + 1 < height:
-                acc += min(hdr[row + 1, col, c], CLAMP)
-                cnt += 1.0
-            if row > 0:
-                acc += min(hdr[row - 1, col, c], CLAMP)
-                cnt += 1.0
-            x = 0.5 * min(hdr[row, col, c], CLAMP) + 0.5 * acc / cnt
-            out[row, col, c] = _encode(x * exposure, inv_w2, lut)
+    for row in band_rows(height, band, bands):
+        for col in range(width):
+            for c in range(3):
+                out[row, col, c] = _encode(hdr[row, col, c] * exposure, inv_w2, lut)
+        for col in range(width):
+            if _on_edge(ids, row, col):
+                for c in range(3):
+                    out[row, col, c] = _encode(_edge_blend(hdr, row, col, c) * exposure, inv_w2, lut)
 
 
-def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray) -> None:
+def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray,
+           threads: int = 1) -> None:
     """Tone-map (H, W, 3) linear radiance to sRGB bytes in ``out``; pixels on an object-id boundary are first
     blended with their 4-neighbourhood (a cheap silhouette antialias: the procedural road is already filtered,
     object edges are not)."""
-    _encode_all(np.ascontiguousarray(hdr), exposure, lut, out)
-    edge = np.zeros(ids.shape, bool)
-    across = ids[:, 1:] != ids[:, :-1]
-    down = ids[1:, :] != ids[:-1, :]
-    edge[:, 1:] |= across
-    edge[:, :-1] |= across
-    edge[1:, :] |= down
-    edge[:-1, :] |= down
-    _smooth_edges(hdr, np.flatnonzero(edge), exposure, lut, out)
+    hdr = np.ascontiguousarray(hdr)
+    run_bands(lambda band, bands: _finish_rows(hdr, ids, exposure, lut, out, band, bands), threads)
 
 
 @kernel
-def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int) -> None:
-    """Box-blur a mirror image along columns in place (wet roads smear reflections vertically)."""
+def _blur_column_band(img: np.ndarray, depth: np.ndarray, radius: int, band: int, bands: int) -> None:
+    """Running box sums down each column of one band: O(height) per column whatever the radius."""
     height, width, _ = img.shape
     column = np.empty((height, 3))
-    for col in range(width):
+    for col in band_rows(width, band, bands):
         for row in range(height):
             for c in range(3):
                 column[row, c] = img[row, col, c]
+        acc0 = acc1 = acc2 = 0.0
+        cnt = 0
+        for row in range(min(radius, height)):  # the window of row -1: rows 0 .. radius - 1
+            if depth[row, col] < np.inf:
+                acc0 += column[row, 0]
+                acc1 += column[row, 1]
+                acc2 += column[row, 2]
+                cnt += 1
         for row in range(height):
-            if depth[row, col] == np.inf:
-                continue
-            lo = max(row - radius, 0)
-            hi = min(row + radius, height - 1)
-            for c in range(3):
-                acc = 0.0
-                cnt = 0
-                for r in range(lo, hi + 1):
-                    if depth[r, col] < np.inf:
-                        acc += column[r, c]
-                        cnt += 1
-                img[row, col, c] = acc / cnt
+            enter, leave = row + radius, row - radius - 1
+            if enter < height and depth[enter, col] < np.inf:
+                acc0 += column[enter, 0]
+                acc1 += column[enter, 1]
+                acc2 += column[enter, 2]
+                cnt += 1
+            if leave >= 0 and depth[leave, col] < np.inf:
+                acc0 -= column[leave, 0]
+                acc1 -= column[leave, 1]
+                acc2 -= column[leave, 2]
+                cnt -= 1
+            if depth[row, col] < np.inf:
+                img[row, col, 0] = acc0 / cnt
+                img[row, col, 1] = acc1 / cnt
+                img[row, col, 2] = acc2 / cnt
+
+
+def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int, threads: int = 1) -> None:
+    """Box-blur a mirror image along columns in place (wet roads smear reflections vertically); the bands of
+    ``threads`` split the columns."""
+    run_bands(lambda band, bands: _blur_column_band(img, depth, radius, band, bands), threads)

@@ -7,12 +7,15 @@ pixel, the nearest face id, its depth and perspective-correct barycentric weight
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..typed import Float32Array, IntArray
 from ._jit import kernel
+from .bands import band_rows, in_band, overlaps_band, run_bands
 
 
 @dataclass(frozen=True)
@@ -37,15 +40,21 @@ def _edge(ax: float, ay: float, bx: float, by: float, px: float, py: float) -> f
 
 @kernel
 def _fill(
-    sx: np.ndarray, sy: np.ndarray, sw: np.ndarray, b1: np.ndarray, b2: np.ndarray, depth_v: np.ndarray,
-    face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool,
-    attributes: bool = True,
+    tris: np.ndarray, slot: int, face_index: int, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+    perspective: bool, attributes: bool, band: int, bands: int,
 ) -> None:
-    """Scan-convert one screen-space triangle (vertices 0, 1, 2 of the small arrays).
+    """Scan-convert the rows of band ``band`` of the screen-space triangle ``tris[slot]`` (see SX .. DZ).
 
     With ``attributes`` False only the depth buffer is written (shadow maps).
     """
     height, width = depth_buf.shape
+    tri = tris[slot]
+    sx = (tri[SX, 0], tri[SX, 1], tri[SX, 2])
+    sy = (tri[SY, 0], tri[SY, 1], tri[SY, 2])
+    sw = (tri[SW, 0], tri[SW, 1], tri[SW, 2])
+    b1 = (tri[B1, 0], tri[B1, 1], tri[B1, 2])
+    b2 = (tri[B2, 0], tri[B2, 1], tri[B2, 2])
+    depth_v = (tri[DZ, 0], tri[DZ, 1], tri[DZ, 2])
     area = _edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2])
     if area == 0.0 or not np.isfinite(area):
         return
@@ -55,6 +64,8 @@ def _fill(
     x_lo_f = min(sx[0], sx[1], sx[2])
     x_hi_f = max(sx[0], sx[1], sx[2])
     for row in range(y_min, y_max + 1):
+        if not in_band(row, band, bands):
+            continue
         py = row + 0.5
         # Solve the three edge inequalities for the covered x interval of this row.
         lo, hi = x_lo_f - 0.5, x_hi_f + 0.5
@@ -98,27 +109,48 @@ def _fill(
                 bary_buf[row, col, 1] = p0 * b2[0] + p1 * b2[1] + p2 * b2[2]
 
 
+@kernel(inline="always")
+def _clear_band(face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray, attributes: bool, band: int,
+                bands: int) -> None:
+    """Empty the band's rows (its own thread touches them first: they stay in its cache)."""
+    for row in band_rows(depth_buf.shape[0], band, bands):
+        depth_buf[row, :] = np.inf
+        if attributes:
+            face_buf[row, :] = -1
+            bary_buf[row, :, :] = 0.0
+
+
+# A screen triangle: rows SX, SY, SW (1 / camera z, perspective) of its vertices, then their weights of the
+# source face's 2nd and 3rd vertex (B1, B2) and their view depth (DZ).
+SX, SY, SW, B1, B2, DZ = range(6)
+
+
+@kernel(inline="always")
+def _store(tris: np.ndarray, rows: np.ndarray, slot: int, height: int) -> None:
+    """Record the rows a stored triangle can cover (the same range ``_fill`` scans)."""
+    sy = tris[slot, SY]
+    rows[slot, 0] = max(int(np.floor(min(sy[0], sy[1], sy[2]) - 0.5)) + 1, 0)
+    rows[slot, 1] = min(int(np.floor(max(sy[0], sy[1], sy[2]) - 0.5)), height - 1)
+
+
 @kernel
-def _raster_perspective(
+def _setup_perspective(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, fx: float, fy: float, cx: float, cy: float,
-    near: float, face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+    near: float, width: int, height: int, tris: np.ndarray, rows: np.ndarray, band: int, bands: int,
 ) -> None:
-    height, width = depth_buf.shape
+    """Cull, clip at the near plane and project the band's share of the faces (a contiguous run of them): face k
+    becomes screen triangles in slots 2k and 2k + 1 (an empty slot gets no rows)."""
     # Clipped polygon: up to 4 vertices, each with position and its weights of the original vertices 1 and 2.
     px = np.empty(4)
     py = np.empty(4)
     pz = np.empty(4)
     pb1 = np.empty(4)
     pb2 = np.empty(4)
-    sx = np.empty(3)
-    sy = np.empty(3)
-    sw = np.empty(3)
-    tb1 = np.empty(3)
-    tb2 = np.empty(3)
-    dz = np.empty(3)
     ref_b1 = (0.0, 1.0, 0.0)
     ref_b2 = (0.0, 0.0, 1.0)
-    for k in range(face_ids.size):
+    for k in range(band * face_ids.size // bands, (band + 1) * face_ids.size // bands):
+        rows[2 * k, 0] = rows[2 * k + 1, 0] = 1
+        rows[2 * k, 1] = rows[2 * k + 1, 1] = 0
         f = face_ids[k]
         i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
         z0, z1, z2 = v_view[i0, 2], v_view[i1, 2], v_view[i2, 2]
@@ -157,68 +189,148 @@ def _raster_perspective(
                 pb2[n] = ref_b2[e] + u * (ref_b2[e1] - ref_b2[e])
                 n += 1
         for t in range(1, n - 1):
+            slot = 2 * k + t - 1
             for m, q in enumerate((0, t, t + 1)):
                 inv = 1.0 / pz[q]
-                sx[m] = fx * px[q] * inv + cx
-                sy[m] = fy * py[q] * inv + cy
-                sw[m] = inv
-                tb1[m], tb2[m] = pb1[q], pb2[q]
-                dz[m] = pz[q]
-            _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, True)
+                tris[slot, SX, m] = fx * px[q] * inv + cx
+                tris[slot, SY, m] = fy * py[q] * inv + cy
+                tris[slot, SW, m] = inv
+                tris[slot, B1, m], tris[slot, B2, m] = pb1[q], pb2[q]
+                tris[slot, DZ, m] = pz[q]
+            _store(tris, rows, slot, height)
 
 
 @kernel
-def _raster_orthographic(
-    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float,
-    face_buf: np.ndarray, depth_buf: np.ndarray, bary_buf: np.ndarray,
+def _setup_orthographic(
+    v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float, width: int,
+    height: int, tris: np.ndarray, rows: np.ndarray, band: int, bands: int,
 ) -> None:
-    height, width = depth_buf.shape
-    sx = np.empty(3)
-    sy = np.empty(3)
-    sw = np.ones(3)
-    tb1 = np.array([0.0, 1.0, 0.0])
-    tb2 = np.array([0.0, 0.0, 1.0])
-    dz = np.empty(3)
-    for k in range(face_ids.size):
+    """Scale the band's share of the faces (a contiguous run) to map texels: face k in slot k."""
+    for k in range(band * face_ids.size // bands, (band + 1) * face_ids.size // bands):
+        rows[k, 0], rows[k, 1] = 1, 0
         f = face_ids[k]
         for m in range(3):
             i = faces[f, m]
-            sx[m] = (v_view[i, 0] - u0) * scale
-            sy[m] = (v_view[i, 1] - v0) * scale
-            dz[m] = v_view[i, 2]
+            tris[k, SX, m] = (v_view[i, 0] - u0) * scale
+            tris[k, SY, m] = (v_view[i, 1] - v0) * scale
+            tris[k, SW, m] = 1.0
+            tris[k, DZ, m] = v_view[i, 2]
+        sx, sy = tris[k, SX], tris[k, SY]
         if max(sx[0], sx[1], sx[2]) < 0 or min(sx[0], sx[1], sx[2]) > width:
             continue
         if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
             continue
-        _fill(sx, sy, sw, tb1, tb2, dz, f, face_buf, depth_buf, bary_buf, False, False)
+        _store(tris, rows, k, height)
 
 
-def _buffers(height: int, width: int) -> tuple[IntArray, Float32Array, Float32Array]:
-    return (np.full((height, width), -1, np.int32), np.full((height, width), np.inf, np.float32),
-            np.zeros((height, width, 2), np.float32))
+@kernel
+def _fill_band(
+    tris: np.ndarray, rows: np.ndarray, per_slot: int, face_ids: np.ndarray, face_buf: np.ndarray,
+    depth_buf: np.ndarray, bary_buf: np.ndarray, perspective: bool, attributes: bool, band: int, bands: int,
+) -> None:
+    """Clear the band's rows, then draw every stored triangle, in face order, into them."""
+    _clear_band(face_buf, depth_buf, bary_buf, attributes, band, bands)
+    for slot in range(rows.shape[0]):
+        if not overlaps_band(rows[slot, 0], rows[slot, 1], band, bands):
+            continue
+        _fill(tris, slot, face_ids[slot // per_slot], face_buf, depth_buf, bary_buf, perspective, attributes, band,
+              bands)
+
+
+_per_thread = threading.local()
+
+
+def _scratch(slots: int) -> tuple[np.ndarray, np.ndarray]:
+    """(slots, 6, 3) float64 triangles and (slots, 2) int64 row ranges, reused by the calling thread's draws
+    (fresh large arrays cost page faults every frame)."""
+    tris: np.ndarray | None = getattr(_per_thread, "tris", None)
+    rows: np.ndarray | None = getattr(_per_thread, "rows", None)
+    if tris is None or rows is None or tris.shape[0] < slots:
+        tris, rows = np.empty((slots, 6, 3)), np.empty((slots, 2), np.int64)
+        _per_thread.tris, _per_thread.rows = tris, rows
+    return tris[:slots], rows[:slots]
+
+
+def _draw(setup: Callable[[np.ndarray, np.ndarray, int, int], None], slots: int, per_slot: int, face_ids: IntArray,
+          buffers: tuple[IntArray, Float32Array, Float32Array], perspective: bool, attributes: bool,
+          threads: int) -> None:
+    """Set up every face's screen triangles (bands take runs of faces), then fill (bands take rows)."""
+    tris, rows = _scratch(slots)
+    run_bands(lambda band, bands: setup(tris, rows, band, bands), threads)
+    face_buf, depth_buf, bary_buf = buffers
+    run_bands(lambda band, bands: _fill_band(tris, rows, per_slot, face_ids, face_buf, depth_buf, bary_buf,
+                                             perspective, attributes, band, bands), threads)
 
 
 def rasterize_perspective(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
-    fx: float, fy: float, cx: float, cy: float, near: float,
+    fx: float, fy: float, cx: float, cy: float, near: float, threads: int = 1,
 ) -> Fragments:
     """Rasterize faces ``face_ids`` of a mesh whose vertices (n, 3) are in an OpenCV camera frame.
 
-    Faces crossing the near plane are clipped; depth is camera z.
+    Faces crossing the near plane are clipped; depth is camera z. Each of ``threads`` row bands walks every face
+    in order, so the depth test resolves ties as one thread would.
     """
     width, height = size
-    face_buf, depth_buf, bary_buf = _buffers(height, width)
-    _raster_perspective(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), fx, fy, cx, cy,
-                        near, face_buf, depth_buf, bary_buf)
+    face_buf, depth_buf = np.empty((height, width), np.int32), np.empty((height, width), np.float32)
+    bary_buf = np.empty((height, width, 2), np.float32)
+    v_camera = np.ascontiguousarray(v_view, np.float64)
+    ids = face_ids.astype(np.int32)
+    _draw(lambda tris, rows, band, bands: _setup_perspective(v_camera, faces, ids, fx, fy, cx, cy, near, width,
+                                                             height, tris, rows, band, bands),
+          2 * ids.size, 2, ids, (face_buf, depth_buf, bary_buf), True, True, threads)
     return Fragments(face_buf, depth_buf, bary_buf)
+
+
+def depth_orthographic_views(
+    v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int],
+    views: Sequence[tuple[float, float, float]], outs: Sequence[Float32Array], threads: int = 1,
+) -> None:
+    """Nearest depth along +z of a view frame into each of ``outs`` ((H, W) float32, C-contiguous) for the
+    orthographic ``views`` (scale, u0, v0): pixel = (x - u0, y - v0) * scale (no clipping). All views are set up
+    in one parallel step and filled in another, so threads are handed work twice, not twice per view."""
+    width, height = size
+    v_view = np.ascontiguousarray(v_view, np.float64)
+    ids = face_ids.astype(np.int32)
+    no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)
+    stored = [(np.empty((ids.size, 6, 3)), np.empty((ids.size, 2), np.int64)) for _ in views]
+
+    def set_up(band: int, bands: int) -> None:
+        for (scale, u0, v0), (tris, rows) in zip(views, stored):
+            _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height, tris, rows, band, bands)
+
+    def fill(band: int, bands: int) -> None:
+        for depth_buf, (tris, rows) in zip(outs, stored):
+            _fill_band(tris, rows, 1, ids, no_faces, depth_buf, no_bary, False, False, band, bands)
+
+    run_bands(set_up, threads)
+    run_bands(fill, threads)
 
 
 def depth_orthographic(
     v_view: np.ndarray, faces: IntArray, face_ids: IntArray, size: tuple[int, int], scale: float, u0: float, v0: float,
+    threads: int = 1,
 ) -> Float32Array:
     """(H, W) float32 nearest depth along +z of a view frame: pixel = (x - u0, y - v0) * scale (no clipping)."""
     width, height = size
-    depth_buf = np.full((height, width), np.inf, np.float32)
-    _raster_orthographic(np.ascontiguousarray(v_view, np.float64), faces, face_ids.astype(np.int32), scale, u0, v0,
-                         np.empty((1, 1), np.int32), depth_buf, np.empty((1, 1, 2), np.float32))
+    depth_buf = np.empty((height, width), np.float32)
+    depth_orthographic_views(v_view, faces, face_ids, size, [(scale, u0, v0)], [depth_buf], threads)
     return depth_buf
+
+
+@kernel
+def _lookup_rows(face_buf: np.ndarray, per_face: np.ndarray, empty: int, out: np.ndarray, band: int,
+                 bands: int) -> None:
+    height, width = face_buf.shape
+    for row in band_rows(height, band, bands):
+        for col in range(width):
+            f = face_buf[row, col]
+            out[row, col] = per_face[max(f, 0)] if f >= 0 else empty
+
+
+def per_pixel(face_buf: IntArray, per_face: IntArray, empty: int, threads: int = 1) -> IntArray:
+    """(H, W) int32 ``per_face[face]`` of every pixel's face, ``empty`` where nothing was drawn."""
+    out = np.empty(face_buf.shape, np.int32)
+    table = np.ascontiguousarray(per_face, np.int32)
+    run_bands(lambda band, bands: _lookup_rows(face_buf, table, empty, out, band, bands), threads)
+    return out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -11,13 +12,26 @@ from ..camera import PinholeCamera
 from ..paint import MATERIAL_ALBEDO
 from ..scene import ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
+from .bands import run_bands
+from .lighting import face_sun_terms
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish
-from .raster import rasterize_perspective
-from .shading import shade, shade_mirror
-from .shadow_map import ShadowMaps, build_shadow_maps
+from .raster import per_pixel, rasterize_perspective
+from .shading import (
+    Geometry,
+    Reflection,
+    RoadLook,
+    SunShadow,
+    View,
+    frame_lighting,
+    shade,
+    shade_mirror,
+    surface_table,
+)
+from .shadow_map import CascadeCache, ShadowMaps, build_shadow_maps
 from .textures import noise_textures
 
+SURFACE_TABLE = surface_table(MATERIAL_ALBEDO)
 MIRROR_BLUR_PX_AT_1280 = 10
 LAMP_RANGE_M = 75.0
 LAMP_BEHIND_M = 12.0
@@ -48,11 +62,12 @@ def _env_vector(env: Environment) -> np.ndarray:
 
 
 def _no_shadows() -> ShadowMaps:
-    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1), np.inf, np.float32),
+    return ShadowMaps(np.full((1, 8, 8), np.inf, np.float32), np.full((1, 1, 1, 2), np.inf, np.float32),
                       np.array([[0.0, 0.0, 1.0]]), np.eye(3))
 
 
-def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera) -> tuple[np.ndarray, np.ndarray]:
+def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamera,
+                 threads: int) -> tuple[np.ndarray, np.ndarray]:
     """Objects mirrored about the ground under them, rasterized and flat-shaded, blurred along columns."""
     k = camera.intrinsics
     env = scene.env
@@ -63,13 +78,16 @@ def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamer
     v_world = packed.vertices.copy()
     v_world[:, 2] = 2.0 * ground - v_world[:, 2]
     frags = rasterize_perspective(camera.world_to_camera(v_world), packed.faces, packed.mirror_faces,
-                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near, threads)
     img = np.zeros((k.height, k.width, 3), np.float64)
     lamp = 0.05 * len(scene.lights) if env.night else 0.0
-    shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission, packed.face_normal,
-                 env.sun_dir_world, env.sun_color.astype(np.float64), _env_vector(env),
-                 env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64), lamp, img)
-    blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)))
+    env_f = _env_vector(env)
+    sun_color, zenith, horizon = (env.sun_color.astype(np.float64), env.sky_zenith.astype(np.float64),
+                                  env.sky_horizon.astype(np.float64))
+    run_bands(lambda band, bands: shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission,
+                                               packed.face_normal, env.sun_dir_world, sun_color, env_f, zenith,
+                                               horizon, lamp, img, band, bands), threads)
+    blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)), threads)
     return img, frags.depth
 
 
@@ -112,12 +130,51 @@ def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
     return packed.mirror_faces.size > 0 and (scene.env.wetness > 0.05 or scene.env.puddles > 0.0 or wet_layers)
 
 
-def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None) -> Frame:
-    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV)."""
-    return render_view(scene, scene.ego.camera(frame, size))
+@lru_cache(maxsize=4)
+def _nothing_mirrored(height: int, width: int) -> Float32Array:
+    """(H, W) float32 all inf: the mirror depth of a dry frame (shared; the renderer never writes to it)."""
+    return np.full((height, width), np.inf, np.float32)
 
 
-def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:
+def _geometry(packed: PackedScene) -> Geometry:
+    return Geometry(packed.faces, packed.vertex_st, packed.vertex_piece, packed.face_grad_st, packed.face_normal,
+                    packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss)
+
+
+def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
+    fine, coarse = noise_textures()
+    return RoadLook(SURFACE_TABLE, packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
+                    float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
+                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params)
+
+
+def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:
+    """The packed faces' ``face_sun_terms`` for the scene's sun (kept while the sun stays)."""
+    key = np.asarray(scene.env.sun_dir_world, np.float64).tobytes()
+    cached = scene.cache.get("sun_terms")
+    if cached is None or cached[0] != key:
+        cached = key, face_sun_terms(packed.face_normal, scene.env.sun_dir_world)
+        scene.cache["sun_terms"] = cached
+    return cached[1]
+
+
+def _cascade_cache(scene: CompiledScene) -> CascadeCache:
+    """The scene's cache of drawn shadow cascades (its casters never change once packed)."""
+    cache = scene.cache.get("shadow_cascades")
+    if cache is None:
+        cache = scene.cache.setdefault("shadow_cascades", CascadeCache())
+    return cache
+
+
+def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None, threads: int = 1) -> Frame:
+    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV).
+
+    ``threads`` row bands of every stage run in parallel; the bytes are those of one thread.
+    """
+    return render_view(scene, scene.ego.camera(frame, size), threads)
+
+
+def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -> Frame:
     """Render ``scene`` from any camera (e.g. ``camera.pose_camera`` of a vehicle driven in closed loop)."""
     timings: dict[str, float] = {}
     clock = time.perf_counter()
@@ -133,32 +190,30 @@ def render_view(scene: CompiledScene, camera: PinholeCamera) -> Frame:
     env = scene.env
     lap("setup")
     frags = rasterize_perspective(camera.world_to_camera(packed.vertices), packed.faces, packed.camera_faces,
-                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near)
+                                  (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near, threads)
     lap("raster")
-    shadows = (build_shadow_maps(packed, camera, env.sun_dir_world)
+    shadows = (build_shadow_maps(packed, camera, env.sun_dir_world, threads=threads, cache=_cascade_cache(scene))
                if env.sun_intensity > 0 and packed.shadow_faces.size else _no_shadows())
     lap("shadow_map")
     if _needs_mirror(scene, packed):
-        refl_rgb, refl_depth = _mirror_pass(packed, scene, camera)
+        refl_rgb, refl_depth = _mirror_pass(packed, scene, camera, threads)
     else:
-        refl_rgb, refl_depth = np.zeros((1, 1, 3)), np.full((k.height, k.width), np.inf, np.float32)
+        refl_rgb, refl_depth = np.zeros((1, 1, 3)), _nothing_mirrored(k.height, k.width)
     lap("mirror")
     hdr = np.empty((k.height, k.width, 3), np.float32)
-    fine, coarse = noise_textures()
-    shade(frags.face, frags.depth, frags.bary, packed.faces, packed.vertex_st, packed.vertex_piece,
-          packed.face_grad_st, camera.R_world_camera, camera.p_world_camera,
-          k.fx, k.fy, k.cx, k.cy, packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
-          packed.face_normal, MATERIAL_ALBEDO, packed.stripes, packed.stripe_index,
-          float(scene.network.lanes_per_direction), scene.network.lane_width,
-          packed.layers.texels, packed.layers.table, packed.layers.first_level, _frame_lights(packed, camera, env),
-          fine, coarse,
-          _env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
-          env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
-          shadows.depth, shadows.coarse, shadows.params, shadows.R_light_world,
-          packed.overhead, packed.overhead_params, refl_rgb, refl_depth, hdr)
+    view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)
+    lighting = frame_lighting(_env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
+                              env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
+                              _frame_lights(packed, camera, env))
+    geometry, road = _geometry(packed), _road_look(scene, packed)
+    sun_shadow = SunShadow(shadows.depth, shadows.cells, shadows.params, shadows.R_light_world,
+                           _sun_terms(scene, packed))
+    reflection = Reflection(refl_rgb, refl_depth)
+    run_bands(lambda band, bands: shade(frags.face, frags.depth, frags.bary, view, geometry, road, lighting,
+                                        sun_shadow, reflection, hdr, band, bands), threads)
     lap("shade")
-    object_id = np.where(frags.face >= 0, packed.face_object[np.maximum(frags.face, 0)], ID_SKY).astype(np.int32)
+    object_id = per_pixel(frags.face, packed.face_object, ID_SKY, threads)
     rgb = np.empty((k.height, k.width, 3), np.uint8)
-    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb)
+    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb, threads)
     lap("post")
     return Frame(rgb, frags.depth, object_id, camera, timings)

@@ -2,14 +2,28 @@
 
 Inputs are the rasterizer's fragments; output is linear HDR radiance. World positions are rebuilt from depth
 and the pixel's camera ray, road coordinates from the face's vertex (s, t) and the barycentric weights.
+
+The kernel walks each row once; what differs between road materials and objects (roughness, Fresnel, water
+film) comes from a table (``surface_table``), not from branches, and one lighting path serves both. (Separate
+sweeps per row for sky, road and objects measured slower in this scalar code: 2 ms more for the sky's own sweep
+at 1280x720, more again with the lighting duplicated for roads and objects.)
+The inputs travel in a few named bundles (``View``, ``Geometry``, ``RoadLook``, ``Lighting``, ``SunShadow``,
+``Reflection``) and every step of a pixel is a small inlined helper.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+from ..paint import MATERIAL_ALBEDO
+from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from ._jit import kernel
+from .bands import band_rows
 from .lighting import (
+    SUN_BIAS,
+    SUN_OFFSET,
     SUN_SCALE,
     fresnel_schlick,
     glossy_lobe,
@@ -23,12 +37,119 @@ from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA = range(8)
-ASPHALT, CONCRETE, KERB = 0, 1, 4
-WET_FILM_MIRROR = 0.45
+ASPHALT = MATERIALS.index("asphalt")
+PAVED = ("asphalt", "concrete", "kerb")  # hold a water film; grass, gravel and dirt soak it up
+# surface_table columns; its rows are the road MATERIALS, then one for every object
+ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0 = range(7)
+OBJECT_ROW = len(MATERIALS)
+WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
 FOOTPRINT_SCALE = 0.75  # box-filter width in pixels' worth of road coordinate
-MAX_FOOTPRINT_M = 50.0  # a wet film mirrors less than standing water
+MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
+STANDING_WATER_ROUGHNESS = 0.03
+
+
+class View(NamedTuple):
+    """The camera: rotation and position of the camera in the world, pinhole intrinsics (pixels)."""
+
+    R_world_camera: FloatArray
+    p_world_camera: FloatArray
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+
+
+class Geometry(NamedTuple):
+    """Per-face and per-vertex arrays of the packed scene (see ``PackedScene``)."""
+
+    faces: IntArray
+    vertex_st: Float32Array
+    vertex_piece: IntArray
+    face_grad_st: Float32Array
+    face_normal: Float32Array
+    face_material: IntArray
+    face_color: Float32Array
+    face_emission: Float32Array
+    face_gloss: Float32Array
+
+
+class RoadLook(NamedTuple):
+    """What the road surface looks like: material table, paint, surface layers, noise and sky openness."""
+
+    surface: FloatArray  # (materials, 6) see surface_table()
+    stripes: FloatArray
+    stripe_index: np.ndarray
+    lanes: float
+    lane_width: float
+    layer_texels: Float32Array
+    layer_table: FloatArray
+    layer_first: IntArray
+    noise_fine: Float32Array
+    noise_coarse: Float32Array
+    overhead: Float32Array
+    overhead_params: FloatArray
+
+
+class Lighting(NamedTuple):
+    """Sun, sky, lamps and fog of the frame; ``ambient``, ``fog_color`` and ``sun`` are derived (rgb)."""
+
+    env_f: FloatArray
+    sun_dir: FloatArray
+    sun_color: FloatArray
+    zenith: FloatArray
+    horizon: FloatArray
+    lights: FloatArray
+    fog_lut: FloatArray
+    ambient: FloatArray
+    fog_color: FloatArray
+    sun: FloatArray
+
+
+class SunShadow(NamedTuple):
+    """The shadow cascades (see ``ShadowMaps``)."""
+
+    depth: Float32Array
+    cells: Float32Array
+    params: FloatArray
+    R_light_world: FloatArray
+    face_terms: FloatArray  # (m, 2) lighting.face_sun_terms
+
+
+class Reflection(NamedTuple):
+    """The blurred mirror image of the objects and its depth (inf where nothing is mirrored)."""
+
+    rgb: np.ndarray
+    depth: Float32Array
+
+
+def surface_table(albedo: np.ndarray = MATERIAL_ALBEDO) -> FloatArray:
+    """(materials + 1, 7) float64 per road material, then for objects: albedo r, g, b (objects: their faces'),
+    roughness, Fresnel f0 of highlights, holds a water film (0/1), Fresnel f0 of the mirror image."""
+    table = np.zeros((OBJECT_ROW + 1, 7))
+    table[:OBJECT_ROW, ALBEDO_R:ALBEDO_B + 1] = albedo
+    table[:, ROUGHNESS], table[:, F0], table[:, MIRROR_F0] = 0.35, 0.04, 0.02
+    table[ASPHALT, ROUGHNESS], table[ASPHALT, F0] = 0.55, 0.02
+    table[[MATERIALS.index(name) for name in PAVED], HOLDS_WATER] = 1.0
+    table[OBJECT_ROW, ROUGHNESS], table[OBJECT_ROW, MIRROR_F0] = 0.25, 0.05  # glossy paint
+    return table
+
+
+def fog_table(density: float, start_m: float) -> np.ndarray:
+    """(FOG_LUT_SIZE,) float64 share of fog at distance (i + 0.5) / FOG_LUT_PER_M metres."""
+    distance_m = (np.arange(FOG_LUT_SIZE) + 0.5) / FOG_LUT_PER_M
+    return 1.0 - np.exp(-density * np.maximum(distance_m - start_m, 0.0))
+
+
+def frame_lighting(env_f: FloatArray, sun_dir: FloatArray, sun_color: FloatArray, zenith: FloatArray,
+                   horizon: FloatArray, lights: FloatArray) -> Lighting:
+    """The frame's ``Lighting`` with its derived colours: sky ambient, fog colour and sun irradiance."""
+    ambient = env_f[AMBIENT] * (0.5 * horizon + 0.5 * zenith) * 2.2
+    fog_color = horizon * (1.6 * (0.25 + 0.75 * min(env_f[AMBIENT] * 3.0, 1.0)))
+    sun = SUN_SCALE * env_f[SUN_I] * sun_color
+    return Lighting(env_f, sun_dir, sun_color, zenith, horizon, np.ascontiguousarray(lights, np.float64),
+                    fog_table(env_f[FOG_DENSITY], env_f[FOG_DISTANCE]), ambient, fog_color, sun)
 
 
 @kernel(inline="always")
@@ -38,204 +159,287 @@ def coordinate_step(gx: float, gy: float, gz: float, ux: float, uy: float, uz: f
     return FOOTPRINT_SCALE * (abs(gx * ux + gy * uy + gz * uz) + abs(gx * vx + gy * vy + gz * vz)) + 1e-3
 
 
-@kernel
-def shade(
-    face_buf, depth_buf, bary_buf, faces, vertex_st, vertex_piece, face_grad_st, R_wc, c_world, fx, fy, cx, cy,
-    face_material, face_color, face_emission, face_gloss, face_normal, material_albedo,
-    stripes, stripe_index, lanes, lane_width, layer_texels, layer_table, layer_first, lights,
-    noise_fine, noise_coarse, env_f, sun_dir, sun_color, zenith, horizon,
-    shadow_depth, shadow_coarse, shadow_params, R_light, overhead, overhead_params, refl_rgb, refl_depth, out,
-):
-    """Linear radiance of every pixel into ``out`` (H, W, 3). Per-pixel state lives in scalars (registers)."""
-    height, width = face_buf.shape
-    amb_r = env_f[AMBIENT] * (0.5 * horizon[0] + 0.5 * zenith[0]) * 2.2
-    amb_g = env_f[AMBIENT] * (0.5 * horizon[1] + 0.5 * zenith[1]) * 2.2
-    amb_b = env_f[AMBIENT] * (0.5 * horizon[2] + 0.5 * zenith[2]) * 2.2
-    fog_level = 1.6 * (0.25 + 0.75 * min(env_f[AMBIENT] * 3.0, 1.0))
-    fog_r, fog_g, fog_b = horizon[0] * fog_level, horizon[1] * fog_level, horizon[2] * fog_level
-    sun_i = env_f[SUN_I]
-    lx_sun, ly_sun, lz_sun = sun_dir[0], sun_dir[1], sun_dir[2]
-    sun_r, sun_g, sun_b = (SUN_SCALE * sun_i * sun_color[0], SUN_SCALE * sun_i * sun_color[1],
-                           SUN_SCALE * sun_i * sun_color[2])
-    wetness, puddles, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[CLOUD], env_f[PENUMBRA]
-    fog_lut = np.empty(FOG_LUT_SIZE)
-    for i in range(FOG_LUT_SIZE):
-        fog_lut[i] = 1.0 - np.exp(-env_f[FOG_DENSITY] * max((i + 0.5) / FOG_LUT_PER_M - env_f[FOG_DISTANCE], 0.0))
-    last_fog = FOG_LUT_SIZE - 1
-    for row in range(height):
-        y_cam = (row + 0.5 - cy) / fy
-        for col in range(width):
-            x_cam = (col + 0.5 - cx) / fx
-            norm = np.sqrt(x_cam * x_cam + y_cam * y_cam + 1.0)
-            inv_norm = 1.0 / norm
-            dx = (R_wc[0, 0] * x_cam + R_wc[0, 1] * y_cam + R_wc[0, 2]) * inv_norm
-            dy = (R_wc[1, 0] * x_cam + R_wc[1, 1] * y_cam + R_wc[1, 2]) * inv_norm
-            dz = (R_wc[2, 0] * x_cam + R_wc[2, 1] * y_cam + R_wc[2, 2]) * inv_norm
-            f = face_buf[row, col]
-            if f < 0:
-                r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
-                out[row, col, 0] = r
-                out[row, col, 1] = g
-                out[row, col, 2] = b
-                continue
-            depth = depth_buf[row, col]
-            dist = depth * norm
-            px = c_world[0] + dx * dist
-            py = c_world[1] + dy * dist
-            pz = c_world[2] + dz * dist
-            nx, ny, nz = face_normal[f, 0], face_normal[f, 1], face_normal[f, 2]
-            n_dot_v = -(nx * dx + ny * dy + nz * dz)
-            if n_dot_v < 0.0:  # back side of a two-sided face
-                nx, ny, nz, n_dot_v = -nx, -ny, -nz, -n_dot_v
-            material = face_material[f]
-            wet = 0.0
-            gloss = face_gloss[f]
-            roughness = 0.25
-            f0 = 0.04
-            if material >= 0:
-                # Road coordinates from the face's vertices, and their change across the pixel by ray
-                # differentials on the face's plane (exact for the affine (s, t) of a road triangle).
-                b1 = bary_buf[row, col, 0]
-                b2 = bary_buf[row, col, 1]
-                b0 = 1.0 - b1 - b2
-                i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
-                piece = vertex_piece[i0]
-                s = b0 * vertex_st[i0, 0] + b1 * vertex_st[i1, 0] + b2 * vertex_st[i2, 0]
-                t = b0 * vertex_st[i0, 1] + b1 * vertex_st[i1, 1] + b2 * vertex_st[i2, 1]
-                n_dot_r = -max(n_dot_v, 1e-4) * norm  # n faces the viewer, so n.ray < 0
-                k_u = (nx * R_wc[0, 0] + ny * R_wc[1, 0] + nz * R_wc[2, 0]) / n_dot_r
-                k_v = (nx * R_wc[0, 1] + ny * R_wc[1, 1] + nz * R_wc[2, 1]) / n_dot_r
-                su, sv = depth / fx, depth / fy
-                ux = su * (R_wc[0, 0] - dx * norm * k_u)
-                uy = su * (R_wc[1, 0] - dy * norm * k_u)
-                uz = su * (R_wc[2, 0] - dz * norm * k_u)
-                vx = sv * (R_wc[0, 1] - dx * norm * k_v)
-                vy = sv * (R_wc[1, 1] - dy * norm * k_v)
-                vz = sv * (R_wc[2, 1] - dz * norm * k_v)
-                fs = min(coordinate_step(face_grad_st[f, 0], face_grad_st[f, 1], face_grad_st[f, 2],
-                                         ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
-                ft = min(coordinate_step(face_grad_st[f, 3], face_grad_st[f, 4], face_grad_st[f, 5],
-                                         ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
-                footprint = max(fs, ft)
-                grain = sample_noise(noise_fine, FINE_TEXEL_M, s, t, footprint)
-                blotch = sample_noise(noise_coarse, COARSE_TEXEL_M, s * 0.5, t, footprint)
-                tone = (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
-                r = material_albedo[material, 0] * tone
-                g = material_albedo[material, 1] * tone
-                b = material_albedo[material, 2] * tone
-                if material == ASPHALT:
-                    r, g, b, wet = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft, False,
-                                                 r, g, b)
-                    # Only the lane boundaries within the footprint can paint this pixel (boundary k: t = (n - k) w).
-                    last = stripe_index.shape[1] - 1
-                    k0 = max(int(np.floor(lanes - (t + ft + 0.5) / lane_width + 0.5)), 0)
-                    k1 = min(int(np.floor(lanes - (t - ft - 0.5) / lane_width + 0.5)), last - 1)
-                    for k in range(k0, k1 + 1):
-                        r, g, b = paint(stripes, stripe_index[piece, k, 0], stripe_index[piece, k, 1], s, t, fs, ft,
-                                        r, g, b)
-                    r, g, b = paint(stripes, stripe_index[piece, last, 0], stripe_index[piece, last, 1], s, t, fs, ft,
-                                    r, g, b)
-                    r, g, b, wet_over = sample_layers(layer_texels, layer_table, layer_first, piece, s, t, fs, ft,
-                                                      True, r, g, b)
-                    wet = max(wet, wet_over)
-                    if puddles > 0.0:
-                        shape = sample_noise(noise_coarse, COARSE_TEXEL_M, s * 0.7 + 37.0, t * 0.7, footprint)
-                        wet = max(wet, min(max((shape - (0.55 - 1.2 * puddles)) * 6.0, 0.0), 1.0))
-                    roughness = 0.55
-                    f0 = 0.02
-                else:
-                    roughness = 0.35
-                gloss = 0.0
+@kernel(inline="always")
+def pixel_ray(R_world_camera: np.ndarray, x_cam: float, y_cam: float) -> tuple[float, float, float, float]:
+    """(dx, dy, dz, norm): the unit world direction through camera-plane point (x_cam, y_cam, 1) and that
+    point's length (camera z to distance along the ray)."""
+    R = R_world_camera
+    norm = np.sqrt(x_cam * x_cam + y_cam * y_cam + 1.0)
+    inv_norm = 1.0 / norm
+    dx = (R[0, 0] * x_cam + R[0, 1] * y_cam + R[0, 2]) * inv_norm
+    dy = (R[1, 0] * x_cam + R[1, 1] * y_cam + R[1, 2]) * inv_norm
+    dz = (R[2, 0] * x_cam + R[2, 1] * y_cam + R[2, 2]) * inv_norm
+    return dx, dy, dz, norm
+
+
+@kernel(inline="always")
+def facing_normal(normal: np.ndarray, f: int, dx: float, dy: float,
+                  dz: float) -> tuple[float, float, float, float]:
+    """(nx, ny, nz, n.v): the face's world normal turned towards the viewer (faces are two-sided)."""
+    nx, ny, nz = normal[f, 0], normal[f, 1], normal[f, 2]
+    n_dot_v = -(nx * dx + ny * dy + nz * dz)
+    if n_dot_v < 0.0:
+        return -nx, -ny, -nz, -n_dot_v
+    return nx, ny, nz, n_dot_v
+
+
+@kernel(inline="always")
+def road_footprint(R_world_camera: np.ndarray, fx: float, fy: float, grad_st: np.ndarray, f: int, depth: float,
+                   norm: float, dx: float, dy: float, dz: float, nx: float, ny: float, nz: float,
+                   n_dot_v: float) -> tuple[float, float]:
+    """(fs, ft): how much s and t change across the pixel, by ray differentials on the face's plane (exact for
+    the affine (s, t) of a road triangle)."""
+    R = R_world_camera
+    n_dot_r = -max(n_dot_v, 1e-4) * norm  # n faces the viewer, so n.ray < 0
+    k_u = (nx * R[0, 0] + ny * R[1, 0] + nz * R[2, 0]) / n_dot_r
+    k_v = (nx * R[0, 1] + ny * R[1, 1] + nz * R[2, 1]) / n_dot_r
+    su, sv = depth / fx, depth / fy
+    ux = su * (R[0, 0] - dx * norm * k_u)
+    uy = su * (R[1, 0] - dy * norm * k_u)
+    uz = su * (R[2, 0] - dz * norm * k_u)
+    vx = sv * (R[0, 1] - dx * norm * k_v)
+    vy = sv * (R[1, 1] - dy * norm * k_v)
+    vz = sv * (R[2, 1] - dz * norm * k_v)
+    fs = min(coordinate_step(grad_st[f, 0], grad_st[f, 1], grad_st[f, 2], ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
+    ft = min(coordinate_step(grad_st[f, 3], grad_st[f, 4], grad_st[f, 5], ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
+    return fs, ft
+
+
+@kernel(inline="always")
+def road_coordinates(faces: np.ndarray, vertex_st: np.ndarray, bary: np.ndarray, row: int, col: int,
+                     f: int) -> tuple[float, float]:
+    """(s, t) of the pixel on road face ``f`` from its perspective-correct barycentric weights."""
+    b1 = bary[row, col, 0]
+    b2 = bary[row, col, 1]
+    b0 = 1.0 - b1 - b2
+    i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+    s = b0 * vertex_st[i0, 0] + b1 * vertex_st[i1, 0] + b2 * vertex_st[i2, 0]
+    t = b0 * vertex_st[i0, 1] + b1 * vertex_st[i1, 1] + b2 * vertex_st[i2, 1]
+    return s, t
+
+
+@kernel(inline="always")
+def albedo(surface: np.ndarray, material: int, grain: float, blotch: float) -> tuple[float, float, float]:
+    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1])."""
+    tone = (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
+    return surface[material, ALBEDO_R] * tone, surface[material, ALBEDO_G] * tone, surface[material, ALBEDO_B] * tone
+
+
+@kernel(inline="always")
+def boundaries_near(lanes: float, lane_width: float, last: int, t: float, ft: float) -> tuple[int, int]:
+    """(k0, k1): the lane boundaries whose paint can reach a pixel at ``t`` (boundary k: t = (n - k) w)."""
+    k0 = max(int(np.floor(lanes - (t + ft + 0.5) / lane_width + 0.5)), 0)
+    k1 = min(int(np.floor(lanes - (t - ft - 0.5) / lane_width + 0.5)), last - 1)
+    return k0, k1
+
+
+@kernel(inline="always")
+def puddle_depth(shape: float, puddles: float) -> float:
+    """Standing water in [0, 1] where the puddle noise is ``shape``, for the weather's puddle coverage."""
+    return min(max((shape - (0.55 - 1.2 * puddles)) * 6.0, 0.0), 1.0)
+
+
+@kernel(inline="always")
+def wet_surface(r: float, g: float, b: float, roughness: float, surface_wet: float,
+                standing: float) -> tuple[float, float, float, float]:
+    """(r, g, b, roughness) of a surface under a water film ``surface_wet`` (darker, smoother; mirror-smooth
+    where ``standing`` water is deep)."""
+    if surface_wet <= 0.0:
+        return r, g, b, roughness
+    darken = 1.0 - 0.5 * surface_wet
+    roughness = roughness * (1.0 - surface_wet) + 0.09 * surface_wet
+    if standing > 0.5:
+        roughness = STANDING_WATER_ROUGHNESS
+    return r * darken, g * darken, b * darken, roughness
+
+
+@kernel(inline="always")
+def sun_lit(sun_dir: np.ndarray, sun: np.ndarray, visibility: float, n_dot_l: float, nx: float, ny: float,
+            nz: float, dx: float, dy: float, dz: float, roughness: float, fresnel: float,
+            shiny: float) -> tuple[float, float, float, float, float, float]:
+    """(diffuse irradiance rgb, specular radiance rgb) of the sun seen with ``visibility``."""
+    k = n_dot_l * visibility
+    spec = 0.0
+    if visibility > 0.0 and shiny > 0.0:
+        hx, hy, hz = sun_dir[0] - dx, sun_dir[1] - dy, sun_dir[2] - dz
+        n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
+        exponent, normalisation, cutoff = lobe_shape(roughness)
+        spec = visibility * glossy_lobe(n_dot_h, exponent, normalisation, cutoff) * fresnel * 0.25 * shiny
+    return sun[0] * k, sun[1] * k, sun[2] * k, sun[0] * spec, sun[1] * spec, sun[2] * spec
+
+
+@kernel(inline="always")
+def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float, dx: float,
+               dy: float, dz: float, roughness: float, fresnel: float,
+               shiny: float) -> tuple[float, float, float, float, float, float]:
+    """(diffuse irradiance rgb, specular radiance rgb) of every lamp at world point p."""
+    light_r = light_g = light_b = 0.0
+    spec_r = spec_g = spec_b = 0.0
+    if lights.shape[0] == 0:
+        return light_r, light_g, light_b, spec_r, spec_g, spec_b
+    lobe = lobe_shape(roughness)
+    for i in range(lights.shape[0]):
+        lx = lights[i, 0] - px
+        ly = lights[i, 1] - py
+        lz = lights[i, 2] - pz
+        d2 = lx * lx + ly * ly + lz * lz
+        inv_dl = 1.0 / np.sqrt(d2)
+        ndl = (nx * lx + ny * ly + nz * lz) * inv_dl
+        if ndl <= 0.0:
+            continue
+        power = lights[i, 6] / (d2 + 1.0)
+        hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
+        n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
+        k_spec = power * glossy_lobe(n_dot_h, lobe[0], lobe[1], lobe[2]) * fresnel * (0.1 + shiny)
+        k_diff = power * ndl
+        light_r += lights[i, 3] * k_diff
+        light_g += lights[i, 4] * k_diff
+        light_b += lights[i, 5] * k_diff
+        spec_r += lights[i, 3] * k_spec
+        spec_g += lights[i, 4] * k_spec
+        spec_b += lights[i, 5] * k_spec
+    return light_r, light_g, light_b, spec_r, spec_g, spec_b
+
+
+@kernel(inline="always")
+def shade_lit(color: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
+              sun: tuple[float, float, float, float, float, float],
+              lamps: tuple[float, float, float, float, float, float]) -> tuple[float, float, float]:
+    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and emission."""
+    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0],
+            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1],
+            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2])
+
+
+@kernel(inline="always")
+def blend(r: float, g: float, b: float, ref: tuple[float, float, float], strength: float) -> tuple[float, float, float]:
+    """(r, g, b) mixed towards the reflected colour ``ref`` by ``strength``."""
+    return (r * (1.0 - strength) + ref[0] * strength, g * (1.0 - strength) + ref[1] * strength,
+            b * (1.0 - strength) + ref[2] * strength)
+
+
+@kernel(inline="always")
+def mirrored_ray(dx: float, dy: float, dz: float, nx: float, ny: float, nz: float) -> tuple[float, float, float]:
+    """The view ray reflected about the normal."""
+    dot = dx * nx + dy * ny + dz * nz
+    return dx - 2.0 * dot * nx, dy - 2.0 * dot * ny, dz - 2.0 * dot * nz
+
+
+@kernel(inline="always")
+def write_fogged(fog_lut: np.ndarray, fog_color: np.ndarray, out: np.ndarray, row: int, col: int, dist: float,
+                 r: float, g: float, b: float) -> None:
+    """Store (r, g, b) seen through ``dist`` metres of fog."""
+    fog = fog_lut[min(int(dist * FOG_LUT_PER_M), fog_lut.size - 1)]
+    out[row, col, 0] = r * (1.0 - fog) + fog_color[0] * fog
+    out[row, col, 1] = g * (1.0 - fog) + fog_color[1] * fog
+    out[row, col, 2] = b * (1.0 - fog) + fog_color[2] * fog
+
+
+@kernel(inline="always")
+def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: View, geometry: Geometry,
+              road: RoadLook, lighting: Lighting, shadow: SunShadow, reflection: Reflection, row: int, y_cam: float,
+              out: np.ndarray) -> None:
+    """Shade ``row``: the sky where nothing was drawn, else the road material (by ``surface_table``) or an
+    object's flat colour, then the same lighting for both.
+
+    The bundles are opened once per row. Helpers that loop (noise, paint, layers, shadow taps) are called from
+    here, not from other helpers, and results are written here: measured, either nested costs 5-10 % of the
+    kernel's time."""
+    R, c_world, fx, fy, cx, _ = view
+    faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss = geometry
+    surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
+        overhead_params = road
+    env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
+    maps, cells, shadow_params, R_light, sun_terms = shadow
+    refl_rgb, refl_depth = reflection
+    wetness, puddles, sun_i, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[SUN_I], env_f[CLOUD], \
+        env_f[PENUMBRA]
+    last = stripe_index.shape[1] - 1
+    for col in range(face.shape[1]):
+        f = face[row, col]
+        dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
+        if f < 0:
+            r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+            out[row, col, 0] = r
+            out[row, col, 1] = g
+            out[row, col, 2] = b
+            continue
+        depth = depth_buf[row, col]
+        dist = depth * norm
+        px, py, pz = c_world[0] + dx * dist, c_world[1] + dy * dist, c_world[2] + dz * dist
+        nx, ny, nz, n_dot_v = facing_normal(normal, f, dx, dy, dz)
+        material = face_material[f]
+        kind = material if material >= 0 else OBJECT_ROW
+        wet = 0.0
+        up = 0.6 + 0.4 * nz
+        if material >= 0:
+            fs, ft = road_footprint(R, fx, fy, grad_st, f, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
+            footprint = max(fs, ft)
+            s, t = road_coordinates(faces, vertex_st, bary, row, col, f)
+            r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint),
+                             sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint))
+            if material == ASPHALT:  # only asphalt carries paint and surface layers
+                piece = vertex_piece[faces[f, 0]]
+                r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
+                k0, k1 = boundaries_near(lanes, lane_width, last, t, ft)
+                for k in range(k0, k1 + 1):
+                    r, g, b = paint(stripes, stripe_index[piece, k, 0], stripe_index[piece, k, 1], s, t, fs, ft, r,
+                                    g, b)
+                r, g, b = paint(stripes, stripe_index[piece, last, 0], stripe_index[piece, last, 1], s, t, fs, ft, r,
+                                g, b)
+                r, g, b, wet_over = sample_layers(texels, table, first, piece, s, t, fs, ft, True, r, g, b)
+                wet = max(wet, wet_over)
+                if puddles > 0.0:
+                    shape = sample_noise(coarse, COARSE_TEXEL_M, s * 0.7 + 37.0, t * 0.7, footprint)
+                    wet = max(wet, puddle_depth(shape, puddles))
+            up *= sky_openness(overhead, overhead_params, px, py)  # ground under a roof sees less sky
+        else:
+            r, g, b = color[f, 0], color[f, 1], color[f, 2]
+        gloss = face_gloss[f]  # 0 on the road
+        surface_wet = max(wetness * surface[kind, HOLDS_WATER], wet)  # 0 on objects
+        r, g, b, roughness = wet_surface(r, g, b, surface[kind, ROUGHNESS], surface_wet, wet)
+        shiny = surface_wet + gloss
+        fresnel = fresnel_schlick(n_dot_v, max(surface[kind, F0], gloss * 0.08))
+        n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
+        direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        if sun_i > 0.0 and n_dot_l > 0.0:
+            vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
+                                 cells, shadow_params, R_light, penumbra)
+            direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
+        lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
+        r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
+        if shiny > 0.0:  # wet road or glossy paint: a mirror of the sky, or on the road of the objects
+            strength = fresnel_schlick(n_dot_v, surface[kind, MIRROR_F0]) * (
+                wet + (surface_wet - wet) * WET_FILM_MIRROR + gloss)
+            mirrored = refl_depth[row, col]
+            if material >= 0 and mirrored < np.inf and mirrored > depth:
+                ref = (refl_rgb[row, col, 0], refl_rgb[row, col, 1], refl_rgb[row, col, 2])
             else:
-                r, g, b = face_color[f, 0], face_color[f, 1], face_color[f, 2]
-            # Paved surfaces hold a water film; grass, gravel and dirt soak it up.
-            paved = material == ASPHALT or material == CONCRETE or material == KERB
-            surface_wet = max(wetness if paved else 0.0, wet)
-            if surface_wet > 0.0:
-                darken = 1.0 - 0.5 * surface_wet
-                r *= darken
-                g *= darken
-                b *= darken
-                roughness = roughness * (1.0 - surface_wet) + 0.09 * surface_wet
-                if wet > 0.5:
-                    roughness = 0.03
-            shiny = surface_wet + gloss
-            spec_f0 = max(f0, gloss * 0.08)
-            exponent, normalisation, cutoff = lobe_shape(roughness)
-            light_r = light_g = light_b = 0.0
-            spec_r = spec_g = spec_b = 0.0
-            # Direct sun.
-            n_dot_l = nx * lx_sun + ny * ly_sun + nz * lz_sun
-            if sun_i > 0.0 and n_dot_l > 0.0:
-                vis = sun_visibility(px, py, pz, nx, ny, nz, n_dot_l, shadow_depth, shadow_coarse, shadow_params,
-                                     R_light, penumbra)
-                k = n_dot_l * vis
-                light_r += sun_r * k
-                light_g += sun_g * k
-                light_b += sun_b * k
-                if vis > 0.0 and shiny > 0.0:
-                    hx, hy, hz = lx_sun - dx, ly_sun - dy, lz_sun - dz
-                    n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-                    k = (vis * glossy_lobe(n_dot_h, exponent, normalisation, cutoff)
-                         * fresnel_schlick(n_dot_v, spec_f0) * 0.25 * shiny)
-                    spec_r += sun_r * k
-                    spec_g += sun_g * k
-                    spec_b += sun_b * k
-            # Lamps.
-            for i in range(lights.shape[0]):
-                lx = lights[i, 0] - px
-                ly = lights[i, 1] - py
-                lz = lights[i, 2] - pz
-                d2 = lx * lx + ly * ly + lz * lz
-                inv_dl = 1.0 / np.sqrt(d2)
-                ndl = (nx * lx + ny * ly + nz * lz) * inv_dl
-                if ndl <= 0.0:
-                    continue
-                power = lights[i, 6] / (d2 + 1.0)
-                hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
-                n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-                k_spec = (power * glossy_lobe(n_dot_h, exponent, normalisation, cutoff)
-                          * fresnel_schlick(n_dot_v, spec_f0) * (0.1 + shiny))
-                k_diff = power * ndl
-                light_r += lights[i, 3] * k_diff
-                light_g += lights[i, 4] * k_diff
-                light_b += lights[i, 5] * k_diff
-                spec_r += lights[i, 3] * k_spec
-                spec_g += lights[i, 4] * k_spec
-                spec_b += lights[i, 5] * k_spec
-            up = 0.6 + 0.4 * nz
-            if material >= 0:  # ground under a roof, deck or crown sees less sky
-                up *= sky_openness(overhead, overhead_params, px, py)
-            r = r * (light_r + amb_r * up) + spec_r + face_emission[f, 0]
-            g = g * (light_g + amb_g * up) + spec_g + face_emission[f, 1]
-            b = b * (light_b + amb_b * up) + spec_b + face_emission[f, 2]
-            # Mirror reflection of sky and objects on wet surfaces and glossy paint.
-            mirror = surface_wet if material >= 0 else gloss
-            if mirror > 0.0:
-                fres = fresnel_schlick(n_dot_v, 0.02 if material >= 0 else 0.05)
-                strength = fres * (wet + (surface_wet - wet) * WET_FILM_MIRROR if material >= 0 else gloss)
-                dot = dx * nx + dy * ny + dz * nz
-                ref_r, ref_g, ref_b = sky_radiance(dx - 2.0 * dot * nx, dy - 2.0 * dot * ny, dz - 2.0 * dot * nz,
-                                                   sun_dir, sun_color, sun_i * (1.0 - roughness), zenith, horizon,
-                                                   cloud)
-                if material >= 0 and refl_depth[row, col] < np.inf and refl_depth[row, col] > depth:
-                    ref_r, ref_g, ref_b = refl_rgb[row, col, 0], refl_rgb[row, col, 1], refl_rgb[row, col, 2]
-                r = r * (1.0 - strength) + ref_r * strength
-                g = g * (1.0 - strength) + ref_g * strength
-                b = b * (1.0 - strength) + ref_b * strength
-            # Distance fog.
-            fog = fog_lut[min(int(dist * FOG_LUT_PER_M), last_fog)]
-            out[row, col, 0] = r * (1.0 - fog) + fog_r * fog
-            out[row, col, 1] = g * (1.0 - fog) + fog_g * fog
-            out[row, col, 2] = b * (1.0 - fog) + fog_b * fog
+                mx, my, mz = mirrored_ray(dx, dy, dz, nx, ny, nz)
+                ref = sky_radiance(mx, my, mz, sun_dir, sun_color, sun_i * (1.0 - roughness), zenith, horizon,
+                                   cloud)
+            r, g, b = blend(r, g, b, ref, strength)
+        write_fogged(fog_lut, fog_color, out, row, col, dist, r, g, b)
 
 
 @kernel
-def shade_mirror(face_buf, depth_buf, face_color, face_emission, face_normal, sun_dir, sun_color, env_f,
-                 zenith, horizon, lights_rgb_scale, out):
-    """Flat-shade the mirrored objects (no shadows): what a wet road reflects."""
+def shade(face: np.ndarray, depth: np.ndarray, bary: np.ndarray, view: View, geometry: Geometry, road: RoadLook,
+          lighting: Lighting, shadow: SunShadow, reflection: Reflection, out: np.ndarray, band: int,
+          bands: int) -> None:
+    """Linear radiance of the pixels of one row band into ``out`` (H, W, 3)."""
+    for row in band_rows(face.shape[0], band, bands):
+        y_cam = (row + 0.5 - view.cy) / view.fy
+        shade_row(face, depth, bary, view, geometry, road, lighting, shadow, reflection, row, y_cam, out)
+
+
+@kernel
+def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.ndarray, face_emission: np.ndarray,
+                 face_normal: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, env_f: np.ndarray,
+                 zenith: np.ndarray, horizon: np.ndarray, lights_rgb_scale: float, out: np.ndarray, band: int,
+                 bands: int) -> None:
+    """Flat-shade the mirrored objects (no shadows) of one row band: what a wet road reflects."""
     height, width = face_buf.shape
-    for row in range(height):
+    for row in band_rows(height, band, bands):
         for col in range(width):
             f = face_buf[row, col]
             if f < 0:

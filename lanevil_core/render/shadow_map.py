@@ -6,19 +6,25 @@ the ground part of one slice of the camera frustum, snapped to whole texels so s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import threading
+from collections import OrderedDict
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..camera import PinholeCamera
 from ..typed import Float32Array, FloatArray
-from .lighting import COARSE_SHIFT, min_pool
+from ._jit import kernel
+from .bands import band_rows, run_bands
+from .lighting import COARSE_SHIFT, FAR_AROUND, NEAR_AROUND
 from .packed import PackedScene
-from .raster import depth_orthographic
+from .raster import depth_orthographic_views
 
 CASCADE_FAR_M = (18.0, 55.0, 220.0)
 CASCADE_SIZE = 1024  # at 1280 pixels wide
 GROUND_BAND_M = (-4.0, 14.0)  # heights around the camera's ground that receive shadows worth mapping
+CACHED_CASCADES = 6  # two frames' worth: a cascade whose snapped origin stays put is not drawn again
 
 
 @dataclass(frozen=True)
@@ -30,7 +36,7 @@ class ShadowMaps:
     """
 
     depth: Float32Array
-    coarse: Float32Array  # (C, S/8, S/8) nearest caster depth per 8x8 texels, for a quick "fully lit" test
+    cells: Float32Array  # (C, S/8, S/8, 2) per 8x8 texels, see lighting.NEAR_AROUND, FAR_AROUND
     params: FloatArray
     R_light_world: FloatArray
 
@@ -63,23 +69,138 @@ def cascade_size(image_width: int) -> int:
     return int(min(max(2 ** round(np.log2(image_width * CASCADE_SIZE / 1280)), 256), 2048))
 
 
+@kernel
+def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np.ndarray, band: int,
+                bands: int) -> None:
+    """The nearest and the farthest caster depth of every 2**shift square of one map, for one band's cell rows."""
+    cells = depth.shape[0] >> shift
+    for cell_y in band_rows(cells, band, bands):
+        for cell_x in range(cells):
+            low = np.inf
+            high = -np.inf
+            for y in range(cell_y << shift, (cell_y + 1) << shift):
+                for x in range(cell_x << shift, (cell_x + 1) << shift):
+                    low = min(low, depth[y, x])
+                    high = max(high, depth[y, x])
+            nearest[cell_y, cell_x] = low
+            farthest[cell_y, cell_x] = high
+
+
+@kernel
+def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
+    """Every cell's extremes over itself and its eight neighbours, for the cell rows of one band."""
+    cells = nearest.shape[0]
+    for y in band_rows(cells, band, bands):
+        for x in range(cells):
+            low = np.inf
+            high = -np.inf
+            for j in range(max(y - 1, 0), min(y + 2, cells)):
+                for i in range(max(x - 1, 0), min(x + 2, cells)):
+                    low = min(low, nearest[j, i])
+                    high = max(high, farthest[j, i])
+            out[y, x, NEAR_AROUND] = low
+            out[y, x, FAR_AROUND] = high
+
+
+def pool_extremes(depths: Sequence[Float32Array], shift: int, threads: int = 1) -> list[Float32Array]:
+    """Per map of ``depths``, (S >> shift, S >> shift, 2): the nearest and the farthest caster depth in each
+    2**shift square and its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is any
+    caster near enough to shade this point?" and "does every texel around it shade it?" for any filter reaching
+    less than 2**shift texels. All maps are pooled in one parallel step and dilated in another."""
+    cells = [depth.shape[0] >> shift for depth in depths]
+    pooled = [(np.full((n, n), np.inf, np.float32), np.full((n, n), -np.inf, np.float32)) for n in cells]
+    outs = [np.empty((n, n, 2), np.float32) for n in cells]
+
+    def pool(band: int, bands: int) -> None:
+        for depth, (nearest, farthest) in zip(depths, pooled):
+            _pool_cells(depth, shift, nearest, farthest, band, bands)
+
+    def dilate(band: int, bands: int) -> None:
+        for (nearest, farthest), out in zip(pooled, outs):
+            _dilate_cells(nearest, farthest, out, band, bands)
+
+    run_bands(pool, threads)
+    run_bands(dilate, threads)
+    return outs
+
+
+CascadeKey = tuple[bytes, int, float, float, float]
+CascadeMaps = tuple[Float32Array, Float32Array]  # depth, extremes per coarse cell
+
+
+@dataclass
+class CascadeCache:
+    """Rasterized cascades of one caster set (a packed scene's), most recent last.
+
+    A cascade is fully determined by the sun direction, its size and its snapped origin and texel, so a key of
+    those finds a map that is byte-identical to drawing it again. The casters of a packed scene never change;
+    a scene whose objects change is compiled and packed anew and gets a new cache.
+    """
+
+    entries: OrderedDict[CascadeKey, CascadeMaps] = field(default_factory=OrderedDict)
+    lock: threading.Lock = field(default_factory=threading.Lock)
+    hits: int = 0
+
+    def get(self, key: CascadeKey) -> CascadeMaps | None:
+        with self.lock:
+            found = self.entries.get(key)
+            if found is not None:
+                self.entries.move_to_end(key)
+                self.hits += 1
+            return found
+
+    def put(self, key: CascadeKey, maps: CascadeMaps) -> None:
+        with self.lock:
+            self.entries[key] = maps
+            while len(self.entries) > CACHED_CASCADES:
+                self.entries.popitem(last=False)
+
+
+def _cascade_frame(camera: PinholeCamera, R_light_world: FloatArray, near: float, far: float,
+                   size: int) -> tuple[float, float, float]:
+    """(u0, v0, texel) of the cascade covering the frustum slice [near, far]: light-frame origin of its corner
+    texel and the texel's size in metres, snapped to whole power-of-two texels."""
+    p_light = _slice_points_world(camera, near, far) @ R_light_world.T
+    lo, hi = p_light[:, :2].min(axis=0), p_light[:, :2].max(axis=0)
+    extent = float(max(hi - lo)) * 1.05 + 1.0
+    texel = float(2.0 ** np.ceil(np.log2(extent / size)))  # power-of-two texels keep snapping stable
+    u0 = float(np.floor((0.5 * (lo[0] + hi[0]) - 0.5 * size * texel) / texel) * texel)
+    v0 = float(np.floor((0.5 * (lo[1] + hi[1]) - 0.5 * size * texel) / texel) * texel)
+    return u0, v0, texel
+
+
 def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world: FloatArray,
-                      size: int | None = None) -> ShadowMaps:
-    """Rasterize every shadow-casting face into each cascade (``size`` texels a side; default from the image)."""
+                      size: int | None = None, threads: int = 1, cache: CascadeCache | None = None) -> ShadowMaps:
+    """Rasterize every shadow-casting face into each cascade (``size`` texels a side; default from the image).
+
+    With a ``cache`` (of this packed scene's casters), a cascade already drawn for the same sun and snapped
+    origin is reused.
+    """
     size = size if size is not None else cascade_size(camera.intrinsics.width)
     R_light_world = light_rotation(sun_dir_world)
-    v_light = packed.vertices @ R_light_world.T
+    sun_key = np.asarray(sun_dir_world, np.float64).tobytes()
     depth = np.empty((len(CASCADE_FAR_M), size, size), np.float32)
+    cells = np.empty((len(CASCADE_FAR_M), size >> COARSE_SHIFT, size >> COARSE_SHIFT, 2), np.float32)
     params = np.zeros((len(CASCADE_FAR_M), 3))
+    missing: list[tuple[int, CascadeKey]] = []
     near = 0.1
     for c, far in enumerate(CASCADE_FAR_M):
-        p_light = _slice_points_world(camera, near, far) @ R_light_world.T
-        lo, hi = p_light[:, :2].min(axis=0), p_light[:, :2].max(axis=0)
-        extent = float(max(hi - lo)) * 1.05 + 1.0
-        texel = 2.0 ** np.ceil(np.log2(extent / size))  # power-of-two texels keep snapping stable
-        u0 = np.floor((0.5 * (lo[0] + hi[0]) - 0.5 * size * texel) / texel) * texel
-        v0 = np.floor((0.5 * (lo[1] + hi[1]) - 0.5 * size * texel) / texel) * texel
-        depth[c] = depth_orthographic(v_light, packed.faces, packed.shadow_faces, (size, size), 1.0 / texel, u0, v0)
+        u0, v0, texel = _cascade_frame(camera, R_light_world, near, far, size)
+        key: CascadeKey = (sun_key, size, u0, v0, texel)
         params[c] = (u0, v0, 1.0 / texel)
+        maps = cache.get(key) if cache is not None else None
+        if maps is None:
+            missing.append((c, key))
+        else:
+            depth[c], cells[c] = maps
         near = far * 0.9
-    return ShadowMaps(depth, min_pool(depth, COARSE_SHIFT), params, R_light_world)
+    if missing:
+        v_light = packed.vertices @ R_light_world.T
+        views = [(params[c, 2], params[c, 0], params[c, 1]) for c, _ in missing]
+        depth_orthographic_views(v_light, packed.faces, packed.shadow_faces, (size, size), views,
+                                 [depth[c] for c, _ in missing], threads)
+        for (c, key), extremes in zip(missing, pool_extremes([depth[c] for c, _ in missing], COARSE_SHIFT, threads)):
+            cells[c] = extremes
+            if cache is not None:
+                cache.put(key, (depth[c], cells[c]))  # views of this frame's maps, never written again
+    return ShadowMaps(depth, cells, params, R_light_world)

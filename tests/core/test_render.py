@@ -14,7 +14,7 @@ from PIL import Image
 
 from lanevil_core.case import Case, load_case
 from lanevil_core.compile import compile_scene
-from lanevil_core.render import render_frame
+from lanevil_core.render import Frame, render_frame
 from lanevil_core.scene import FIRST_OBJECT_ID, ID_ROAD, ID_SKY
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -130,3 +130,29 @@ def test_every_stock_case_renders(path: Path) -> None:
     case = load_case(path)
     frame = render_frame(compile_scene(_small(case, (160, 90))), case.ego.frames - 1)
     assert frame.rgb.std() > 5.0  # not a blank image
+
+
+THREADED_CASE = "40_reflection/vehicle_reflection/05_level5.json"  # vehicles, sun shadows, a wet road and a puddle
+
+
+def _buffers_equal(a: Frame, b: Frame) -> bool:
+    return (np.array_equal(a.rgb, b.rgb) and np.array_equal(a.depth, b.depth)
+            and np.array_equal(a.object_id, b.object_id))
+
+
+def test_threads_give_the_bytes_of_one_thread() -> None:
+    scene = compile_scene(_small(load_case(ROOT / "scenes" / THREADED_CASE)))
+    assert scene.env.sun_intensity > 0 and scene.env.wetness > 0 and scene.meshes
+    one = render_frame(scene, 4, threads=1)
+    assert _buffers_equal(one, render_frame(scene, 4, threads=2))
+    assert _buffers_equal(one, render_frame(scene, 4, threads=3))
+
+
+def test_a_frame_after_other_frames_equals_it_rendered_cold() -> None:
+    case = _small(load_case(ROOT / "scenes" / THREADED_CASE))
+    cold = render_frame(compile_scene(case), 6)
+    warm_scene = compile_scene(case)
+    for index in (0, 5, 6, 7, 6):  # shadow cascades that did not move are reused
+        warm = render_frame(warm_scene, index, threads=2)
+    assert warm_scene.cache["shadow_cascades"].hits > 0
+    assert _buffers_equal(cold, warm)
