@@ -25,6 +25,7 @@ from .case import Case, parse_case
 from .compile import compile_scene
 from .labels import h_samples_for, tusimple_record
 from .render import render_frame
+from .scene import CompiledScene
 from .typed import BoolArray, UInt8Array
 
 BAND_RADIUS_FRACTION = 1.0 / 64.0  # band half width as a share of the image width (20 px at 1280)
@@ -109,7 +110,12 @@ def in_view_frames(case: Case, count: int, step: int = 2) -> tuple[int, ...]:
 def frame_changes(original: Case, perturbed: Case, frames: Sequence[int],
                   size: tuple[int, int] = (320, 180)) -> list[BandChange]:
     """Band change of each frame between two renders of the same drive (the original's lanes as the band)."""
-    scene_original, scene_perturbed = compile_scene(original), compile_scene(perturbed)
+    return scene_changes(compile_scene(original), compile_scene(perturbed), frames, size)
+
+
+def scene_changes(scene_original: CompiledScene, scene_perturbed: CompiledScene, frames: Sequence[int],
+                  size: tuple[int, int] = (320, 180)) -> list[BandChange]:
+    """``frame_changes`` of two compiled scenes (a caller that has the perturbed scene compiled already)."""
     rows = h_samples_for(size[1])
     changes = []
     for frame_index in frames:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..benchmark_layout import frame_file
-from ..case import parse_case
+from ..case import case_json, parse_case
 from ..compile import compile_scene
 from ..encode import jpeg_bytes, png_bytes
 from ..labels import tusimple_record
@@ -26,7 +26,8 @@ from ..typed import UInt8Array
 from .plan import FORMATS, RenderTask
 
 JPEG_QUALITY = 95
-SCENE_CACHE_SIZE = 2  # compiled scenes kept per process: consecutive chunks of a case compile it once
+SCENE_CACHE_SIZE = 2  # compiled scenes kept per process: consecutive chunks of a case (and of the same case
+# without its illusion, which test records are measured against) compile it once
 
 
 @dataclass(frozen=True)
@@ -80,15 +81,17 @@ def frame_record(scene: CompiledScene, task: RenderTask, frame_index: int, frame
     return {**tusimple_record(scene, frame_index, frame, raw_file), **task.extras}
 
 
-def illusion_changes(task: RenderTask) -> dict[int, dict[str, float]]:
-    """Per frame of a case with an illusion: the share of the lane band it changes and its effect there
-    (``illusion_effect``, measured on small renders against the case without its illusions)."""
-    from ..illusion_effect import SHARE_SIZE, clean_of, frame_changes
+def illusion_changes(task: RenderTask, scene: CompiledScene) -> dict[int, dict[str, float]]:
+    """Per frame of a case with an illusion (compiled: ``scene``): the share of the lane band it changes and its
+    effect there (``illusion_effect``, measured on small renders against the case without its illusions)."""
+    from ..illusion_effect import SHARE_SIZE, clean_of, scene_changes
 
     case = parse_case(task.case_text)
     if not case.illusions:
         return {}
-    changes = frame_changes(clean_of(case), case, task.frames, SHARE_SIZE)
+    clean_text = case_json(clean_of(case))
+    clean = compiled_scene(clean_text, hashlib.sha256(clean_text.encode("utf-8")).hexdigest())
+    changes = scene_changes(clean, scene, task.frames, SHARE_SIZE)
     return {frame: {"illusion_share": round(change.share, 4), "illusion_effect": round(change.effect, 3)}
             for frame, change in zip(task.frames, changes, strict=True)}
 
@@ -97,7 +100,7 @@ def render_chunk(task: RenderTask) -> list[FrameResult]:
     """Render, label and encode the task's frames (encoding of frame k overlaps rendering of frame k + 1)."""
     scene = compiled_scene(task.case_text, task.case_sha256)
     suffix = FORMATS[task.image_format]
-    changes = illusion_changes(task) if task.split == "test" else {}
+    changes = illusion_changes(task, scene) if task.split == "test" else {}
     pending: list[tuple[int, dict[str, Any], Future[tuple[bytes, str]]]] = []
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="lanevil-encode") as encoder:
         for frame_index in task.frames:

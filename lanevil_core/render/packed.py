@@ -68,7 +68,8 @@ def _mips(rgba: np.ndarray, wet: np.ndarray | None) -> list[np.ndarray]:
     levels = [level]
     while min(level.shape[:2]) > 2 and len(levels) < 10:
         h, w = (level.shape[0] // 2) * 2, (level.shape[1] // 2) * 2
-        level = level[:h, :w].reshape(h // 2, 2, w // 2, 2, 5).mean(axis=(1, 3))
+        # The 2x2 box mean as four strided adds: several times faster than reshape().mean() on large layers.
+        level = (level[0:h:2, 0:w:2] + level[1:h:2, 0:w:2] + level[0:h:2, 1:w:2] + level[1:h:2, 1:w:2]) * 0.25
         levels.append(level)
     return levels
 
