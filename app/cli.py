@@ -9,16 +9,10 @@ from pathlib import Path
 
 from lanevil_core import cli as core_cli
 from lanevil_core.cli import Command, UsageError
+from lanevil_core.cli.base import bounded
 
-
-def _port(text: str) -> int:
-    try:
-        port = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a port number") from None
-    if not 0 <= port <= 65535:
-        raise argparse.ArgumentTypeError(f"{text!r}: a port lies in 0..65535 (0 = any free port)")
-    return port
+# 0 = any free port
+_port = bounded(int, "a port number", 0, 65535, " (0 = any free port)")
 
 
 def _serve_arguments(parser: argparse.ArgumentParser) -> None:

@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NoReturn
+from typing import NoReturn, TypeVar
 
 import numpy as np
 
@@ -43,6 +43,33 @@ class Command:
 
 
 # ---------------------------------------------------------------------------------------------- argument types
+
+Number = TypeVar("Number", int, float)
+
+
+def bounded(kind: Callable[[str], Number], noun: str, low: Number, high: Number | None = None,
+            note: str = "") -> Callable[[str], Number]:
+    """An argparse type: ``kind(text)`` (``int`` or ``float``) no less than ``low`` and, if given, no more than
+    ``high``; argparse names the option in the one-line error (``note`` is added to the range)."""
+
+    def parse(text: str) -> Number:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {noun}") from None
+        if high is None and value < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low}")
+        if high is not None and not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text!r}: choose {low}..{high}{note}")
+        return value
+
+    return parse
+
+
+def count(minimum: int) -> Callable[[str], int]:
+    """An argparse type: an integer of at least ``minimum``."""
+    return bounded(int, "an integer", minimum)
+
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (width, height), each 64..4096."""

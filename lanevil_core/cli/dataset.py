@@ -6,33 +6,17 @@ import argparse
 import functools
 import os
 import sys
-from collections.abc import Callable
 from pathlib import Path
 
-from .base import Command, UsageError, parse_size
-
-
-def _count(minimum: int) -> Callable[[str], int]:
-    """An argparse type: an integer of at least ``minimum`` (argparse names the option in errors)."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"must be at least {minimum}")
-        return value
-
-    return parse
+from .base import Command, UsageError, count, parse_size
 
 
 def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cases", type=Path, required=True, help="folder of case files (searched recursively)")
     parser.add_argument("--out", type=Path, required=True, help="output folder (reruns resume into it)")
-    parser.add_argument("--train-frames", type=_count(0), default=0,
+    parser.add_argument("--train-frames", type=count(0), default=0,
                         help="clean train frames, from variations of the clean cases (default 0)")
-    parser.add_argument("--frames-per-case", type=_count(1), default=None,
+    parser.add_argument("--frames-per-case", type=count(1), default=None,
                         help="frames per test case (default: every frame)")
     parser.add_argument("--sampling", choices=("in_view", "even"), default="in_view",
                         help="which test frames with --frames-per-case: in_view (default) = evenly over the frames "
@@ -41,13 +25,13 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--size", type=parse_size, default=(1280, 720), help="WIDTHxHEIGHT (default 1280x720)")
     parser.add_argument("--format", choices=("png", "jpg"), default="png", dest="image_format",
                         help="image format (default png)")
-    parser.add_argument("--workers", type=_count(1), default=os.cpu_count() or 1,
+    parser.add_argument("--workers", type=count(1), default=os.cpu_count() or 1,
                         help="local worker processes (default: all cores; ignored with --scheduler)")
     parser.add_argument("--scheduler", default=None,
                         help="run on the Dask cluster of this scheduler, tcp://HOST:PORT")
     parser.add_argument("--scheduler-timeout", type=float, default=10.0,
                         help="seconds to wait for the scheduler (default 10)")
-    parser.add_argument("--seed", type=_count(0), default=0, help="seed of the train variations")
+    parser.add_argument("--seed", type=count(0), default=0, help="seed of the train variations")
     parser.add_argument("--no-paint", action="store_true",
                         help="also render every original test case with its lane paint removed "
                              "(<case>_nopaint folders, records with \"paint\": false): the paint-free control")

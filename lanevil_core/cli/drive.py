@@ -6,17 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .base import Command, UsageError, parse_size
-
-
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    if not 0.1 <= value <= 600:
-        raise argparse.ArgumentTypeError(f"{text!r}: choose 0.1..600 seconds")
-    return value
+from .base import Command, UsageError, bounded, parse_size
 
 
 def _drive_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,7 +22,7 @@ def _drive_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--weights", type=Path, default=None, help="model folder of a learned detector")
     parser.add_argument("--controller", choices=CONTROLLERS, default="pure_pursuit",
                         help="lateral controller (default pure_pursuit)")
-    parser.add_argument("--seconds", type=_seconds, default=None,
+    parser.add_argument("--seconds", type=bounded(float, "a number of seconds", 0.1, 600, " seconds"), default=None,
                         help="how long to drive (default: the case's drive, frames / fps)")
     parser.add_argument("--size", type=parse_size, default=DEFAULT_SIZE,
                         help=f"camera WIDTHxHEIGHT (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")

@@ -6,8 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .base import Command, UsageError, parse_size
-from .dataset import _count
+from .base import Command, UsageError, count, parse_size
 
 
 def _train_arguments(parser: argparse.ArgumentParser) -> None:
@@ -21,24 +20,24 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--width", type=float, default=0.25,
                         help="backbone channel multiplier (1.0 = published ResNet widths; default 0.25)")
     parser.add_argument("--size", type=parse_size, default=(320, 180), help="network input WxH (default 320x180)")
-    parser.add_argument("--epochs", type=_count(1), default=12, help="default 12")
-    parser.add_argument("--batch", type=_count(1), default=16, help="default 16")
+    parser.add_argument("--epochs", type=count(1), default=12, help="default 12")
+    parser.add_argument("--batch", type=count(1), default=16, help="default 16")
     parser.add_argument("--lr", type=float, default=2e-3, help="peak learning rate of AdamW (default 2e-3)")
     parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste", "aam"),
                         default="none",
                         help="training augmentation / defence: the paper's baselines or aam, Attention Area Mixing "
                              "with hard examples rendered from training variations (default none)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
-    parser.add_argument("--seed", type=_count(0), default=0, help="default 0")
+    parser.add_argument("--seed", type=count(0), default=0, help="default 0")
     parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",
                         help="share of the train split's case folders held out for validation (default 0.1)")
     parser.add_argument("--init", type=Path, default=None,
                         help="state dict to initialise the backbone from (e.g. ImageNet ResNet weights)")
-    parser.add_argument("--threads", type=_count(0), default=0,
+    parser.add_argument("--threads", type=count(0), default=0,
                         help="CPU threads (default 0 = every core; use 1 when other work shares the cores: "
                              "oversubscribed threads make training many times slower)")
     parser.add_argument("--resume", action="store_true", help="continue from MODEL_DIR/checkpoint.pt")
-    parser.add_argument("--max-steps", type=_count(1), default=None, help="batches per epoch at most (smoke runs)")
+    parser.add_argument("--max-steps", type=count(1), default=None, help="batches per epoch at most (smoke runs)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

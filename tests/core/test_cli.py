@@ -224,3 +224,16 @@ def test_bench_on_the_stock_cases(capsys):
     result = json.loads(capsys.readouterr().out)
     assert list(result) == ["1280x720", "640x360"]
     assert result["1280x720"]["median_ms"] > result["640x360"]["median_ms"] > 0
+
+
+def test_bounded_argument_types_name_the_range():
+    import argparse
+
+    from lanevil_core.cli.base import bounded, count
+
+    port = bounded(int, "a port number", 0, 65535)
+    assert port("8080") == 8080 and count(1)("3") == 3
+    for parse, text, message in ((port, "x", "'x' is not a port number"), (port, "70000", "choose 0..65535"),
+                                 (count(1), "0", "must be at least 1")):
+        with pytest.raises(argparse.ArgumentTypeError, match=message):
+            parse(text)
