@@ -1,7 +1,9 @@
 """The one numba decorator of the renderer's hot loops, and a guard for numba's on-disk cache.
 
 Fast-math lets LLVM fuse and vectorise arithmetic; ``nnan``/``ninf`` stay off because depth buffers use inf
-for "nothing here". Results are deterministic for a given machine and build.
+for "nothing here". numpy's error model drops the zero check numba puts before every division (Python would
+raise ZeroDivisionError; the kernels guard their divisors themselves): 25 % off ``shade`` at 1280x720. Results are
+deterministic for a given machine and build.
 
 Numba keys a cached kernel on its own source file only, so a kernel that inlines helpers from another module
 would keep running stale machine code after that module changes. The guard below drops the package's cache
@@ -54,7 +56,8 @@ _drop_stale_cache()
 
 
 def kernel(fn: Callable[..., Any] | None = None, *, inline: str = "never") -> Any:
-    """``numba.njit`` with on-disk caching, the renderer's fast-math flags and the GIL released (so row bands of
-    one frame run on several threads, see ``bands``)."""
-    decorator = nb.njit(cache=True, fastmath=FASTMATH, inline=inline, nogil=True)  # type: ignore[call-overload]  # a set is a valid fastmath
+    """``numba.njit`` with on-disk caching, the renderer's fast-math flags, numpy's error model and the GIL
+    released (so row bands of one frame run on several threads, see ``bands``)."""
+    decorator = nb.njit(  # type: ignore[call-overload]  # a set is a valid fastmath
+        cache=True, fastmath=FASTMATH, inline=inline, nogil=True, error_model="numpy")
     return decorator if fn is None else decorator(fn)
