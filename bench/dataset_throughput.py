@@ -30,7 +30,7 @@ from pathlib import Path
 
 from lanevil_core.dataset import Settings, generate_dataset
 from lanevil_core.dataset.distributed import run_dask
-from lanevil_core.dataset.local import run_local
+from lanevil_core.dataset.local import LocalPool
 from lanevil_core.dataset.run import Executor
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
@@ -62,6 +62,9 @@ def cpu_seconds() -> float:
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
+RENDERED: list[int] = []  # frames rendered per run (in-view sampling may find fewer than asked for per case)
+
+
 def timed_runs(cases: Path, work: Path, settings: Settings, executor: Executor, repeats: int,
                cpu: list[float] | None = None) -> list[float]:
     """frames/s of ``repeats`` runs, each into an empty folder; CPU s per frame of each run appended to ``cpu``."""
@@ -70,6 +73,7 @@ def timed_runs(cases: Path, work: Path, settings: Settings, executor: Executor, 
         out = work / f"run{repeat}"
         cpu_start = cpu_seconds()
         summary = generate_dataset(cases, out, settings, executor, show_progress=False)
+        RENDERED.append(summary.rendered)
         rates.append(summary.rendered / summary.seconds)
         if cpu is not None:
             cpu.append((cpu_seconds() - cpu_start) / summary.rendered)
@@ -91,11 +95,10 @@ def measure(cases: Path, work: Path, settings: Settings, repeats: int) -> dict[s
     (``cpu-local-1``, ``cpu-local-2``: every process of the run, pool start-up included)."""
     results: dict[str, list[float]] = {}
     for workers in (1, 2):
-        executor: Executor = functools.partial(run_local, workers=workers)
         if workers == 1:  # load the kernels in this process once, as a spawned worker does per run
-            timed_runs(cases, work, settings, executor, 1)
+            timed_runs(cases, work, settings, LocalPool(workers), 1)
         cpu: list[float] = []
-        results[f"local-{workers}"] = timed_runs(cases, work, settings, executor, repeats, cpu)
+        results[f"local-{workers}"] = timed_runs(cases, work, settings, LocalPool(workers), repeats, cpu)
         results[f"cpu-local-{workers}"] = cpu
     for workers in (1, 2):
         with dask_executor(workers) as executor:
@@ -138,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="lanevil-bench-") as tmp:
         cases = copy_cases(Path(tmp) / "cases", args.cases)
         results = measure(cases, Path(tmp) / "out", settings, args.repeats)
-    frames = args.cases * args.frames_per_case
+    frames = max(RENDERED)
     if args.json:
         medians = {name: statistics.median(rates) for name, rates in results.items()}
         print(json.dumps({"frames_per_run": frames, "size": list(SIZE), "runs": results, "median": medians}))

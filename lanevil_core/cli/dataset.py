@@ -41,7 +41,8 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
 def _run_dataset(args: argparse.Namespace) -> int:
     from ..dataset import PlanError, Settings, generate_dataset
     from ..dataset.distributed import SchedulerError, check_scheduler_address, run_dask
-    from ..dataset.local import run_local
+    from ..dataset.local import LocalPool
+    from ..dataset.run import Executor
 
     if not args.cases.is_dir():
         raise UsageError(f"--cases {args.cases}: no such folder")
@@ -50,9 +51,9 @@ def _run_dataset(args: argparse.Namespace) -> int:
             address = check_scheduler_address(args.scheduler)
         except SchedulerError as error:
             raise UsageError(str(error)) from None
-        executor = functools.partial(run_dask, address=address, timeout_s=args.scheduler_timeout)
+        executor: Executor = functools.partial(run_dask, address=address, timeout_s=args.scheduler_timeout)
     else:
-        executor = functools.partial(run_local, workers=args.workers)
+        executor = LocalPool(args.workers)
     settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
                         train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint,
                         sampling=args.sampling)

@@ -20,6 +20,8 @@ from .worker import FrameResult, TaskDone
 from .writer import DatasetFolder
 
 Executor = Callable[[Sequence[RenderTask], TaskDone], None]
+# An executor may also have ``start()`` (called before planning, e.g. to spawn workers) and ``close()`` (called
+# after the run, also when it fails): see ``local.LocalPool``.
 
 
 @dataclass(frozen=True)
@@ -99,20 +101,24 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
                      show_progress: bool = True) -> RunSummary:
     """Render the dataset of the cases under ``cases_dir`` into ``out_dir``; frames verified on disk are kept."""
     start = time.perf_counter()
-    plan = build_plan(discover_cases(cases_dir), settings)
-    versions = software_versions()
-    code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
-    folder = DatasetFolder(out_dir, settings.suffix)
-    sidecars = _Sidecars(plan, folder, versions)
-    pending = sidecars.scan()
-    tasks = render_tasks(plan, pending)
-    kept = len(sidecars.found)
-    with progress_bar(plan.total_frames, kept, show_progress) as bar:
+    getattr(executor, "start", lambda: None)()  # e.g. LocalPool: workers start up while the plan is made
+    try:
+        plan = build_plan(discover_cases(cases_dir), settings)
+        versions = software_versions()
+        code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
+        folder = DatasetFolder(out_dir, settings.suffix)
+        sidecars = _Sidecars(plan, folder, versions)
+        pending = sidecars.scan()
+        tasks = render_tasks(plan, pending)
+        kept = len(sidecars.found)
+        with progress_bar(plan.total_frames, kept, show_progress) as bar:
 
-        def on_done(task: RenderTask, results: list[FrameResult]) -> None:
-            sidecars.store(task, results)
-            bar.update(len(results))
+            def on_done(task: RenderTask, results: list[FrameResult]) -> None:
+                sidecars.store(task, results)
+                bar.update(len(results))
 
-        executor(tasks, on_done)
+            executor(tasks, on_done)
+    finally:
+        getattr(executor, "close", lambda: None)()
     _finish(plan, folder, sidecars, versions, code_sha256)
     return RunSummary(out_dir, plan.total_frames, plan.total_frames - kept, kept, time.perf_counter() - start)

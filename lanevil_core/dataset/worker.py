@@ -96,6 +96,17 @@ def illusion_changes(task: RenderTask, scene: CompiledScene) -> dict[int, dict[s
             for frame, change in zip(task.frames, changes, strict=True)}
 
 
+WARM_UP_SIZE = (32, 18)
+
+
+def warm_up() -> None:
+    """Load the renderer's cached kernels in this process (a tiny frame of the default case), so a worker started
+    ahead of its first task is ready when it comes."""
+    from ..case import Case
+
+    render_frame(compile_scene(Case()), 0, WARM_UP_SIZE)
+
+
 def render_chunk(task: RenderTask) -> list[FrameResult]:
     """Render, label and encode the task's frames (encoding of frame k overlaps rendering of frame k + 1)."""
     scene = compiled_scene(task.case_text, task.case_sha256)

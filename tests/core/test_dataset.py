@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import multiprocessing
 import shutil
 import socket
 from collections.abc import Sequence
@@ -16,8 +17,8 @@ from PIL import Image
 from lanevil_core.case import case_json, load_case
 from lanevil_core.cli import main
 from lanevil_core.dataset import Settings, generate_dataset
-from lanevil_core.dataset.local import run_local
-from lanevil_core.dataset.plan import RenderTask
+from lanevil_core.dataset.local import LocalPool, run_local
+from lanevil_core.dataset.plan import PlanError, RenderTask
 from lanevil_core.dataset.worker import FrameResult, TaskDone
 from lanevil_core.labels import h_samples_for
 
@@ -259,6 +260,14 @@ def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err
     assert not (tmp_path / "out" / "manifest.json").exists()
+
+
+def test_workers_started_before_planning_stop_when_planning_fails(tmp_path: Path) -> None:
+    pool = LocalPool(2)
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(PlanError, match="no case files"):
+        generate_dataset(tmp_path / "empty", tmp_path / "out", Settings(size=(64, 36)), pool, show_progress=False)
+    assert multiprocessing.active_children() == []
 
 
 def test_dask_cluster_writes_the_same_bytes_as_the_local_run(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
