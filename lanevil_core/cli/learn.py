@@ -23,10 +23,11 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--epochs", type=count(1), default=12, help="default 12")
     parser.add_argument("--batch", type=count(1), default=16, help="default 16")
     parser.add_argument("--lr", type=float, default=2e-3, help="peak learning rate of AdamW (default 2e-3)")
-    parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste", "aam"),
+    parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste", "aam", "pgd"),
                         default="none",
-                        help="training augmentation / defence: the paper's baselines or aam, Attention Area Mixing "
-                             "with hard examples rendered from training variations (default none)")
+                        help="training augmentation / defence: the paper's baselines, aam (Attention Area Mixing "
+                             "with hard examples rendered from training variations) or pgd (adversarial training) "
+                             "(default none)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
     parser.add_argument("--seed", type=count(0), default=0, help="default 0")
     parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",

@@ -35,6 +35,7 @@ from .data import LabelledFrames, file_sha256, read_records, split_indices
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
+from .pgd import PgdSettings, pgd_batch
 
 CHECKPOINT_FILE = "checkpoint.pt"
 AAM_BANK_FILE = "aam_bank.pt"
@@ -62,6 +63,7 @@ class TrainSettings:
     init: Path | None = None
     max_steps: int | None = None  # stop each epoch after this many batches (tests and smoke runs)
     aam: AamSettings = field(default_factory=AamSettings)
+    pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
 
 
@@ -234,6 +236,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
                 group["lr"] = _lr_at(epoch * steps_per_epoch + step, total_steps, settings.lr)
             if hard:
                 batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step)
+            if settings.augment == "pgd":
+                batch["image"] = pgd_batch(model, spec.family, batch, settings.pgd, settings.seed, epoch, step)
             batch = {k: v.to(device) for k, v in batch.items()}
             loss, terms = detector_loss(spec.family, model(batch["image"]), batch)
             optimizer.zero_grad(set_to_none=True)

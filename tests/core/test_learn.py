@@ -237,6 +237,49 @@ def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):
     assert all(p.mask.mean() > 0 for p in bank)
 
 
+@pytest.mark.parametrize("family", ["ufld", "seg"])
+def test_pgd_adversary_stays_in_its_ball_and_raises_the_loss(family):
+    from lanevil_core.learn.losses import detector_loss
+    from lanevil_core.learn.models import build_model
+    from lanevil_core.learn.pgd import PgdSettings, adversary
+
+    torch.manual_seed(0)
+    spec = ModelSpec(family=family, **TINY_SPEC)
+    model = build_model(spec).train()
+    placed = assign_slots(lane_lines(straight_record()["lanes"], TUSIMPLE_H_SAMPLES, (1280, 720)), spec.slots)
+    batch = {"image": torch.rand(2, 3, 72, 128),
+             "rows": torch.from_numpy(np.stack([encode_row_anchors(placed, spec.anchor_rows, spec.grid)] * 2)),
+             "mask": torch.from_numpy(np.stack([encode_lane_mask(placed, spec.mask_size)] * 2)).long(),
+             "exist": torch.tensor([[line is not None for line in placed]] * 2, dtype=torch.float32)}
+    running = [b.running_mean.clone() for b in model.modules() if isinstance(b, torch.nn.BatchNorm2d)]
+    settings = PgdSettings(epsilon=8 / 255, steps=3, step_size=4 / 255)
+    adv = adversary(model, family, batch, settings, torch.Generator().manual_seed(0))
+    assert (adv - batch["image"]).abs().max() <= settings.epsilon + 1e-6 and 0.0 <= adv.min() and adv.max() <= 1.0
+    # batch norm statistics untouched by the attack's passes; the model is back in training mode
+    after = [b.running_mean for b in model.modules() if isinstance(b, torch.nn.BatchNorm2d)]
+    assert all(torch.equal(a, b) for a, b in zip(running, after)) and model.training
+    with torch.no_grad():
+        norms = [b for b in model.modules() if isinstance(b, torch.nn.BatchNorm2d)]
+        for b in norms:
+            b.eval()
+        clean_loss, _ = detector_loss(family, model(batch["image"]), batch)
+        adv_loss, _ = detector_loss(family, model(adv), batch)
+    assert float(adv_loss) > float(clean_loss)
+    again = adversary(model.train(), family, batch, settings, torch.Generator().manual_seed(0))
+    assert torch.equal(adv, again)  # same generator seed, same adversary
+
+
+def test_pgd_training_replaces_a_share_of_each_batch(tiny_dataset, tmp_path):
+    from lanevil_core.learn.train import TrainSettings, train
+
+    spec = ModelSpec(family="ufld", **TINY_SPEC)
+    settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=1, batch=2, augment="pgd",
+                             val_fraction=0.5, max_steps=2)
+    summary = train(settings, show_progress=False)
+    assert summary["augment"] == "pgd" and len(summary["history"]) == 1
+    assert (tmp_path / "model.onnx").is_file()
+
+
 def test_rendered_frames_give_the_same_samples_as_files(tmp_path):
     from lanevil_core.learn.data import RenderedFrames
 
