@@ -14,7 +14,7 @@ the illusion is in view.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -82,8 +82,9 @@ def with_illusion(case: Case, illusion: dict[str, Any]) -> Case:
 
 
 def clean_of(case: Case) -> Case:
-    """The case without its illusions (what an illusion's change is measured against)."""
-    return case.model_copy(update={"illusions": []})
+    """The case without its illusions (what an illusion's change is measured against), untitled: every level of a
+    type folder has the same clean case, down to its text."""
+    return case.model_copy(update={"illusions": [], "title": "", "description": ""})
 
 
 SHARE_SIZE = (160, 90)  # renders that only locate an illusion are this small
@@ -113,16 +114,25 @@ def frame_changes(original: Case, perturbed: Case, frames: Sequence[int],
     return scene_changes(compile_scene(original), compile_scene(perturbed), frames, size)
 
 
-def scene_changes(scene_original: CompiledScene, scene_perturbed: CompiledScene, frames: Sequence[int],
-                  size: tuple[int, int] = (320, 180)) -> list[BandChange]:
-    """``frame_changes`` of two compiled scenes (a caller that has the perturbed scene compiled already)."""
+CleanView = Callable[[CompiledScene, int, tuple[int, int]], tuple[UInt8Array, BoolArray]]
+
+
+def clean_view(scene_original: CompiledScene, frame_index: int, size: tuple[int, int]) -> tuple[UInt8Array, BoolArray]:
+    """The original's render of a frame and its lane band: what every perturbed version is compared with."""
     rows = h_samples_for(size[1])
+    clean = render_frame(scene_original, frame_index, size)
+    record = tusimple_record(scene_original, frame_index, clean, "", rows)
+    return clean.rgb, lane_band(record["lanes"], rows, size)
+
+
+def scene_changes(scene_original: CompiledScene, scene_perturbed: CompiledScene, frames: Sequence[int],
+                  size: tuple[int, int] = (320, 180), original_view: CleanView = clean_view) -> list[BandChange]:
+    """``frame_changes`` of two compiled scenes (a caller that has the perturbed scene compiled already; one that
+    compares several perturbed scenes with the same original can pass a cached ``original_view``)."""
     changes = []
     for frame_index in frames:
-        clean = render_frame(scene_original, frame_index, size)
-        record = tusimple_record(scene_original, frame_index, clean, "", rows)
-        band = lane_band(record["lanes"], rows, size)
-        changes.append(band_change(clean.rgb, render_frame(scene_perturbed, frame_index, size).rgb, band))
+        original, band = original_view(scene_original, frame_index, size)
+        changes.append(band_change(original, render_frame(scene_perturbed, frame_index, size).rgb, band))
     return changes
 
 

@@ -7,6 +7,7 @@ caller alone writes files, so workers need no shared file system.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import threading
 from collections import OrderedDict
@@ -22,7 +23,7 @@ from ..encode import jpeg_bytes, png_bytes
 from ..labels import tusimple_record
 from ..render import render_frame
 from ..scene import CompiledScene
-from ..typed import UInt8Array
+from ..typed import BoolArray, UInt8Array
 from .plan import FORMATS, RenderTask
 
 JPEG_QUALITY = 95
@@ -81,6 +82,29 @@ def frame_record(scene: CompiledScene, task: RenderTask, frame_index: int, frame
     return {**tusimple_record(scene, frame_index, frame, raw_file), **task.extras}
 
 
+CLEAN_VIEWS_KEPT = 256  # small renders of originals (40 kB each): every level of a type folder is measured
+_CLEAN_VIEWS: OrderedDict[tuple[str, int, tuple[int, int]], tuple[UInt8Array, BoolArray]] = OrderedDict()
+# against the same original at the same frames, so a worker renders each of those once
+
+
+def _cached_clean_view(case_sha256: str, scene: CompiledScene, frame_index: int,
+                       size: tuple[int, int]) -> tuple[UInt8Array, BoolArray]:
+    from ..illusion_effect import clean_view
+
+    key = (case_sha256, frame_index, size)
+    with _SCENES_LOCK:
+        found = _CLEAN_VIEWS.get(key)
+        if found is not None:
+            _CLEAN_VIEWS.move_to_end(key)
+            return found
+    view = clean_view(scene, frame_index, size)
+    with _SCENES_LOCK:
+        _CLEAN_VIEWS[key] = view
+        while len(_CLEAN_VIEWS) > CLEAN_VIEWS_KEPT:
+            _CLEAN_VIEWS.popitem(last=False)
+    return view
+
+
 def illusion_changes(task: RenderTask, scene: CompiledScene) -> dict[int, dict[str, float]]:
     """Per frame of a case with an illusion (compiled: ``scene``): the share of the lane band it changes and its
     effect there (``illusion_effect``, measured on small renders against the case without its illusions)."""
@@ -90,8 +114,9 @@ def illusion_changes(task: RenderTask, scene: CompiledScene) -> dict[int, dict[s
     if not case.illusions:
         return {}
     clean_text = case_json(clean_of(case))
-    clean = compiled_scene(clean_text, hashlib.sha256(clean_text.encode("utf-8")).hexdigest())
-    changes = scene_changes(clean, scene, task.frames, SHARE_SIZE)
+    clean_sha256 = hashlib.sha256(clean_text.encode("utf-8")).hexdigest()
+    clean = compiled_scene(clean_text, clean_sha256)
+    changes = scene_changes(clean, scene, task.frames, SHARE_SIZE, functools.partial(_cached_clean_view, clean_sha256))
     return {frame: {"illusion_share": round(change.share, 4), "illusion_effect": round(change.effect, 3)}
             for frame, change in zip(task.frames, changes, strict=True)}
 

@@ -262,6 +262,27 @@ def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path
     assert not (tmp_path / "out" / "manifest.json").exists()
 
 
+def test_levels_of_a_folder_share_the_worker_s_original_renders() -> None:
+    from lanevil_core.compile import compile_scene
+    from lanevil_core.dataset import worker
+    from lanevil_core.illusion_effect import SHARE_SIZE, clean_of, scene_changes
+
+    folder = SCENES / "30_shadow" / "fence_shadow"
+    frames = (0, 30)
+    worker._CLEAN_VIEWS.clear()
+    for level in (2, 4):
+        case = load_case(folder / f"0{level}_level{level}.json")
+        text = case_json(case)
+        task = RenderTask("test", f"level{level}", text, hashlib.sha256(text.encode()).hexdigest(), frames,
+                          (320, 180), "png", {})
+        scene = worker.compiled_scene(task.case_text, task.case_sha256)
+        measured = worker.illusion_changes(task, scene)
+        fresh = scene_changes(compile_scene(clean_of(case)), scene, frames, SHARE_SIZE)  # nothing cached
+        assert [measured[f] for f in frames] == [
+            {"illusion_share": round(c.share, 4), "illusion_effect": round(c.effect, 3)} for c in fresh]
+        assert len(worker._CLEAN_VIEWS) == len(frames)  # the second level found the original's renders
+
+
 def test_workers_started_before_planning_stop_when_planning_fails(tmp_path: Path) -> None:
     pool = LocalPool(2)
     (tmp_path / "empty").mkdir()
