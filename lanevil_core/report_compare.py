@@ -72,7 +72,7 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
                          f"{_pct(getattr(row.no_paint, 'accuracy', None))} |")
         lines.append("")
     if baseline is not None:
-        lines += defence_table(sorted(detectors, key=lambda d: d.name != baseline))
+        lines += defences(detectors, baseline)
     lines += type_table(detectors)
     lines += ["## Accuracy drop by severity (all categories)", "",
               "| Detector | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
@@ -121,7 +121,73 @@ def type_table(detectors: list[Detector]) -> list[str]:
     return lines
 
 
-def defence_table(detectors: list[Detector]) -> list[str]:
+SEED_MARK = "@"  # a detector named "aam@1" is the run of defence "aam" with seed 1
+
+
+def defence_and_seed(name: str) -> tuple[str, str | None]:
+    """("aam", "1") for "aam@1"; (name, None) for a name without a seed."""
+    defence, mark, seed = name.rpartition(SEED_MARK)
+    return (defence, seed) if mark and defence and seed else (name, None)
+
+
+def defences(detectors: list[Detector], baseline: str) -> list[str]:
+    """The defence table against ``baseline`` (a detector name, or a defence whose runs are named ``baseline@SEED``:
+    then one table per seed, each against that seed's baseline run, and the mean over seeds)."""
+    if any(d.name == baseline for d in detectors):
+        return defence_table(sorted(detectors, key=lambda d: d.name != baseline))
+    seeds = sorted({seed for d in detectors for defence, seed in [defence_and_seed(d.name)]
+                    if defence == baseline and seed is not None})
+    lines: list[str] = []
+    for seed in seeds:
+        runs = [d for d in detectors if defence_and_seed(d.name)[1] == seed]
+        lines += defence_table(sorted(runs, key=lambda d: d.name != f"{baseline}{SEED_MARK}{seed}"),
+                               f"Defences, seed {seed}")
+    return lines + seed_mean_table(detectors, baseline, seeds)
+
+
+def _average(report: Report, field: str) -> float | None:
+    row = category_rows(report)[-1]
+    return getattr(getattr(row, field), "accuracy", None)
+
+
+def seed_mean_table(detectors: list[Detector], baseline: str, seeds: list[str]) -> list[str]:
+    """Markdown lines: per defence, its average perturbed gain over the baseline run of the same seed, each seed's
+    and their mean (ranked by the mean), and the mean change of clean accuracy."""
+    by_name = {d.name: d for d in detectors}
+    rows: list[tuple[float, str]] = []
+    for defence in dict.fromkeys(defence_and_seed(d.name)[0] for d in detectors):
+        if defence == baseline:
+            continue
+        gains, clean = [], []
+        for seed in seeds:
+            run, base = by_name.get(f"{defence}{SEED_MARK}{seed}"), by_name[f"{baseline}{SEED_MARK}{seed}"]
+            mine, theirs = (None, None) if run is None else (_average(run.report, "perturbed"),
+                                                              _average(base.report, "perturbed"))
+            gains.append(None if mine is None or theirs is None else mine - theirs)
+            o_mine, o_theirs = (None, None) if run is None else (_average(run.report, "original"),
+                                                                  _average(base.report, "original"))
+            clean.append(None if o_mine is None or o_theirs is None else o_mine - o_theirs)
+        found = [g for g in gains if g is not None]
+        if not found:
+            continue
+        mean = sum(found) / len(found)
+        found_clean = [c for c in clean if c is not None]
+        mean_clean = sum(found_clean) / len(found_clean) if found_clean else None
+        cells = [_pct(g, signed=True) for g in gains]
+        rows.append((mean, f"| {defence} | " + " | ".join(cells) + f" | **{_pct(mean, signed=True)}** | "
+                           f"{_pct(mean_clean, signed=True)} | {len(found)} |"))
+    if not rows:
+        return []
+    lines = ["## Defences, mean over seeds", "",
+             f"Average perturbed accuracy gain (points) over `{baseline}` trained with the same seed, per seed and "
+             "their mean (best first), and the mean change of clean accuracy.", "",
+             "| Defence | " + " | ".join(f"seed {seed}" for seed in seeds) + " | Mean gain | Clean change | Seeds |",
+             "|---|" + "---:|" * (len(seeds) + 3)]
+    lines += [line for _, line in sorted(rows, key=lambda r: -r[0])]
+    return lines + [""]
+
+
+def defence_table(detectors: list[Detector], title: str = "Defences") -> list[str]:
     """Markdown lines: each detector's Perturbed accuracy per category and average, its gain over the first
     detector (the baseline: the vanilla model when comparing training defences), and its clean (Original)
     accuracy and change."""
@@ -129,7 +195,7 @@ def defence_table(detectors: list[Detector]) -> list[str]:
         return []
     base = {_heading(row): row for row in category_rows(detectors[0].report)}
     heads = list(base)
-    lines = ["## Defences", "",
+    lines = [f"## {title}", "",
              f"Perturbed accuracy (%) per category and its gain over `{detectors[0].name}` in brackets; Clean = "
              "accuracy on the originals (a defence should not cost more than 1 point there).", "",
              "| Detector | " + " | ".join(heads) + " | Clean |", "|---|" + "---:|" * (len(heads) + 1)]

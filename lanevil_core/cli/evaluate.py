@@ -81,7 +81,9 @@ def _report_arguments(parser: argparse.ArgumentParser) -> None:
                         help="detector name for each --pred, in order (default: the file names)")
     parser.add_argument("--baseline", default=None, metavar="NAME",
                         help="with several --pred: add the defence table, each detector's perturbed accuracy and its "
-                             "gain over this one (e.g. the model trained with --augment none)")
+                             "gain over this one (e.g. the model trained with --augment none); with runs named "
+                             "DEFENCE@SEED (e.g. --name none@0 --name aam@0 --name none@1 --name aam@1 --baseline "
+                             "none), one table per seed and the mean gain over seeds")
     parser.add_argument("--out", type=Path, required=True, help="report folder")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet", help="F1 variant (default ganet)")
     parser.add_argument("--title", default=None, help="report title (default: from the prediction file name)")
@@ -91,7 +93,7 @@ def _run_report(args: argparse.Namespace) -> int:
     from ..metrics.evaluate import score_tusimple_files
     from ..metrics.formats import split_labels
     from ..report import build_report, write_report
-    from ..report_compare import Detector, write_comparison
+    from ..report_compare import SEED_MARK, Detector, defence_and_seed, write_comparison
 
     names = args.name or [path.stem for path in args.pred]
     if len(names) != len(args.pred):
@@ -115,8 +117,10 @@ def _run_report(args: argparse.Namespace) -> int:
     if len(detectors) == 1:
         paths = write_report(detectors[0].report, args.out)
     else:
-        if args.baseline is not None and args.baseline not in names:
-            raise UsageError(f"--baseline {args.baseline!r}: not one of the detector names {', '.join(names)}")
+        seeded = {f"{args.baseline}{SEED_MARK}{defence_and_seed(name)[1]}" for name in names}
+        if args.baseline is not None and args.baseline not in names and not seeded & set(names):
+            raise UsageError(f"--baseline {args.baseline!r}: not one of the detector names {', '.join(names)} "
+                             f"(nor a defence whose runs are named {args.baseline}{SEED_MARK}SEED)")
         paths = write_comparison(detectors, args.out, args.f1, args.baseline)
     for path in paths:
         print(path)

@@ -146,6 +146,27 @@ def test_paint_free_control_and_several_detectors(tmp_path):
     assert len(paths) == 3 + 2 * 4
 
 
+def test_defences_over_seeds_compare_each_run_with_its_own_seed_s_baseline():
+    from lanevil_core.report_compare import Detector, defence_and_seed
+    from lanevil_core.report_compare import markdown as compare_markdown
+
+    def report(clean: float, perturbed: float):
+        return build_report([scored("Shadow", "Fence", 0, clean), scored("Shadow", "Fence", 5, perturbed)], "ganet")
+
+    runs = {"none@0": (0.90, 0.60), "aam@0": (0.90, 0.70), "cutout@0": (0.88, 0.75),
+            "none@1": (0.90, 0.80), "aam@1": (0.89, 0.86), "cutout@1": (0.90, 0.79)}
+    detectors = [Detector(name, report(*scores)) for name, scores in runs.items()]
+    text = compare_markdown(detectors, "ganet", baseline="none")
+    assert "## Defences, seed 0" in text and "## Defences, seed 1" in text
+    assert "| aam@1 | 86.00 (+6.00) | 86.00 (+6.00) | 89.00 (-1.00) |" in text  # against none@1, not none@0
+    mean = text.split("## Defences, mean over seeds")[1]
+    # aam: +10 and +6 -> +8; cutout: +15 and -1 -> +7; best first
+    assert mean.index("| aam | +10.00 | +6.00 | **+8.00** | -0.50 | 2 |") < mean.index(
+        "| cutout | +15.00 | -1.00 | **+7.00** | -1.00 | 2 |")
+    assert defence_and_seed("aam@1") == ("aam", "1") and defence_and_seed("aam") == ("aam", None)
+    assert defence_and_seed("@1") == ("@1", None)
+
+
 def test_level5_drop_by_type_marks_drops_that_grow_with_the_level():
     from lanevil_core.report_compare import Detector, grows_with_level, type_table
 
