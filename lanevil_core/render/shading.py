@@ -7,6 +7,9 @@ The kernel walks each row once; what differs between road materials and objects 
 film) comes from a table (``surface_table``), not from branches, and one lighting path serves both. (Separate
 sweeps per row for sky, road and objects measured slower in this scalar code: 2 ms more for the sky's own sweep
 at 1280x720, more again with the lighting duplicated for roads and objects.)
+The sky is smooth away from the sun and the horizon, so a row's sky radiance is evaluated every ``SKY_STEP`` columns
+and interpolated (exact near the sun and across the horizon): at most one level of 255 apart from a per-pixel sky
+on 0.1 % of pixels, 2.5 ms less ``shade`` at 1280x720 on the clean cases.
 The inputs travel in a few named bundles (``View``, ``Geometry``, ``RoadLook``, ``Lighting``, ``SunShadow``,
 ``Reflection``) and every step of a pixel is a small inlined helper.
 """
@@ -48,6 +51,8 @@ MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 STANDING_WATER_ROUGHNESS = 0.03
+SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
+SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
 
 class View(NamedTuple):
@@ -355,15 +360,37 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     wetness, puddles, sun_i, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[SUN_I], env_f[CLOUD], \
         env_f[PENUMBRA]
     last = stripe_index.shape[1] - 1
-    for col in range(face.shape[1]):
+    width = face.shape[1]
+    span = -1  # the sky samples below are those of columns span * SKY_STEP and (span + 1) * SKY_STEP
+    exact = True
+    r0 = g0 = b0 = r1 = g1 = b1 = 0.0
+    for col in range(width):
         f = face[row, col]
-        dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
         if f < 0:
-            r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+            # The sky is smooth away from the sun and the horizon: sampled every SKY_STEP columns and
+            # interpolated, exact where a sample is near the sun or the two lie on both sides of the horizon.
+            k = col // SKY_STEP
+            if k != span:
+                c0, c1 = k * SKY_STEP, min((k + 1) * SKY_STEP, width - 1)
+                ex, ey, ez, _ = pixel_ray(R, (c0 + 0.5 - cx) / fx, y_cam)
+                r0, g0, b0 = sky_radiance(ex, ey, ez, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                qx, qy, qz, _ = pixel_ray(R, (c1 + 0.5 - cx) / fx, y_cam)
+                r1, g1, b1 = sky_radiance(qx, qy, qz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                near_sun = max(ex * sun_dir[0] + ey * sun_dir[1] + ez * sun_dir[2],
+                               qx * sun_dir[0] + qy * sun_dir[1] + qz * sun_dir[2]) > SKY_EXACT_NEAR_SUN
+                exact = near_sun or (ez < 0.0) != (qz < 0.0) or c1 == c0
+                span = k
+            if exact:
+                dx, dy, dz, _ = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
+                r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+            else:
+                w = (col - k * SKY_STEP) / (min((k + 1) * SKY_STEP, width - 1) - k * SKY_STEP)
+                r, g, b = r0 + (r1 - r0) * w, g0 + (g1 - g0) * w, b0 + (b1 - b0) * w
             out[row, col, 0] = r
             out[row, col, 1] = g
             out[row, col, 2] = b
             continue
+        dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
         depth = depth_buf[row, col]
         dist = depth * norm
         px, py, pz = c_world[0] + dx * dist, c_world[1] + dy * dist, c_world[2] + dz * dist
