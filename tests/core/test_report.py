@@ -174,9 +174,11 @@ def test_level5_drop_by_type_marks_drops_that_grow_with_the_level():
         return [scored("Shadow", type_name, level, acc) for level, acc in enumerate(accuracies)]
 
     report = build_report(ladder("Fence", [0.9, 0.9, 0.85, 0.85, 0.7, 0.5])
-                          + ladder("Wire", [0.9, 0.8, 0.85, 0.8, 0.8, 0.8]), "ganet")
+                          + ladder("Wire", [0.9, 0.8, 0.85, 0.8, 0.8, 0.8])
+                          + ladder("Rail", [0.9, 0.85, 0.85, 0.85, 0.85, 0.85]), "ganet")
     rows = {row.type: row for row in report.rows}
     assert grows_with_level(rows["Fence"]) and not grows_with_level(rows["Wire"])
+    assert not grows_with_level(rows["Rail"])  # the same drop at every level: flat, not growing
     lines = type_table([Detector("a", report)])
     assert "| Shadow | Fence | -40.00 ↑ |" in lines and "| Shadow | Wire | -10.00 |" in lines
-    assert "| **Mean over types** | | -25.00 (1/2 ↑) |" in lines
+    assert "| **Mean over types** | | -18.33 (1/3 ↑) |" in lines
