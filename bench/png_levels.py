@@ -128,7 +128,7 @@ def report(results: dict[str, dict[str, float]], frames: int, repeat: int) -> st
              f"* = png_bytes ({chosen})",
              f"  {'setting':<24} {'ms/frame':>9} {'KiB':>7} {'time':>6} {'size':>6}  checks"]
     for name, row in results.items():
-        if name == PROJECT:
+        if name == PROJECT and chosen != PROJECT:  # the project's bytes are another setting's: shown there
             continue
         checks = ("lossless" if row["lossless"] else "LOSSY") + (" stable" if row["stable"] else " UNSTABLE")
         lines.append(f"{'*' if name == chosen else ' '} {name:<24} {row['ms']:>9.1f} {row['bytes'] / 1024:>7.0f} "

@@ -39,3 +39,18 @@ def test_different_frames_give_different_bytes(rendered):
     changed = rendered.copy()
     changed[90, 160] ^= 1
     assert png_bytes(changed) != png_bytes(rendered)
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 3), (1, 2, 3), (2, 1, 3), (9, 7, 3)])
+def test_png_decodes_the_same_in_two_independent_readers(shape):
+    import cv2
+
+    image = np.random.default_rng(sum(shape)).integers(0, 256, shape, dtype=np.uint8)
+    data = png_bytes(image)
+    np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(data)).convert("RGB")), image)
+    np.testing.assert_array_equal(cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)[..., ::-1], image)
+
+
+def test_png_refuses_other_than_rgb():
+    with pytest.raises(ValueError, match="RGB"):
+        png_bytes(np.zeros((4, 4, 4), np.uint8))
