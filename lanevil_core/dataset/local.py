@@ -7,10 +7,11 @@ start-up (spawn, imports, loading the cached kernels) overlaps the planner's ren
 from __future__ import annotations
 
 import multiprocessing
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from typing import Any
 
-from .plan import RenderTask
+from .plan import RenderTask, threads_map
 from .worker import TaskDone, render_chunk, warm_up
 
 
@@ -40,6 +41,13 @@ class LocalPool:
             self._pool = _spawn_pool(self.workers)
             for _ in range(self.workers):
                 self._pool.submit(warm_up)
+
+    def map(self, fn: Callable[[Any], Any], items: list[Any]) -> Iterable[Any]:
+        """``fn`` over ``items`` on the started workers (the planner's in-view search, while they have nothing
+        else to do); on threads here when no worker was started."""
+        if self._pool is None:
+            return threads_map(fn, items)
+        return list(self._pool.map(fn, items))
 
     def close(self) -> None:
         """Stop workers that ``start()`` spawned and no call used (a run that failed while planning)."""

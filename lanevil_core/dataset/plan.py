@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path, PurePosixPath
@@ -205,11 +206,26 @@ def discover_cases(root: Path) -> list[SourceCase]:
 SAMPLINGS = ("in_view", "even")
 
 
-def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None) -> dict[str, tuple[int, ...]]:
-    """Test frames per case folder (a type's original and levels) where that folder's most severe case shows
-    its illusion near the lanes, so Original and every level are scored on the same views."""
+Mapper = Callable[[Callable[[Any], Any], list[Any]], Iterable[Any]]  # like the builtin map, over a list
+
+
+def threads_map(fn: Callable[[Any], Any], items: list[Any]) -> Iterable[Any]:
+    """``map`` on one thread per core: the planner's small renders spend their time in GIL-free kernels."""
+    with ThreadPoolExecutor(max_workers=max(min(len(items), os.cpu_count() or 1), 1)) as pool:
+        return list(pool.map(fn, items))
+
+
+def _in_view(job: tuple[Case, int]) -> tuple[int, ...]:
     from ..illusion_effect import in_view_frames
 
+    return in_view_frames(*job)
+
+
+def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None,
+                      mapper: Mapper = threads_map) -> dict[str, tuple[int, ...]]:
+    """Test frames per case folder (a type's original and levels) where that folder's most severe case shows
+    its illusion near the lanes, so Original and every level are scored on the same views. Folders are planned
+    with ``mapper`` (a dataset run passes its local workers' when it has them)."""
     if frames_per_case is None:
         return {}
     strongest: dict[str, SourceCase] = {}
@@ -219,10 +235,8 @@ def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None) -> d
             best = strongest.get(folder)
             if best is None or source.case.illusions[0].severity > best.case.illusions[0].severity:
                 strongest[folder] = source
-    # The small renders spend their time in GIL-free kernels, so folders are planned on threads (every core).
-    with ThreadPoolExecutor(max_workers=max(min(len(strongest), os.cpu_count() or 1), 1)) as pool:
-        chosen = pool.map(lambda source: in_view_frames(source.case, frames_per_case), strongest.values())
-        return dict(zip(strongest, chosen, strict=True))
+    chosen = mapper(_in_view, [(source.case, frames_per_case) for source in strongest.values()])
+    return dict(zip(strongest, chosen, strict=True))
 
 
 def planned_test_case(source: SourceCase, frames_per_case: int | None,
@@ -350,15 +364,16 @@ def _check_unique(cases: list[PlannedCase]) -> None:
         seen[key] = where
 
 
-def build_plan(sources: list[SourceCase], settings: Settings) -> DatasetPlan:
-    """The test split from the typed cases, the train split from variations of the clean ones."""
+def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = threads_map) -> DatasetPlan:
+    """The test split from the typed cases, the train split from variations of the clean ones (in-view frames
+    found with ``mapper``)."""
     if not sources:
         raise PlanError("no case files (*.json) found")
     typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
     clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
     if settings.sampling not in SAMPLINGS:
         raise PlanError(f"sampling: {settings.sampling!r} is not one of {', '.join(SAMPLINGS)}")
-    chosen = in_view_by_folder(typed, settings.frames_per_case) if settings.sampling == "in_view" else {}
+    chosen = in_view_by_folder(typed, settings.frames_per_case, mapper) if settings.sampling == "in_view" else {}
     planned = [planned_test_case(source, settings.frames_per_case,
                                  chosen.get(str(source.relative.parent))) for source in typed]
     if settings.no_paint:

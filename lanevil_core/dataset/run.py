@@ -14,14 +14,25 @@ from pathlib import Path
 from typing import Any
 
 from .manifest import build_manifest, frame_key, software_versions, source_digest
-from .plan import SPLIT_LABELS, DatasetPlan, PlannedCase, RenderTask, Settings, build_plan, discover_cases, render_tasks
+from .plan import (
+    SPLIT_LABELS,
+    DatasetPlan,
+    PlannedCase,
+    RenderTask,
+    Settings,
+    build_plan,
+    discover_cases,
+    render_tasks,
+    threads_map,
+)
 from .progress import progress_bar
 from .worker import FrameResult, TaskDone
 from .writer import DatasetFolder
 
 Executor = Callable[[Sequence[RenderTask], TaskDone], None]
-# An executor may also have ``start()`` (called before planning, e.g. to spawn workers) and ``close()`` (called
-# after the run, also when it fails): see ``local.LocalPool``.
+# An executor may also have ``start()`` (called before planning, e.g. to spawn workers), ``map(fn, items)`` (the
+# planner's in-view search runs on it) and ``close()`` (called after the run, also when it fails): see
+# ``local.LocalPool``.
 
 
 @dataclass(frozen=True)
@@ -103,7 +114,7 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
     start = time.perf_counter()
     getattr(executor, "start", lambda: None)()  # e.g. LocalPool: workers start up while the plan is made
     try:
-        plan = build_plan(discover_cases(cases_dir), settings)
+        plan = build_plan(discover_cases(cases_dir), settings, getattr(executor, "map", threads_map))
         versions = software_versions()
         code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
         folder = DatasetFolder(out_dir, settings.suffix)

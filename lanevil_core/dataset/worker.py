@@ -18,7 +18,7 @@ from typing import Any
 
 from ..benchmark_layout import frame_file
 from ..case import case_json, parse_case
-from ..compile import compile_scene
+from ..compile import compile_scene, roadside_key
 from ..encode import jpeg_bytes, png_bytes
 from ..labels import tusimple_record
 from ..render import render_frame
@@ -64,11 +64,16 @@ _SCENES_LOCK = threading.Lock()  # a Dask worker may run several tasks on thread
 
 
 def compiled_scene(case_text: str, case_sha256: str) -> CompiledScene:
-    """The compiled scene of a case, from this process's small LRU cache keyed by the case hash."""
+    """The compiled scene of a case, from this process's small LRU cache keyed by the case hash; a case compiled
+    anew takes the road network and roadside of a cached scene with the same ``roadside_key`` (every level of a
+    type folder and its original share them), as the editor does for an edit."""
     with _SCENES_LOCK:
         scene = _SCENES.pop(case_sha256, None)
+        cached = list(_SCENES.values())
     if scene is None:
-        scene = compile_scene(parse_case(case_text))
+        case = parse_case(case_text)
+        key = roadside_key(case)
+        scene = compile_scene(case, next((s for s in reversed(cached) if roadside_key(s.case) == key), None))
     with _SCENES_LOCK:
         _SCENES[case_sha256] = scene
         while len(_SCENES) > SCENE_CACHE_SIZE:

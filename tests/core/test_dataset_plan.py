@@ -98,6 +98,20 @@ def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[Source
     assert all(change.share >= IN_VIEW_SHARE for change in changes)
 
 
+def test_in_view_planning_on_worker_processes_picks_the_same_frames(stock: list[SourceCase]) -> None:
+    from lanevil_core.dataset.local import LocalPool
+
+    sources = [source for source in stock if source.relative.parent.name in ("fence_shadow", "vehicle")]
+    on_threads = build_plan(sources, Settings(frames_per_case=3))
+    pool = LocalPool(2)
+    pool.start()
+    try:
+        on_workers = build_plan(sources, Settings(frames_per_case=3), pool.map)
+    finally:
+        pool.close()
+    assert [case.frames for case in on_workers.cases] == [case.frames for case in on_threads.cases]
+
+
 def test_a_single_type_folder_keeps_its_original_as_that_type() -> None:
     sources = discover_cases(SCENES / "30_shadow" / "fence_shadow")
     assert [str(s.relative) for s in sources][:2] == ["fence_shadow/00_original.json", "fence_shadow/01_level1.json"]
