@@ -60,34 +60,53 @@ class PackedScene:
     overhead_params: FloatArray  # (3,) x0, y0, cells per metre
 
 
-def _mips(rgba: np.ndarray, wet: np.ndarray | None) -> list[np.ndarray]:
-    rgba = np.asarray(rgba, np.float32)
-    premultiplied = np.concatenate([rgba[..., :3] * rgba[..., 3:4], rgba[..., 3:4]], axis=-1)
-    wet = wet if wet is not None else np.zeros(rgba.shape[:2], np.float32)
-    level = np.concatenate([premultiplied, wet[..., None]], axis=-1).astype(np.float32)
-    levels = [level]
-    while min(level.shape[:2]) > 2 and len(levels) < 10:
-        h, w = (level.shape[0] // 2) * 2, (level.shape[1] // 2) * 2
+MAX_MIP_LEVELS = 10
+
+
+def _mip_shapes(rows: int, cols: int) -> list[tuple[int, int]]:
+    """(rows, cols) of every mip level of a layer: halving (rounding down) while both sides exceed 2."""
+    shapes = [(rows, cols)]
+    while min(shapes[-1]) > 2 and len(shapes) < MAX_MIP_LEVELS:
+        shapes.append((shapes[-1][0] // 2, shapes[-1][1] // 2))
+    return shapes
+
+
+def _fill_mips(rgba: np.ndarray, wet: np.ndarray | None, levels: list[np.ndarray]) -> None:
+    """Write a layer's pyramid into ``levels`` ((rows, cols, 5) float32 views of the atlas): premultiplied rgb,
+    alpha and wetness at level 0, then each level the 2x2 box mean of the one above."""
+    base = levels[0]
+    alpha = np.asarray(rgba[..., 3], np.float32)
+    np.multiply(np.asarray(rgba[..., :3], np.float32), alpha[..., None], out=base[..., :3])
+    base[..., 3] = alpha
+    base[..., 4] = 0.0 if wet is None else wet
+    for above, level in zip(levels, levels[1:]):
+        h, w = level.shape[0] * 2, level.shape[1] * 2
         # The 2x2 box mean as four strided adds: several times faster than reshape().mean() on large layers.
-        level = (level[0:h:2, 0:w:2] + level[1:h:2, 0:w:2] + level[0:h:2, 1:w:2] + level[1:h:2, 1:w:2]) * 0.25
-        levels.append(level)
-    return levels
+        np.add(above[0:h:2, 0:w:2], above[1:h:2, 0:w:2], out=level)
+        level += above[0:h:2, 1:w:2]
+        level += above[1:h:2, 1:w:2]
+        level *= 0.25
 
 
 def layer_atlas(scene: CompiledScene) -> LayerAtlas:
-    chunks, table, first = [], [], [0]
+    table, first, spans = [], [0], []
     offset = 0
     for layer in scene.layers:
-        for lvl, mip in enumerate(_mips(layer.rgba, layer.wet)):
-            rows, cols = mip.shape[:2]
+        shapes = _mip_shapes(*layer.rgba.shape[:2])
+        for lvl, (rows, cols) in enumerate(shapes):
             table.append([layer.piece, layer.s0, layer.t0, layer.texel * 2**lvl, rows, cols, offset,
                           float(layer.over_paint), lvl])
-            chunks.append(mip.reshape(-1, 5))
             offset += rows * cols
         first.append(len(table))
-    texels = np.concatenate(chunks) if chunks else np.zeros((1, 5), np.float32)
-    return LayerAtlas(np.ascontiguousarray(texels, np.float32), np.array(table, np.float64).reshape(-1, 9),
-                      np.array(first, np.int32))
+        spans.append(shapes)
+    texels = np.empty((max(offset, 1), 5), np.float32)
+    if offset == 0:
+        texels[:] = 0.0
+    for layer, shapes, row0 in zip(scene.layers, spans, first):
+        views = [texels[int(table[row0 + lvl][6]):int(table[row0 + lvl][6]) + rows * cols].reshape(rows, cols, 5)
+                 for lvl, (rows, cols) in enumerate(shapes)]
+        _fill_mips(layer.rgba, layer.wet, views)
+    return LayerAtlas(texels, np.array(table, np.float64).reshape(-1, 9), np.array(first, np.int32))
 
 
 def _face_normals(vertices: FloatArray, faces: IntArray) -> Float32Array:
