@@ -205,21 +205,22 @@ def _setup_orthographic(
     v_view: np.ndarray, faces: np.ndarray, face_ids: np.ndarray, scale: float, u0: float, v0: float, width: int,
     height: int, tris: np.ndarray, rows: np.ndarray, band: int, bands: int,
 ) -> None:
-    """Scale the band's share of the faces (a contiguous run) to map texels: face k in slot k."""
+    """Scale the band's share of the faces (a contiguous run) to map texels: face k in slot k (a face off the map
+    is culled before anything is stored for it: its slot keeps no rows)."""
     for k in range(band * face_ids.size // bands, (band + 1) * face_ids.size // bands):
         rows[k, 0], rows[k, 1] = 1, 0
         f = face_ids[k]
-        for m in range(3):
-            i = faces[f, m]
-            tris[k, SX, m] = (v_view[i, 0] - u0) * scale
-            tris[k, SY, m] = (v_view[i, 1] - v0) * scale
-            tris[k, SW, m] = 1.0
-            tris[k, DZ, m] = v_view[i, 2]
-        sx, sy = tris[k, SX], tris[k, SY]
-        if max(sx[0], sx[1], sx[2]) < 0 or min(sx[0], sx[1], sx[2]) > width:
+        i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+        x0, x1, x2 = (v_view[i0, 0] - u0) * scale, (v_view[i1, 0] - u0) * scale, (v_view[i2, 0] - u0) * scale
+        if max(x0, x1, x2) < 0 or min(x0, x1, x2) > width:
             continue
-        if max(sy[0], sy[1], sy[2]) < 0 or min(sy[0], sy[1], sy[2]) > height:
+        y0, y1, y2 = (v_view[i0, 1] - v0) * scale, (v_view[i1, 1] - v0) * scale, (v_view[i2, 1] - v0) * scale
+        if max(y0, y1, y2) < 0 or min(y0, y1, y2) > height:
             continue
+        tris[k, SX, 0], tris[k, SX, 1], tris[k, SX, 2] = x0, x1, x2
+        tris[k, SY, 0], tris[k, SY, 1], tris[k, SY, 2] = y0, y1, y2
+        tris[k, SW, 0] = tris[k, SW, 1] = tris[k, SW, 2] = 1.0
+        tris[k, DZ, 0], tris[k, DZ, 1], tris[k, DZ, 2] = v_view[i0, 2], v_view[i1, 2], v_view[i2, 2]
         _store(tris, rows, k, height)
 
 
