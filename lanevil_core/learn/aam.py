@@ -8,12 +8,22 @@
 2. **Hard examples.** Before every epoch after the first, the current model scores the bank (TuSimple accuracy of
    each frame against its labels); the ``hard_share`` lowest-scoring patches of each illusion type are the ones
    mixed in that epoch.
-3. **Mixing.** For a training image ``x`` (a share ``probability`` of each batch) the model's own attention ``A``
+3. **High-attention areas.** In the same pass the model's attention on each bank frame is compared with the
+   frame's ground truth, as the paper's HAA extraction does (blur ``mismatch_blur_px``, threshold
+   ``mismatch_threshold``): the *mismatches* are where the model looks but no lane is (a seam, a streak or a
+   shadow edge it follows) and the lanes it no longer sees. Grown by ``mismatch_grow_px`` and restricted to the
+   illusion's pixels, they are the patch's high-attention area ``H``: exactly the part of the illusion that still
+   misleads the current model.
+4. **Mixing.** For a training image ``x`` (a share ``probability`` of each batch) the model's own attention ``A``
    (its lane probability, 1 - background, of the lane-mask head: the segmentation output of ``seg``, the
    auxiliary head of ``ufld``; widened to the area around the lanes by ``attention_spread_px`` and normalised to
-   0..1 per image) is computed on ``x``, and a random hard patch
-   ``(h, M)`` is blended where the model looks: ``x' = x * (1 - A * M) + h * A * M``. Labels stay those of ``x``:
-   illusions never move the lanes, and only masked pixels change.
+   0..1 per image) is computed on ``x``, and a random hard patch ``(h, M, H)`` is blended where the model looks
+   and where it was misled: ``W = max(A * M, H)``, ``x' = x * (1 - W) + h * W``. Labels stay those of ``x``:
+   illusions never move the lanes, and only masked pixels change (``H`` lies inside ``M``). With
+   ``mismatch_threshold = None`` the high-attention areas are left out (``W = A * M``).
+
+Attention maps are taken with batch norm on its running statistics (``models.running_statistics``), so these
+extra forward passes do not count as training data.
 """
 
 from __future__ import annotations
@@ -31,12 +41,13 @@ import torch.nn.functional as F
 from ..case import Case, case_json, load_case
 from ..compile import compile_scene
 from ..dataset.plan import train_variation
-from ..illusion_effect import CHANGED_LEVEL, luminance, with_illusion
+from ..illusion_effect import CHANGED_LEVEL, lane_band, luminance, with_illusion
 from ..illusions import REGISTRY
 from ..labels import h_samples_for, tusimple_record
 from ..render import render_frame
 from ..scene import FIRST_OBJECT_ID
 from .data import resized, targets_for
+from .models import LaneNet, running_statistics
 
 BANK_SEED_OFFSET = 1_000_003  # bank variations draw from a seed space of their own
 BANK_RENDER_SIZE = (640, 360)
@@ -52,6 +63,10 @@ class AamSettings:
     probability: float = 0.5  # share of training images mixed
     mask_blur_px: float = 1.0  # softening of the patch mask at the network's input size
     attention_spread_px: int = 0  # widen the lanes' attention to the area around them (box radius px, 2 passes)
+    mismatch_threshold: float | None = 0.3  # T: blurred attention above it is the model's focus; None = no HAA
+    mismatch_blur_px: float = 1.5  # sigma of the Gaussian blur of the attention before the threshold
+    mismatch_grow_px: int = 3  # the mismatch regions grown by this radius (input pixels)
+    lane_band_px: int = 2  # half width of a ground-truth lane at the input size
 
 
 @dataclass
@@ -66,6 +81,7 @@ class HardPatch:
     case_sha256: str
     illusion_type: str
     accuracy: float = 1.0
+    haa: np.ndarray | None = None  # (H, W) float32 0..1: the high-attention area of the last scoring, inside mask
 
 
 def bank_case(clean: list[Case], seed: int, index: int) -> Case:
@@ -138,6 +154,15 @@ def hard_patches(patches: list[HardPatch], share: float) -> list[HardPatch]:
     return [patches[i] for i in sorted(chosen)]
 
 
+def hard_summary(hard: list[HardPatch]) -> dict[str, float]:
+    """What an epoch mixed: the hard patches' count, mean accuracy and the share of their illusion pixels that is
+    high-attention area (``training.json`` records it per epoch)."""
+    mask = sum(float(p.mask.sum()) for p in hard)
+    area = sum(float(p.haa.sum()) for p in hard if p.haa is not None)
+    return {"hard_patches": len(hard), "hard_accuracy": round(float(np.mean([p.accuracy for p in hard])), 4),
+            "attention_area_share": round(area / mask, 4) if mask > 0 else 0.0}
+
+
 def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: int = 0) -> torch.Tensor:
     """(N, H, W) the model's lane attention at the input size: 1 - background probability of its lane-mask
     head, widened by two box blurs of radius ``spread_px`` (the *area* the model attends to: the lines and the
@@ -152,17 +177,66 @@ def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: in
 
 
 def mix(images: torch.Tensor, attention_map: torch.Tensor, patches: torch.Tensor,
-        masks: torch.Tensor) -> torch.Tensor:
-    """``x * (1 - A * M) + h * A * M`` for images (N, 3, H, W), attention (N, H, W), patches (N, 3, H, W) and
-    masks (N, H, W), all in 0..1."""
-    weight = (attention_map * masks)[:, None]
+        masks: torch.Tensor, areas: torch.Tensor | None = None) -> torch.Tensor:
+    """``x * (1 - W) + h * W`` with ``W = max(A * M, H)`` for images (N, 3, H, W), attention (N, H, W), patches
+    (N, 3, H, W), masks (N, H, W) and high-attention areas (N, H, W; none: ``W = A * M``), all in 0..1."""
+    weight = attention_map * masks
+    if areas is not None:
+        weight = torch.maximum(weight, areas)
+    weight = weight[:, None]
     return images * (1.0 - weight) + patches * weight
 
 
-def patch_tensors(chosen: list[HardPatch]) -> tuple[torch.Tensor, torch.Tensor]:
-    """(N, 3, H, W) float 0..1 images and (N, H, W) masks of bank patches."""
+def patch_tensors(chosen: list[HardPatch]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(N, 3, H, W) float 0..1 images, (N, H, W) masks and (N, H, W) high-attention areas (zero where a patch has
+    none) of bank patches."""
     images = torch.from_numpy(np.stack([p.image for p in chosen]).transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
-    return images, torch.from_numpy(np.stack([p.mask for p in chosen]))
+    areas = np.stack([p.haa if p.haa is not None else np.zeros_like(p.mask) for p in chosen])
+    return images, torch.from_numpy(np.stack([p.mask for p in chosen])), torch.from_numpy(areas)
+
+
+def lane_attention(model: LaneNet, images: torch.Tensor, spread_px: int = 0) -> torch.Tensor:
+    """(N, H, W) ``attention`` of ``model`` on ``images`` ((N, 3, H, W) 0..1, the model's device), on the model's
+    lane-mask head (training mode keeps ``ufld``'s auxiliary head) with batch norm on its running statistics."""
+    with torch.no_grad(), running_statistics(model):
+        out = model(images)
+    return attention(out, model.spec.input_size, spread_px)
+
+
+def mismatch_area(attention_map: np.ndarray, lanes: np.ndarray, settings: AamSettings) -> np.ndarray:
+    """(H, W) bool: where the model's focus (``attention_map`` (H, W) 0..1, blurred, above the threshold) and the
+    ground-truth lanes (``lanes`` (H, W) bool) disagree: focus away from every lane, or a lane without focus;
+    grown by ``mismatch_grow_px``."""
+    assert settings.mismatch_threshold is not None
+    blurred = cv2.GaussianBlur(attention_map.astype(np.float32), (0, 0), settings.mismatch_blur_px)
+    focus: np.ndarray = blurred > settings.mismatch_threshold
+    grow = 2 * settings.mismatch_grow_px + 1
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (grow, grow))
+    near_lanes: np.ndarray = cv2.dilate(lanes.astype(np.uint8), kernel).astype(bool)
+    wrong = (focus & ~near_lanes) | (lanes & ~focus)
+    return cv2.dilate(wrong.astype(np.uint8), kernel).astype(bool)
+
+
+def patch_lanes(patch: HardPatch, size: tuple[int, int], radius: int) -> np.ndarray:
+    """(H, W) bool at ``size``: the ground-truth lanes of a bank frame, ``radius`` px each side."""
+    sx, sy = size[0] / patch.frame_size[0], size[1] / patch.frame_size[1]
+    lanes = [[round(x * sx) if x >= 0 else -2 for x in lane] for lane in patch.record["lanes"]]
+    return lane_band(lanes, [round(h * sy) for h in patch.record["h_samples"]], size, radius)
+
+
+def update_attention_areas(model: LaneNet, bank: list[HardPatch], settings: AamSettings, batch: int = 32) -> None:
+    """Set every bank patch's high-attention area ``haa`` from the current model's attention on it."""
+    if settings.mismatch_threshold is None:
+        return
+    device = next(model.parameters()).device
+    size = model.spec.input_size
+    for start in range(0, len(bank), batch):
+        chunk = bank[start:start + batch]
+        images = torch.from_numpy(np.stack([p.image for p in chunk]).transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
+        maps = lane_attention(model, images.to(device)).cpu().numpy()
+        for patch, attention_map in zip(chunk, maps, strict=True):
+            area = mismatch_area(attention_map, patch_lanes(patch, size, settings.lane_band_px), settings)
+            patch.haa = (patch.mask * area).astype(np.float32)
 
 
 def patch_targets(patch: HardPatch, spec: Any) -> Any:

@@ -14,6 +14,9 @@ Both take ``(N, 3, H, W)`` float RGB in 0..1 (normalised inside the network) at 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import torch
 import torch.nn.functional as F
 from torch import nn
@@ -150,3 +153,18 @@ class Deployed(nn.Module):
         if self.family == "ufld":
             return (torch.softmax(out["row_logits"], dim=-1),)
         return torch.softmax(out["mask_logits"], dim=1), torch.sigmoid(out["exist_logits"])
+
+
+@contextmanager
+def running_statistics(model: nn.Module) -> Iterator[None]:
+    """Batch norm layers normalise with their running statistics (and leave them unchanged) inside the block, while
+    the rest of ``model`` stays in training mode (auxiliary heads included): for extra forward passes of a
+    training step, an attack's or an attention map's, that must not count as training data."""
+    norms = [m for m in model.modules() if isinstance(m, nn.modules.batchnorm._BatchNorm) and m.training]
+    for m in norms:
+        m.eval()
+    try:
+        yield
+    finally:
+        for m in norms:
+            m.train()

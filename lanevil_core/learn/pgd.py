@@ -17,6 +17,7 @@ import torch
 from torch import nn
 
 from .losses import detector_loss
+from .models import running_statistics
 
 
 @dataclass(frozen=True)
@@ -29,28 +30,18 @@ class PgdSettings:
     probability: float = 0.5  # share of a batch's images replaced by their adversary
 
 
-def _batch_norms(model: nn.Module) -> list[nn.Module]:
-    return [m for m in model.modules() if isinstance(m, nn.modules.batchnorm._BatchNorm)]
-
-
 def adversary(model: nn.Module, family: str, batch: dict[str, torch.Tensor], settings: PgdSettings,
               generator: torch.Generator) -> torch.Tensor:
     """The PGD adversary of ``batch["image"]`` ((N, 3, H, W) in 0..1) against ``model``'s loss on the batch's
     targets (same device as the model)."""
     images = batch["image"]
     delta = (torch.rand(images.shape, generator=generator) * 2.0 - 1.0).to(images.device) * settings.epsilon
-    norms = [m for m in _batch_norms(model) if m.training]
-    for m in norms:
-        m.eval()
-    try:
+    with running_statistics(model):
         for _ in range(settings.steps):
             delta.requires_grad_(True)
             loss, _ = detector_loss(family, model((images + delta).clamp(0.0, 1.0)), batch)
             (grad,) = torch.autograd.grad(loss, delta)
             delta = (delta.detach() + settings.step_size * grad.sign()).clamp(-settings.epsilon, settings.epsilon)
-    finally:
-        for m in norms:
-            m.train()
     model.zero_grad(set_to_none=True)
     return (images + delta).clamp(0.0, 1.0).detach()
 

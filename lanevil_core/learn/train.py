@@ -28,7 +28,16 @@ from ..files import write_atomic
 from ..labels import on_tusimple_grid
 from ..metrics.formats import split_labels
 from ..metrics.tusimple import score_image
-from .aam import AamSettings, attention, build_bank, hard_patches, mix, patch_tensors
+from .aam import (
+    AamSettings,
+    build_bank,
+    hard_patches,
+    hard_summary,
+    lane_attention,
+    mix,
+    patch_tensors,
+    update_attention_areas,
+)
 from .augment import AUGMENTS
 from .backbone import load_init
 from .data import LabelledFrames, file_sha256, read_records, split_indices
@@ -153,12 +162,10 @@ def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainS
     if not len(chosen):
         return images
     device = next(model.parameters()).device
-    with torch.no_grad():
-        out = model(images[chosen].to(device))
-    attention_map = attention(out, model.spec.input_size, settings.aam.attention_spread_px).cpu()
-    patches, masks = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
+    attention_map = lane_attention(model, images[chosen].to(device), settings.aam.attention_spread_px).cpu()
+    patches, masks, areas = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
     images = images.clone()
-    images[chosen] = mix(images[chosen], attention_map, patches, masks)
+    images[chosen] = mix(images[chosen], attention_map, patches, masks, areas)
     return images
 
 
@@ -221,6 +228,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
                                 [p.frame_size for p in bank], device)
             for patch, (pred, gt, rows) in zip(bank, scores, strict=True):
                 patch.accuracy = score_image(pred, gt, rows, 0.0).accuracy
+            update_attention_areas(model, bank, settings.aam)
             hard = hard_patches(bank, settings.aam.hard_share)
         started = time.perf_counter()
         train_set.epoch = epoch
@@ -249,7 +257,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         bar.close()
         val_accuracy = tusimple_accuracy(predict_lanes(model, val_set, device)) if val_set is not None else None
         history.append({"epoch": epoch + 1, "loss": float(np.mean(losses)) if losses else None,
-                        "val_accuracy": val_accuracy, "seconds": round(time.perf_counter() - started, 2)})
+                        "val_accuracy": val_accuracy, "seconds": round(time.perf_counter() - started, 2),
+                        **({"aam": hard_summary(hard)} if hard else {})})
         if show_progress:
             shown = "n/a" if val_accuracy is None else f"{100 * val_accuracy:.2f} %"
             print(f"epoch {epoch + 1}: loss {history[-1]['loss']:.4f}  val accuracy {shown}", flush=True)

@@ -182,6 +182,26 @@ def test_aam_mixing_touches_only_masked_pixels():
     assert torch.all(mixed[:, :, 2:4, 3:6] == 0)  # full attention and mask: the patch replaces the pixel
     half = mix(images, attention_map * 0.5, patches, masks)
     assert torch.allclose(half[:, :, 2:4, 3:6], images[:, :, 2:4, 3:6] * 0.5)
+    # a high-attention area (inside the mask) takes the patch even where the lanes draw no attention
+    areas = masks.clone()
+    areas[:, :, :5] = 0.0
+    unseen = mix(images, attention_map * 0.0, patches, masks, areas)
+    assert torch.all(unseen[:, :, 2:4, 5:6] == 0) and torch.equal(unseen[:, :, :, :5], images[:, :, :, :5])
+    assert torch.equal(unseen[outside], images[outside])
+
+
+def test_mismatch_area_is_focus_off_the_lanes_and_lanes_without_focus():
+    from lanevil_core.learn.aam import AamSettings, mismatch_area
+
+    lanes = np.zeros((40, 60), bool)
+    lanes[:, 10:12] = True  # a lane the model sees ...
+    lanes[:, 50:52] = True  # ... and one it lost
+    attention_map = np.zeros((40, 60), np.float32)
+    attention_map[:, 9:13] = 1.0
+    attention_map[:, 29:33] = 1.0  # a distractor it follows
+    area = mismatch_area(attention_map, lanes, AamSettings())
+    assert area[20, 31] and area[20, 50]
+    assert not area[20, 11] and not area[20, 40]
 
 
 def test_aam_attention_spreads_around_the_lanes_and_peaks_at_one():
@@ -235,6 +255,8 @@ def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):
     bank = torch.load(tmp_path / AAM_BANK_FILE, weights_only=False)["patches"]
     assert bank and all(0.0 <= p.mask.min() and p.mask.max() <= 1.0 for p in bank)
     assert all(p.mask.mean() > 0 for p in bank)
+    mixed = summary["history"][1]["aam"]  # the bank is scored, and its attention areas found, after epoch 1
+    assert mixed["hard_patches"] >= 1 and 0.0 <= mixed["attention_area_share"] <= 1.0
 
 
 @pytest.mark.parametrize("family", ["ufld", "seg"])
