@@ -1,0 +1,84 @@
+"""The defence comparison: one detector family trained with every ``--augment`` over several seeds, scored on the
+benchmark's test split, and ``lanevil report``'s defence table (gain over vanilla per seed and averaged).
+
+Every run uses the same train split, family, size and epochs; only ``--augment`` and ``--seed`` change (the seed
+also picks the held-out folders and the initialisation). Runs train with one thread each, ``--jobs`` of them at a
+time; a run whose model (or predictions) already exist is not repeated, so the script resumes.
+
+Usage::
+
+    lanevil dataset --cases scenes/00_clean --out data/train2k --train-frames 2000 --size 640x360
+    lanevil dataset --cases scenes --out data/bench --frames-per-case 10 --train-frames 0 --no-paint
+    python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
+        [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd] [--seeds 0,1,2] [--jobs 2]
+
+Writes ``OUT/models/AUGMENT@SEED/``, ``OUT/pred/AUGMENT@SEED.json`` and ``OUT/report/`` (``compare.md`` holds the
+defence tables); prints each run's seconds and the report's path.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+AUGMENTS = ("none", "aam", "cutout", "copy_paste", "hsv", "mixup", "pgd")
+
+
+def lanevil(*args: str) -> None:
+    """Run one ``lanevil`` command in this interpreter's environment; its output is shown only if it fails."""
+    done = subprocess.run([sys.executable, "-m", "app.cli", *args], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"lanevil {' '.join(args)} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
+
+
+def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
+    """Train (unless done) and detect (unless done) one ``AUGMENT@SEED`` run; (name, seconds)."""
+    augment, seed = name.split("@")
+    model_dir = args.out / "models" / name
+    pred = args.out / "pred" / f"{name}.json"
+    started = time.perf_counter()
+    if not (model_dir / "model.onnx").is_file():
+        extra = ["--max-steps", str(args.max_steps)] if args.max_steps else []
+        lanevil("train", "--data", str(args.data), "--out", str(model_dir), "--model", args.family,
+                "--epochs", str(args.epochs), "--augment", augment, "--seed", seed, "--threads", "1", "--quiet",
+                *extra)
+    if not pred.is_file():
+        pred.parent.mkdir(parents=True, exist_ok=True)
+        lanevil("detect", str(args.bench), "--method", args.family, "--weights", str(model_dir), "--out", str(pred))
+    return name, time.perf_counter() - started
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--data", type=Path, required=True, help="a dataset folder with a clean train split")
+    parser.add_argument("--bench", type=Path, required=True, help="the benchmark's test split folder")
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--family", choices=("seg", "ufld"), default="seg")
+    parser.add_argument("--epochs", type=int, default=6)
+    parser.add_argument("--augments", default=",".join(AUGMENTS))
+    parser.add_argument("--seeds", default="0,1,2")
+    parser.add_argument("--jobs", type=int, default=2, help="runs at a time (each trains with one thread)")
+    parser.add_argument("--max-steps", type=int, default=None, help="optimiser steps per epoch at most (smoke runs)")
+    args = parser.parse_args(argv)
+    augments = [a for a in args.augments.split(",") if a]
+    unknown = sorted(set(augments) - set(AUGMENTS))
+    if unknown or "none" not in augments:
+        parser.error(f"--augments: {', '.join(unknown) or 'none'} {'unknown' if unknown else 'is needed'}"
+                     f" (choose from {', '.join(AUGMENTS)}; 'none' is the baseline)")
+    names = [f"{augment}@{seed}" for seed in args.seeds.split(",") for augment in augments]
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        for name, seconds in pool.map(lambda n: run_one(args, n), names):
+            print(f"{name}: {seconds:.0f} s", flush=True)
+    report = args.out / "report"
+    pairs = [part for name in names for part in ("--pred", str(args.out / "pred" / f"{name}.json"), "--name", name)]
+    lanevil("report", "--gt", str(args.bench), *pairs, "--baseline", "none", "--out", str(report))
+    print(f"defence tables: {report / 'compare.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
