@@ -4,7 +4,9 @@
    so never a test case; checked by case hash) each get one illusion of a type taken in turn, at severity 3-5 with
    a fresh seed. Each is rendered with and without the illusion; the *patch* is the perturbed frame restricted to
    the illusion's own pixels: the pixels of its meshes (object ids) and every pixel whose luminance it changes by
-   more than ``illusion_effect.CHANGED_LEVEL`` (its shadows, streaks, surface layers), softened by a small blur.
+   more than ``illusion_effect.CHANGED_LEVEL`` (its shadows, streaks, surface layers), less the bank frame's own
+   lane markings (found by a third render with the paint removed from the world): a mixed patch never carries
+   another frame's lanes into an image whose labels do not have them. The mask is softened by a small blur.
 2. **Hard examples.** Before every epoch after the first, the current model scores the bank (TuSimple accuracy of
    each frame against its labels); the ``hard_share`` lowest-scoring patches of each illusion type are the ones
    mixed in that epoch.
@@ -96,17 +98,23 @@ def bank_case(clean: list[Case], seed: int, index: int) -> Case:
 
 
 def illusion_mask(clean_rgb: np.ndarray, perturbed_rgb: np.ndarray, object_id: np.ndarray,
-                  illusion_ids: np.ndarray) -> np.ndarray:
-    """(H, W) bool: the illusion's meshes plus every pixel whose luminance it changes visibly."""
+                  illusion_ids: np.ndarray, unpainted_rgb: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) bool: the illusion's meshes plus every pixel whose luminance it changes visibly; with the frame
+    rendered without lane paint (``unpainted_rgb``), less the frame's own markings and a pixel around them."""
     changed = np.abs(luminance(perturbed_rgb) - luminance(clean_rgb)) > CHANGED_LEVEL
-    return changed | np.isin(object_id, illusion_ids)
+    mask = changed | np.isin(object_id, illusion_ids)
+    if unpainted_rgb is not None:
+        paint = (np.abs(luminance(clean_rgb) - luminance(unpainted_rgb)) > CHANGED_LEVEL).astype(np.uint8)
+        mask &= ~cv2.dilate(paint, np.ones((3, 3), np.uint8)).astype(bool)
+    return mask
 
 
 def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
     """The bank frames of one bank case (its ``BANK_FRAMES``), at the network's input size."""
     clean_case = with_illusion(case, {"type": case.illusions[0].type, "severity": 1}).model_copy(
         update={"illusions": []})
-    scene, clean_scene = compile_scene(case), compile_scene(clean_case)
+    unpainted_case = clean_case.model_copy(update={"road": clean_case.road.model_copy(update={"paint": False})})
+    scene, clean_scene, unpainted_scene = compile_scene(case), compile_scene(clean_case), compile_scene(unpainted_case)
     illusion_ids = np.array([FIRST_OBJECT_ID + i for i, mesh in enumerate(scene.meshes) if mesh.source >= 0])
     rows = h_samples_for(BANK_RENDER_SIZE[1])
     sha = hashlib.sha256(case_json(case).encode("utf-8")).hexdigest()
@@ -114,7 +122,8 @@ def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
     for frame_index in BANK_FRAMES:
         frame = render_frame(scene, frame_index, BANK_RENDER_SIZE)
         clean = render_frame(clean_scene, frame_index, BANK_RENDER_SIZE)
-        mask = illusion_mask(clean.rgb, frame.rgb, frame.object_id, illusion_ids).astype(np.float32)
+        unpainted = render_frame(unpainted_scene, frame_index, BANK_RENDER_SIZE).rgb
+        mask = illusion_mask(clean.rgb, frame.rgb, frame.object_id, illusion_ids, unpainted).astype(np.float32)
         if mask.mean() < 0.002:  # the illusion is not in this frame
             continue
         record = tusimple_record(clean_scene, frame_index, clean, "", rows)

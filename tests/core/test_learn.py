@@ -190,6 +190,19 @@ def test_aam_mixing_touches_only_masked_pixels():
     assert torch.equal(unseen[outside], images[outside])
 
 
+def test_aam_patch_mask_leaves_out_the_bank_frames_own_paint():
+    from lanevil_core.learn.aam import illusion_mask
+
+    unpainted = np.full((10, 12, 3), 60, np.uint8)
+    clean = unpainted.copy()
+    clean[:, 5] = 200  # a lane line
+    perturbed = clean // 4  # a shadow over everything, the line included
+    ids = np.zeros((10, 12), np.int32)
+    assert illusion_mask(clean, perturbed, ids, np.array([7])).all()
+    mask = illusion_mask(clean, perturbed, ids, np.array([7]), unpainted)
+    assert not mask[:, 4:7].any() and mask[:, :4].all() and mask[:, 7:].all()
+
+
 def test_mismatch_area_is_focus_off_the_lanes_and_lanes_without_focus():
     from lanevil_core.learn.aam import AamSettings, mismatch_area
 
