@@ -63,6 +63,36 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
     return lit
 
 
+@kernel(inline="always")
+def _window_weights(x: float, radius: float) -> tuple[int, int, float, float, float, float]:
+    """The bilinear taps at x - radius, x and x + radius (texels) along one axis as weights of the four
+    consecutive texels from ``first``: (first, span, w0, w1, w2, w3). The four hold every tap when ``span`` (the
+    last tap's first texel minus the first tap's) is at most 2."""
+    a, b, c = x - radius - 0.5, x - 0.5, x + radius - 0.5
+    ia, ib, ic = int(np.floor(a)), int(np.floor(b)), int(np.floor(c))
+    fa, fb, fc = a - ia, b - ib, c - ic
+    ob, oc = ib - ia, ic - ia
+    w0 = 1.0 - fa + (1.0 - fb if ob == 0 else 0.0)
+    w1 = fa + (fb if ob == 0 else 0.0) + (1.0 - fb if ob == 1 else 0.0) + (1.0 - fc if oc == 1 else 0.0)
+    w2 = (fb if ob == 1 else 0.0) + (1.0 - fb if ob == 2 else 0.0) + (fc if oc == 1 else 0.0) \
+        + (1.0 - fc if oc == 2 else 0.0)
+    w3 = (fb if ob == 2 else 0.0) + (fc if oc == 2 else 0.0)
+    return ia, oc, w0, w1, w2, w3
+
+
+@kernel(inline="always")
+def _window_row(depth: np.ndarray, c: int, y: int, x: int, limit: float, w0: float, w1: float, w2: float,
+                w3: float) -> float:
+    """The sum of the weights of texels x .. x + 3 of map row ``y`` (clamped to the map) lit at ``limit``."""
+    size = depth.shape[1]
+    yi = min(max(y, 0), size - 1)
+    lit = w0 if depth[c, yi, min(max(x, 0), size - 1)] >= limit else 0.0
+    lit += w1 if depth[c, yi, min(max(x + 1, 0), size - 1)] >= limit else 0.0
+    lit += w2 if depth[c, yi, min(max(x + 2, 0), size - 1)] >= limit else 0.0
+    lit += w3 if depth[c, yi, min(max(x + 3, 0), size - 1)] >= limit else 0.0
+    return lit
+
+
 SUN_OFFSET, SUN_BIAS = range(2)  # face_sun_terms columns
 
 
@@ -119,10 +149,19 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
             z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
             blocker = z_center if z_center < d - bias else nearest
             radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
-            taps = 0.0
-            for j in range(-1, 2):
-                for i in range(-1, 2):
-                    taps += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
+            x0, x_span, wx0, wx1, wx2, wx3 = _window_weights(x, radius)
+            y0, y_span, wy0, wy1, wy2, wy3 = _window_weights(y, radius)
+            if x_span <= 2 and y_span <= 2:  # a narrow soft edge: the nine taps read a 4x4 window of texels
+                limit = d - bias
+                taps = wy0 * _window_row(maps, c, y0, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy1 * _window_row(maps, c, y0 + 1, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy2 * _window_row(maps, c, y0 + 2, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy3 * _window_row(maps, c, y0 + 3, x0, limit, wx0, wx1, wx2, wx3)
+            else:
+                taps = 0.0
+                for j in range(-1, 2):
+                    for i in range(-1, 2):
+                        taps += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
             lit = taps / 9.0
     # Every path ends on a use of the three arrays, so numba releases them in one place (see ``_jit``).
     return lit if maps.shape[0] == cells.shape[0] == params.shape[0] else lit
