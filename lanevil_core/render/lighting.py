@@ -20,6 +20,7 @@ NEAR_AROUND, FAR_AROUND = range(2)
 def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
                  zenith: np.ndarray, horizon: np.ndarray, cloudiness: float) -> tuple[float, float, float]:
     """Radiance (r, g, b) of the sky seen along unit world direction (dx, dy, dz): gradient, sun disk, glow."""
+    sun_r, sun_g, sun_b = sun_color[0], sun_color[1], sun_color[2]  # read before any branch (see ``_jit``)
     k = np.sqrt(max(dz, 0.0))
     below = 0.85 if dz < 0.0 else 1.0  # below the horizon (seen past the terrain's edge): darker haze
     r = SKY_SCALE * below * (horizon[0] * (1.0 - k) + zenith[0] * k)
@@ -35,9 +36,9 @@ def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color
         c16 = c8 * c8
         halo = np.exp(400.0 * np.log(cos_sun)) if cos_sun > 0.97 else 0.0
         glow = sun_intensity * (disk + halo * 3.0 * clear + c16 * 0.35 * (0.3 + 0.7 * clear))
-        r += sun_color[0] * glow
-        g += sun_color[1] * glow
-        b += sun_color[2] * glow
+        r += sun_r * glow
+        g += sun_g * glow
+        b += sun_b * glow
     return r, g, b
 
 
@@ -59,6 +60,36 @@ def _shadow_tap(depth: np.ndarray, c: int, u: float, v: float, d: float, bias: f
             w = (fx if dx else 1.0 - fx) * (fy if dy else 1.0 - fy)
             if depth[c, yi, xi] >= d - bias:
                 lit += w
+    return lit
+
+
+@kernel(inline="always")
+def _window_weights(x: float, radius: float) -> tuple[int, int, float, float, float, float]:
+    """The bilinear taps at x - radius, x and x + radius (texels) along one axis as weights of the four
+    consecutive texels from ``first``: (first, span, w0, w1, w2, w3). The four hold every tap when ``span`` (the
+    last tap's first texel minus the first tap's) is at most 2."""
+    a, b, c = x - radius - 0.5, x - 0.5, x + radius - 0.5
+    ia, ib, ic = int(np.floor(a)), int(np.floor(b)), int(np.floor(c))
+    fa, fb, fc = a - ia, b - ib, c - ic
+    ob, oc = ib - ia, ic - ia
+    w0 = 1.0 - fa + (1.0 - fb if ob == 0 else 0.0)
+    w1 = fa + (fb if ob == 0 else 0.0) + (1.0 - fb if ob == 1 else 0.0) + (1.0 - fc if oc == 1 else 0.0)
+    w2 = (fb if ob == 1 else 0.0) + (1.0 - fb if ob == 2 else 0.0) + (fc if oc == 1 else 0.0) \
+        + (1.0 - fc if oc == 2 else 0.0)
+    w3 = (fb if ob == 2 else 0.0) + (fc if oc == 2 else 0.0)
+    return ia, oc, w0, w1, w2, w3
+
+
+@kernel(inline="always")
+def _window_row(depth: np.ndarray, c: int, y: int, x: int, limit: float, w0: float, w1: float, w2: float,
+                w3: float) -> float:
+    """The sum of the weights of texels x .. x + 3 of map row ``y`` (clamped to the map) lit at ``limit``."""
+    size = depth.shape[1]
+    yi = min(max(y, 0), size - 1)
+    lit = w0 if depth[c, yi, min(max(x, 0), size - 1)] >= limit else 0.0
+    lit += w1 if depth[c, yi, min(max(x + 1, 0), size - 1)] >= limit else 0.0
+    lit += w2 if depth[c, yi, min(max(x + 2, 0), size - 1)] >= limit else 0.0
+    lit += w3 if depth[c, yi, min(max(x + 3, 0), size - 1)] >= limit else 0.0
     return lit
 
 
@@ -93,30 +124,47 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
     size = maps.shape[1]
-    for c in range(maps.shape[0]):
+    cascades = maps.shape[0]
+    c = 0
+    x = y = scale = 0.0
+    while c < cascades:  # the first cascade that holds the point
         scale = params[c, 2]
         x = (u - params[c, 0]) * scale
         y = (v - params[c, 1]) * scale
-        if x < 2 or y < 2 or x > size - 2 or y > size - 2:
-            continue
+        if x >= 2 and y >= 2 and x <= size - 2 and y <= size - 2:
+            break
+        c += 1
+    lit = 1.0
+    if c < cascades:
         bias = bias_texels / scale
         # Nearest caster within the point's coarse cell and its neighbours (pre-dilated): none -> fully lit.
         cell_y, cell_x = int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT
         nearest = cells[c, cell_y, cell_x, NEAR_AROUND]
         if nearest >= d - bias:
-            return 1.0
-        if cells[c, cell_y, cell_x, FAR_AROUND] < d - bias:
-            return 0.0
-        # The caster right above the point (else the nearest one around) sets the penumbra width.
-        z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
-        blocker = z_center if z_center < d - bias else nearest
-        radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
-        lit = 0.0
-        for j in range(-1, 2):
-            for i in range(-1, 2):
-                lit += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
-        return lit / 9.0
-    return 1.0
+            lit = 1.0
+        elif cells[c, cell_y, cell_x, FAR_AROUND] < d - bias:
+            lit = 0.0
+        else:
+            # The caster right above the point (else the nearest one around) sets the penumbra width.
+            z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
+            blocker = z_center if z_center < d - bias else nearest
+            radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
+            x0, x_span, wx0, wx1, wx2, wx3 = _window_weights(x, radius)
+            y0, y_span, wy0, wy1, wy2, wy3 = _window_weights(y, radius)
+            if x_span <= 2 and y_span <= 2:  # a narrow soft edge: the nine taps read a 4x4 window of texels
+                limit = d - bias
+                taps = wy0 * _window_row(maps, c, y0, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy1 * _window_row(maps, c, y0 + 1, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy2 * _window_row(maps, c, y0 + 2, x0, limit, wx0, wx1, wx2, wx3)
+                taps += wy3 * _window_row(maps, c, y0 + 3, x0, limit, wx0, wx1, wx2, wx3)
+            else:
+                taps = 0.0
+                for j in range(-1, 2):
+                    for i in range(-1, 2):
+                        taps += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
+            lit = taps / 9.0
+    # Every path ends on a use of the three arrays, so numba releases them in one place (see ``_jit``).
+    return lit if maps.shape[0] == cells.shape[0] == params.shape[0] else lit
 
 
 @kernel(inline="always")

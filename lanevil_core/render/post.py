@@ -22,21 +22,30 @@ SRGB_LUT = _srgb_lut()
 
 
 @kernel(inline="always")
-def _encode(x: float, inv_w2: float, lut: np.ndarray) -> np.uint8:
-    """Extended Reinhard curve, then sRGB encoding through a lookup table."""
+def _lut_index(x: float, inv_w2: float, top: int) -> int:
+    """Extended Reinhard curve, then the entry of the sRGB lookup table (``top`` + 1 entries) that encodes it."""
     x = max(x, 0.0)
     y = x * (1.0 + x * inv_w2) / (1.0 + x)
-    top = lut.size - 1
-    return lut[min(int(y * top + 0.5), top)]
+    return min(int(y * top + 0.5), top)
 
 
 @kernel(inline="always")
-def _on_edge(ids: np.ndarray, row: int, col: int) -> bool:
-    """Whether the pixel's object id differs from one of its 4-neighbours'."""
-    height, width = ids.shape
+def _differs(ids: np.ndarray, row: int, col: int, above: int, below: int, left: int, right: int) -> bool:
+    """Whether the id at (row, col) differs from the one at any of the given neighbouring rows and columns."""
     here = ids[row, col]
-    return ((col + 1 < width and ids[row, col + 1] != here) or (col > 0 and ids[row, col - 1] != here)
-            or (row + 1 < height and ids[row + 1, col] != here) or (row > 0 and ids[row - 1, col] != here))
+    return (ids[row, right] != here) | (ids[row, left] != here) | (ids[below, col] != here) | (ids[above, col] != here)
+
+
+@kernel(inline="always")
+def _edges(ids: np.ndarray, row: int, on_edge: np.ndarray) -> None:
+    """Per column of ``row``: whether the pixel's object id differs from one of its 4-neighbours' (a neighbour
+    off the image is the pixel itself). Branch-free inside the row, so that loop runs on whole vectors of columns."""
+    height, width = ids.shape
+    above, below = max(row - 1, 0), min(row + 1, height - 1)
+    for col in range(1, width - 1):
+        on_edge[col] = _differs(ids, row, col, above, below, col - 1, col + 1)
+    on_edge[0] = _differs(ids, row, 0, above, below, 0, min(1, width - 1))
+    on_edge[width - 1] = _differs(ids, row, width - 1, above, below, max(width - 2, 0), width - 1)
 
 
 @kernel(inline="always")
@@ -63,16 +72,25 @@ def _edge_blend(hdr: np.ndarray, row: int, col: int, c: int) -> float:
 @kernel
 def _finish_rows(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray, band: int,
                  bands: int) -> None:
+    """Tone-map the rows of one band: every channel's lookup-table index in one arithmetic sweep of the row (it
+    vectorises), the table reads in a second; then the pixels on an object edge again, blended."""
     height, width, _ = hdr.shape
     inv_w2 = 1.0 / (WHITE_POINT * WHITE_POINT)
+    top = lut.size - 1
+    index = np.empty(width * 3, np.uint16)  # unsigned: the table reads need no check for negative indices
+    on_edge = np.empty(width, np.bool_)
     for row in band_rows(height, band, bands):
+        radiance = hdr[row].reshape(width * 3)
+        for k in range(width * 3):
+            index[k] = np.uint16(_lut_index(radiance[k] * exposure, inv_w2, top))
+        encoded = out[row].reshape(width * 3)
+        for k in range(width * 3):
+            encoded[k] = lut[index[k]]
+        _edges(ids, row, on_edge)
         for col in range(width):
-            for c in range(3):
-                out[row, col, c] = _encode(hdr[row, col, c] * exposure, inv_w2, lut)
-        for col in range(width):
-            if _on_edge(ids, row, col):
+            if on_edge[col]:
                 for c in range(3):
-                    out[row, col, c] = _encode(_edge_blend(hdr, row, col, c) * exposure, inv_w2, lut)
+                    out[row, col, c] = lut[_lut_index(_edge_blend(hdr, row, col, c) * exposure, inv_w2, top)]
 
 
 def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray,

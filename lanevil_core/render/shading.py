@@ -263,14 +263,16 @@ def sun_lit(sun_dir: np.ndarray, sun: np.ndarray, visibility: float, n_dot_l: fl
             nz: float, dx: float, dy: float, dz: float, roughness: float, fresnel: float,
             shiny: float) -> tuple[float, float, float, float, float, float]:
     """(diffuse irradiance rgb, specular radiance rgb) of the sun seen with ``visibility``."""
+    sun_x, sun_y, sun_z = sun_dir[0], sun_dir[1], sun_dir[2]  # read before any branch (see ``_jit``)
+    sun_r, sun_g, sun_b = sun[0], sun[1], sun[2]
     k = n_dot_l * visibility
     spec = 0.0
     if visibility > 0.0 and shiny > 0.0:
-        hx, hy, hz = sun_dir[0] - dx, sun_dir[1] - dy, sun_dir[2] - dz
+        hx, hy, hz = sun_x - dx, sun_y - dy, sun_z - dz
         n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
         exponent, normalisation, cutoff = lobe_shape(roughness)
         spec = visibility * glossy_lobe(n_dot_h, exponent, normalisation, cutoff) * fresnel * 0.25 * shiny
-    return sun[0] * k, sun[1] * k, sun[2] * k, sun[0] * spec, sun[1] * spec, sun[2] * spec
+    return sun_r * k, sun_g * k, sun_b * k, sun_r * spec, sun_g * spec, sun_b * spec
 
 
 @kernel(inline="always")

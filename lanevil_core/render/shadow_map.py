@@ -70,20 +70,38 @@ def cascade_size(image_width: int) -> int:
 
 
 @kernel
-def _pool_cells(depth: np.ndarray, shift: int, nearest: np.ndarray, farthest: np.ndarray, band: int,
-                bands: int) -> None:
-    """The nearest and the farthest caster depth of every 2**shift square of one map, for one band's cell rows."""
-    cells = depth.shape[0] >> shift
+def _pool_cells(depth: np.ndarray, nearest: np.ndarray, farthest: np.ndarray, band: int, bands: int) -> None:
+    """The nearest and the farthest caster depth of every coarse cell (2**COARSE_SHIFT texels square) of one map,
+    for one band's cell rows. The map is read row by row, each row's cells side by side, in the order it lies
+    in memory (with the cell's width known when compiling, 4-5x faster than a cell at a time)."""
+    cells = depth.shape[0] >> COARSE_SHIFT
     for cell_y in band_rows(cells, band, bands):
-        for cell_x in range(cells):
-            low = np.inf
-            high = -np.inf
-            for y in range(cell_y << shift, (cell_y + 1) << shift):
-                for x in range(cell_x << shift, (cell_x + 1) << shift):
-                    low = min(low, depth[y, x])
-                    high = max(high, depth[y, x])
-            nearest[cell_y, cell_x] = low
-            farthest[cell_y, cell_x] = high
+        low = nearest[cell_y]
+        high = farthest[cell_y]
+        low[:] = np.inf
+        high[:] = -np.inf
+        for y in range(cell_y << COARSE_SHIFT, (cell_y + 1) << COARSE_SHIFT):
+            row = depth[y]
+            for cell_x in range(cells):
+                a = low[cell_x]
+                b = high[cell_x]
+                for k in range(1 << COARSE_SHIFT):
+                    a = min(a, row[(cell_x << COARSE_SHIFT) + k])
+                    b = max(b, row[(cell_x << COARSE_SHIFT) + k])
+                low[cell_x] = a
+                high[cell_x] = b
+
+
+@kernel(inline="always")
+def _around(cells: np.ndarray, rows: tuple[int, int, int], x: int, last: int, nearest: bool) -> float:
+    """The least (``nearest``) or greatest value of ``cells`` over the given rows and columns x - 1 .. x + 1
+    (clamped to the grid: a repeated cell changes neither)."""
+    left, right = max(x - 1, 0), min(x + 1, last)
+    out = cells[rows[1], x]
+    for y in rows:
+        for i in (left, x, right):
+            out = min(out, cells[y, i]) if nearest else max(out, cells[y, i])
+    return out
 
 
 @kernel
@@ -91,29 +109,24 @@ def _dilate_cells(nearest: np.ndarray, farthest: np.ndarray, out: np.ndarray, ba
     """Every cell's extremes over itself and its eight neighbours, for the cell rows of one band."""
     cells = nearest.shape[0]
     for y in band_rows(cells, band, bands):
+        rows = (max(y - 1, 0), y, min(y + 1, cells - 1))
         for x in range(cells):
-            low = np.inf
-            high = -np.inf
-            for j in range(max(y - 1, 0), min(y + 2, cells)):
-                for i in range(max(x - 1, 0), min(x + 2, cells)):
-                    low = min(low, nearest[j, i])
-                    high = max(high, farthest[j, i])
-            out[y, x, NEAR_AROUND] = low
-            out[y, x, FAR_AROUND] = high
+            out[y, x, NEAR_AROUND] = _around(nearest, rows, x, cells - 1, True)
+            out[y, x, FAR_AROUND] = _around(farthest, rows, x, cells - 1, False)
 
 
-def pool_extremes(depths: Sequence[Float32Array], shift: int, threads: int = 1) -> list[Float32Array]:
-    """Per map of ``depths``, (S >> shift, S >> shift, 2): the nearest and the farthest caster depth in each
-    2**shift square and its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is any
-    caster near enough to shade this point?" and "does every texel around it shade it?" for any filter reaching
-    less than 2**shift texels. All maps are pooled in one parallel step and dilated in another."""
-    cells = [depth.shape[0] >> shift for depth in depths]
-    pooled = [(np.full((n, n), np.inf, np.float32), np.full((n, n), -np.inf, np.float32)) for n in cells]
+def pool_extremes(depths: Sequence[Float32Array], threads: int = 1) -> list[Float32Array]:
+    """Per map of ``depths``, (S >> COARSE_SHIFT, S >> COARSE_SHIFT, 2): the nearest and the farthest caster depth
+    in each coarse cell and its eight neighbours (see lighting.NEAR_AROUND, FAR_AROUND). One lookup answers "is
+    any caster near enough to shade this point?" and "does every texel around it shade it?" for any filter
+    reaching less than a cell. All maps are pooled in one parallel step and dilated in another."""
+    cells = [depth.shape[0] >> COARSE_SHIFT for depth in depths]
+    pooled = [(np.empty((n, n), np.float32), np.empty((n, n), np.float32)) for n in cells]
     outs = [np.empty((n, n, 2), np.float32) for n in cells]
 
     def pool(band: int, bands: int) -> None:
         for depth, (nearest, farthest) in zip(depths, pooled):
-            _pool_cells(depth, shift, nearest, farthest, band, bands)
+            _pool_cells(depth, nearest, farthest, band, bands)
 
     def dilate(band: int, bands: int) -> None:
         for (nearest, farthest), out in zip(pooled, outs):
@@ -199,7 +212,7 @@ def build_shadow_maps(packed: PackedScene, camera: PinholeCamera, sun_dir_world:
         views = [(params[c, 2], params[c, 0], params[c, 1]) for c, _ in missing]
         depth_orthographic_views(v_light, packed.faces, packed.shadow_faces, (size, size), views,
                                  [depth[c] for c, _ in missing], threads)
-        for (c, key), extremes in zip(missing, pool_extremes([depth[c] for c, _ in missing], COARSE_SHIFT, threads)):
+        for (c, key), extremes in zip(missing, pool_extremes([depth[c] for c, _ in missing], threads)):
             cells[c] = extremes
             if cache is not None:
                 cache.put(key, (depth[c], cells[c]))  # views of this frame's maps, never written again
