@@ -20,8 +20,11 @@
    (its lane probability, 1 - background, of the lane-mask head: the segmentation output of ``seg``, the
    auxiliary head of ``ufld``; widened to the area around the lanes by ``attention_spread_px`` and normalised to
    0..1 per image) is computed on ``x``, and a random hard patch ``(h, M, H)`` is blended where the model looks
-   and where it was misled: ``W = max(A * M, H)``, ``x' = x * (1 - W) + h * W``. Labels stay those of ``x``:
-   illusions never move the lanes, and only masked pixels change (``H`` lies inside ``M``). With
+   and where it was misled: ``W = max(A * M, H)``, ``x' = x * (1 - W) + t * W``. The mixed-in ``t`` is ``h``
+   where the illusion's meshes are (an occluder) and elsewhere ``x`` relit by the illusion, ``x * g`` with ``g``
+   the perturbed over the clean bank render (a shadow, a glare, a crack's or a seam's albedo): the illusion falls
+   on this image's own road and paint. Labels stay those of ``x``: illusions never move the lanes, and only masked
+   pixels change (``H`` lies inside ``M``). With
    ``mismatch_threshold = None`` the high-attention areas are left out (``W = A * M``).
 
 Attention maps are taken with batch norm on its running statistics (``models.running_statistics``), so these
@@ -47,7 +50,7 @@ from ..illusion_effect import CHANGED_LEVEL, lane_band, luminance, with_illusion
 from ..illusions import REGISTRY
 from ..labels import h_samples_for, tusimple_record
 from ..render import render_frame
-from ..scene import FIRST_OBJECT_ID
+from ..scene import FIRST_OBJECT_ID, ID_ROAD
 from .data import resized, targets_for
 from .models import LaneNet, running_statistics
 
@@ -84,6 +87,8 @@ class HardPatch:
     illusion_type: str
     accuracy: float = 1.0
     haa: np.ndarray | None = None  # (H, W) float32 0..1: the high-attention area of the last scoring, inside mask
+    gain: np.ndarray | None = None  # (H, W, 3) float32: perturbed / clean radiance, the illusion's light change
+    objects: np.ndarray | None = None  # (H, W) float32 0..1: the illusion's own meshes (pasted, not relit)
 
 
 def bank_case(clean: list[Case], seed: int, index: int) -> Case:
@@ -99,14 +104,27 @@ def bank_case(clean: list[Case], seed: int, index: int) -> Case:
 
 def illusion_mask(clean_rgb: np.ndarray, perturbed_rgb: np.ndarray, object_id: np.ndarray,
                   illusion_ids: np.ndarray, unpainted_rgb: np.ndarray | None = None) -> np.ndarray:
-    """(H, W) bool: the illusion's meshes plus every pixel whose luminance it changes visibly; with the frame
-    rendered without lane paint (``unpainted_rgb``), less the frame's own markings and a pixel around them."""
+    """(H, W) bool: the illusion's meshes plus every pixel of the carriageway whose luminance it changes visibly
+    (not the sky, roadside or buildings a moved sun relights); with the frame rendered without lane paint
+    (``unpainted_rgb``), those road pixels less the frame's own markings and a pixel around them."""
     changed = np.abs(luminance(perturbed_rgb) - luminance(clean_rgb)) > CHANGED_LEVEL
-    mask = changed | np.isin(object_id, illusion_ids)
+    road = changed & (object_id == ID_ROAD)
     if unpainted_rgb is not None:
         paint = (np.abs(luminance(clean_rgb) - luminance(unpainted_rgb)) > CHANGED_LEVEL).astype(np.uint8)
-        mask &= ~cv2.dilate(paint, np.ones((3, 3), np.uint8)).astype(bool)
-    return mask
+        road &= ~cv2.dilate(paint, np.ones((3, 3), np.uint8)).astype(bool)
+    return road | np.isin(object_id, illusion_ids)
+
+
+GAIN_OFFSET = 8.0  # grey levels added to both renders before their ratio (keeps dark pixels' gains bounded)
+MAX_GAIN = 6.0
+
+
+def light_gain(clean_rgb: np.ndarray, perturbed_rgb: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32: how the illusion scales each pixel's colour (perturbed over clean, per channel): a
+    shadow's darkening, a reflection's glare, a crack's or a seam's albedo, transferable to another image's road
+    without carrying that frame's own content."""
+    ratio = (perturbed_rgb.astype(np.float32) + GAIN_OFFSET) / (clean_rgb.astype(np.float32) + GAIN_OFFSET)
+    return np.clip(ratio, 0.0, MAX_GAIN).astype(np.float32)
 
 
 def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
@@ -128,8 +146,11 @@ def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
             continue
         record = tusimple_record(clean_scene, frame_index, clean, "", rows)
         small_mask = cv2.resize(mask, input_size, interpolation=cv2.INTER_AREA)
-        patches.append(HardPatch(resized(frame.rgb, input_size), np.clip(small_mask, 0.0, 1.0), record,
-                                 BANK_RENDER_SIZE, sha, case.illusions[0].type))
+        image = resized(frame.rgb, input_size)
+        objects = np.isin(frame.object_id, illusion_ids).astype(np.float32)
+        patches.append(HardPatch(image, np.clip(small_mask, 0.0, 1.0), record, BANK_RENDER_SIZE, sha,
+                                 case.illusions[0].type, gain=light_gain(resized(clean.rgb, input_size), image),
+                                 objects=np.clip(cv2.resize(objects, input_size, interpolation=cv2.INTER_AREA), 0, 1)))
     return patches
 
 
@@ -186,22 +207,50 @@ def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: in
 
 
 def mix(images: torch.Tensor, attention_map: torch.Tensor, patches: torch.Tensor,
-        masks: torch.Tensor, areas: torch.Tensor | None = None) -> torch.Tensor:
-    """``x * (1 - W) + h * W`` with ``W = max(A * M, H)`` for images (N, 3, H, W), attention (N, H, W), patches
-    (N, 3, H, W), masks (N, H, W) and high-attention areas (N, H, W; none: ``W = A * M``), all in 0..1."""
+        masks: torch.Tensor, areas: torch.Tensor | None = None, gains: torch.Tensor | None = None,
+        objects: torch.Tensor | None = None) -> torch.Tensor:
+    """``x * (1 - W) + t * W`` with ``W = max(A * M, H)`` for images (N, 3, H, W), attention (N, H, W), patches
+    (N, 3, H, W), masks (N, H, W) and high-attention areas (N, H, W; none: ``W = A * M``), all in 0..1.
+
+    The mixed-in ``t`` is the patch itself, or with ``gains`` (N, 3, H, W) and ``objects`` (N, H, W) the patch
+    where the illusion's meshes are and elsewhere the image relit by the illusion (``x * gain``): a shadow or a
+    streak then falls on this image's own paint instead of replacing it with another frame's road."""
     weight = attention_map * masks
     if areas is not None:
         weight = torch.maximum(weight, areas)
     weight = weight[:, None]
-    return images * (1.0 - weight) + patches * weight
+    target = patches
+    if gains is not None and objects is not None:
+        occluded = objects[:, None]
+        target = patches * occluded + (images * gains).clamp(0.0, 1.0) * (1.0 - occluded)
+    return images * (1.0 - weight) + target * weight
 
 
-def patch_tensors(chosen: list[HardPatch]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """(N, 3, H, W) float 0..1 images, (N, H, W) masks and (N, H, W) high-attention areas (zero where a patch has
-    none) of bank patches."""
-    images = torch.from_numpy(np.stack([p.image for p in chosen]).transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
-    areas = np.stack([p.haa if p.haa is not None else np.zeros_like(p.mask) for p in chosen])
-    return images, torch.from_numpy(np.stack([p.mask for p in chosen])), torch.from_numpy(areas)
+@dataclass(frozen=True)
+class PatchBatch:
+    """Bank patches as tensors: images (N, 3, H, W) 0..1, masks, areas, objects (N, H, W), gains (N, 3, H, W)."""
+
+    images: torch.Tensor
+    masks: torch.Tensor
+    areas: torch.Tensor
+    gains: torch.Tensor
+    objects: torch.Tensor
+
+
+def patch_tensors(chosen: list[HardPatch]) -> PatchBatch:
+    """The tensors of bank patches (zero areas where a patch has none; a patch without gains is pasted whole)."""
+    def stacked(arrays: list[np.ndarray]) -> torch.Tensor:
+        return torch.from_numpy(np.ascontiguousarray(np.stack(arrays), dtype=np.float32))
+
+    images = stacked([p.image.astype(np.float32) / 255.0 for p in chosen]).permute(0, 3, 1, 2)
+    return PatchBatch(
+        images=images,
+        masks=stacked([p.mask for p in chosen]),
+        areas=stacked([p.haa if p.haa is not None else np.zeros_like(p.mask) for p in chosen]),
+        gains=stacked([p.gain if p.gain is not None else np.ones_like(p.image, np.float32)
+                       for p in chosen]).permute(0, 3, 1, 2),
+        objects=stacked([p.objects if p.objects is not None else np.ones_like(p.mask) for p in chosen]),
+    )
 
 
 def lane_attention(model: LaneNet, images: torch.Tensor, spread_px: int = 0) -> torch.Tensor:

@@ -163,9 +163,10 @@ def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainS
         return images
     device = next(model.parameters()).device
     attention_map = lane_attention(model, images[chosen].to(device), settings.aam.attention_spread_px).cpu()
-    patches, masks, areas = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
+    bank = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
     images = images.clone()
-    images[chosen] = mix(images[chosen], attention_map, patches, masks, areas)
+    images[chosen] = mix(images[chosen], attention_map, bank.images, bank.masks, bank.areas, bank.gains,
+                         bank.objects)
     return images
 
 

@@ -188,19 +188,30 @@ def test_aam_mixing_touches_only_masked_pixels():
     unseen = mix(images, attention_map * 0.0, patches, masks, areas)
     assert torch.all(unseen[:, :, 2:4, 5:6] == 0) and torch.equal(unseen[:, :, :, :5], images[:, :, :, :5])
     assert torch.equal(unseen[outside], images[outside])
+    # with gains, a light change scales the image's own pixels; the illusion's meshes are still pasted
+    gains, objects = torch.full_like(images, 0.5), torch.zeros(2, 8, 10)
+    objects[:, 2:4, 3] = 1.0
+    relit = mix(images, attention_map, patches, masks, None, gains, objects)
+    assert torch.allclose(relit[:, :, 2:4, 4:6], images[:, :, 2:4, 4:6] * 0.5)
+    assert torch.all(relit[:, :, 2:4, 3] == 0) and torch.equal(relit[outside], images[outside])
 
 
 def test_aam_patch_mask_leaves_out_the_bank_frames_own_paint():
     from lanevil_core.learn.aam import illusion_mask
+    from lanevil_core.scene import ID_ROAD, ID_SKY
 
     unpainted = np.full((10, 12, 3), 60, np.uint8)
     clean = unpainted.copy()
     clean[:, 5] = 200  # a lane line
-    perturbed = clean // 4  # a shadow over everything, the line included
-    ids = np.zeros((10, 12), np.int32)
-    assert illusion_mask(clean, perturbed, ids, np.array([7])).all()
-    mask = illusion_mask(clean, perturbed, ids, np.array([7]), unpainted)
-    assert not mask[:, 4:7].any() and mask[:, :4].all() and mask[:, 7:].all()
+    perturbed = clean // 4  # a shadow over everything, the line included ...
+    perturbed[8:, 5] = 90  # ... and a vehicle of the illusion's over the line
+    ids = np.full((10, 12), ID_ROAD, np.int32)
+    ids[:2] = ID_SKY  # the sky is not the illusion's, however a moved sun changes it
+    ids[8:, 5] = 20
+    assert illusion_mask(clean, perturbed, ids, np.array([20]))[2:].all()
+    mask = illusion_mask(clean, perturbed, ids, np.array([20]), unpainted)
+    assert not mask[:2].any() and mask[2:, :4].all() and mask[2:, 7:].all()
+    assert not mask[2:8, 4:7].any() and mask[8:, 5].all()
 
 
 def test_mismatch_area_is_focus_off_the_lanes_and_lanes_without_focus():
