@@ -83,13 +83,13 @@ def _window_weights(x: float, radius: float) -> tuple[int, int, float, float, fl
 @kernel(inline="always")
 def _window_row(depth: np.ndarray, c: int, y: int, x: int, limit: float, w0: float, w1: float, w2: float,
                 w3: float) -> float:
-    """The sum of the weights of texels x .. x + 3 of map row ``y`` (clamped to the map) lit at ``limit``."""
-    size = depth.shape[1]
-    yi = min(max(y, 0), size - 1)
-    lit = w0 if depth[c, yi, min(max(x, 0), size - 1)] >= limit else 0.0
-    lit += w1 if depth[c, yi, min(max(x + 1, 0), size - 1)] >= limit else 0.0
-    lit += w2 if depth[c, yi, min(max(x + 2, 0), size - 1)] >= limit else 0.0
-    lit += w3 if depth[c, yi, min(max(x + 3, 0), size - 1)] >= limit else 0.0
+    """The sum of the weights of texels x .. x + 3 of map row ``y`` lit at ``limit``. The window lies inside the
+    map: the point is 2 texels inside it (``sun_visibility``) and a window's taps reach less than 1.5 texels
+    around it (its span is at most 2), so the four reads are contiguous and unclamped."""
+    lit = w0 if depth[c, y, x] >= limit else 0.0
+    lit += w1 if depth[c, y, x + 1] >= limit else 0.0
+    lit += w2 if depth[c, y, x + 2] >= limit else 0.0
+    lit += w3 if depth[c, y, x + 3] >= limit else 0.0
     return lit
 
 

@@ -158,13 +158,6 @@ def frame_lighting(env_f: FloatArray, sun_dir: FloatArray, sun_color: FloatArray
 
 
 @kernel(inline="always")
-def coordinate_step(gx: float, gy: float, gz: float, ux: float, uy: float, uz: float, vx: float, vy: float,
-                    vz: float) -> float:
-    """How much a road coordinate with world gradient g changes across one pixel (steps u and v)."""
-    return FOOTPRINT_SCALE * (abs(gx * ux + gy * uy + gz * uz) + abs(gx * vx + gy * vy + gz * vz)) + 1e-3
-
-
-@kernel(inline="always")
 def pixel_ray(R_world_camera: np.ndarray, x_cam: float, y_cam: float) -> tuple[float, float, float, float]:
     """(dx, dy, dz, norm): the unit world direction through camera-plane point (x_cam, y_cam, 1) and that
     point's length (camera z to distance along the ray)."""
@@ -189,24 +182,39 @@ def facing_normal(normal: np.ndarray, f: int, dx: float, dy: float,
 
 
 @kernel(inline="always")
-def road_footprint(R_world_camera: np.ndarray, fx: float, fy: float, grad_st: np.ndarray, f: int, depth: float,
-                   norm: float, dx: float, dy: float, dz: float, nx: float, ny: float, nz: float,
-                   n_dot_v: float) -> tuple[float, float]:
+def gradients_camera(R_world_camera: np.ndarray, grad_st: np.ndarray,
+                     f: int) -> tuple[float, float, float, float, float, float]:
+    """The world gradients of s and of t on road face ``f`` in camera axes: (s_x, s_y, s_z, t_x, t_y, t_z)."""
+    R = R_world_camera
+    sx, sy, sz, tx, ty, tz = grad_st[f, 0], grad_st[f, 1], grad_st[f, 2], grad_st[f, 3], grad_st[f, 4], grad_st[f, 5]
+    return (sx * R[0, 0] + sy * R[1, 0] + sz * R[2, 0], sx * R[0, 1] + sy * R[1, 1] + sz * R[2, 1],
+            sx * R[0, 2] + sy * R[1, 2] + sz * R[2, 2], tx * R[0, 0] + ty * R[1, 0] + tz * R[2, 0],
+            tx * R[0, 1] + ty * R[1, 1] + tz * R[2, 1], tx * R[0, 2] + ty * R[1, 2] + tz * R[2, 2])
+
+
+@kernel(inline="always")
+def coordinate_step(g_x_cam: float, g_y_cam: float, g_z_cam: float, x_cam: float, y_cam: float, k_u: float,
+                    k_v: float, su: float, sv: float) -> float:
+    """How much a road coordinate with gradient g (camera axes) changes across one pixel: its steps along the
+    pixel's ray differentials u = su (x - r k_u) and v = sv (y - r k_v) on the face's plane, r = (x_cam, y_cam, 1)."""
+    g_dot_r = g_x_cam * x_cam + g_y_cam * y_cam + g_z_cam
+    step = abs(su * (g_x_cam - g_dot_r * k_u)) + abs(sv * (g_y_cam - g_dot_r * k_v))
+    return min(FOOTPRINT_SCALE * step + 1e-3, MAX_FOOTPRINT_M)
+
+
+@kernel(inline="always")
+def road_footprint(R_world_camera: np.ndarray, fx: float, fy: float,
+                   grad_cam: tuple[float, float, float, float, float, float], depth: float, norm: float,
+                   x_cam: float, y_cam: float, nx: float, ny: float, nz: float, n_dot_v: float) -> tuple[float, float]:
     """(fs, ft): how much s and t change across the pixel, by ray differentials on the face's plane (exact for
-    the affine (s, t) of a road triangle)."""
+    the affine (s, t) of a road triangle); ``grad_cam`` is the face's ``gradients_camera``."""
     R = R_world_camera
     n_dot_r = -max(n_dot_v, 1e-4) * norm  # n faces the viewer, so n.ray < 0
     k_u = (nx * R[0, 0] + ny * R[1, 0] + nz * R[2, 0]) / n_dot_r
     k_v = (nx * R[0, 1] + ny * R[1, 1] + nz * R[2, 1]) / n_dot_r
     su, sv = depth / fx, depth / fy
-    ux = su * (R[0, 0] - dx * norm * k_u)
-    uy = su * (R[1, 0] - dy * norm * k_u)
-    uz = su * (R[2, 0] - dz * norm * k_u)
-    vx = sv * (R[0, 1] - dx * norm * k_v)
-    vy = sv * (R[1, 1] - dy * norm * k_v)
-    vz = sv * (R[2, 1] - dz * norm * k_v)
-    fs = min(coordinate_step(grad_st[f, 0], grad_st[f, 1], grad_st[f, 2], ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
-    ft = min(coordinate_step(grad_st[f, 3], grad_st[f, 4], grad_st[f, 5], ux, uy, uz, vx, vy, vz), MAX_FOOTPRINT_M)
+    fs = coordinate_step(grad_cam[0], grad_cam[1], grad_cam[2], x_cam, y_cam, k_u, k_v, su, sv)
+    ft = coordinate_step(grad_cam[3], grad_cam[4], grad_cam[5], x_cam, y_cam, k_u, k_v, su, sv)
     return fs, ft
 
 
@@ -366,6 +374,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     span = -1  # the sky samples below are those of columns span * SKY_STEP and (span + 1) * SKY_STEP
     exact = True
     r0 = g0 = b0 = r1 = g1 = b1 = 0.0
+    grad_face = -1  # the road face whose gradients_camera grad_cam holds (faces repeat along a row)
+    grad_cam = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for col in range(width):
         f = face[row, col]
         if f < 0:
@@ -392,7 +402,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             out[row, col, 1] = g
             out[row, col, 2] = b
             continue
-        dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
+        x_cam = (col + 0.5 - cx) / fx
+        dx, dy, dz, norm = pixel_ray(R, x_cam, y_cam)
         depth = depth_buf[row, col]
         dist = depth * norm
         px, py, pz = c_world[0] + dx * dist, c_world[1] + dy * dist, c_world[2] + dz * dist
@@ -402,7 +413,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         wet = 0.0
         up = 0.6 + 0.4 * nz
         if material >= 0:
-            fs, ft = road_footprint(R, fx, fy, grad_st, f, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
+            if f != grad_face:
+                grad_cam = gradients_camera(R, grad_st, f)
+                grad_face = f
+            fs, ft = road_footprint(R, fx, fy, grad_cam, depth, norm, x_cam, y_cam, nx, ny, nz, n_dot_v)
             footprint = max(fs, ft)
             s, t = road_coordinates(faces, vertex_st, bary, row, col, f)
             r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint),

@@ -111,6 +111,16 @@ def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: f
 
 
 @kernel(inline="always")
+def _anisotropy(fs: float, ft: float) -> tuple[float, float, int]:
+    """(short, long, taps): the footprint's short axis (the mip level's width, at least long / MAX_ANISO), its
+    long axis and the samples spread along it."""
+    short = min(fs, ft)
+    long = max(fs, ft)
+    taps = min(int(np.ceil(long / max(short, 1e-6))), MAX_ANISO)
+    return max(short, long / MAX_ANISO), long, taps
+
+
+@kernel(inline="always")
 def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piece: int, s: float, t: float,
                   fs: float, ft: float, over_paint: bool, r: float, g: float,
                   b: float) -> tuple[float, float, float, float]:
@@ -121,11 +131,6 @@ def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piec
     spread along the long one, so marks running along the road stay sharp far ahead.
     """
     wet = 0.0
-    short = min(fs, ft)
-    long = max(fs, ft)
-    taps = min(int(np.ceil(long / max(short, 1e-6))), MAX_ANISO)
-    short = max(short, long / MAX_ANISO)
-    along_s = fs >= ft
     for layer in range(first.size - 1):
         row0 = first[layer]
         if int(table[row0, 0]) != piece or (table[row0, 7] > 0.5) != over_paint:
@@ -134,6 +139,7 @@ def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piec
         rows0, cols0 = table[row0, 4], table[row0, 5]
         if s < s0 or t < t0 or s >= s0 + rows0 * texel0 or t >= t0 + cols0 * texel0:
             continue
+        short, long, taps = _anisotropy(fs, ft)
         level = row0
         ratio = short / texel0
         while ratio > 1.0 and level < first[layer + 1] - 1:
@@ -142,7 +148,7 @@ def sample_layers(texels: np.ndarray, table: np.ndarray, first: np.ndarray, piec
         pr = pg = pb = alpha = w = 0.0
         for k in range(taps):
             offset = ((k + 0.5) / taps - 0.5) * long
-            if along_s:
+            if fs >= ft:
                 q0, q1, q2, q3, q4 = _bilinear5(texels, table, level, s + offset, t, s0, t0)
             else:
                 q0, q1, q2, q3, q4 = _bilinear5(texels, table, level, s, t + offset, s0, t0)
