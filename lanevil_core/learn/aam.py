@@ -72,6 +72,7 @@ class AamSettings:
     mismatch_blur_px: float = 1.5  # sigma of the Gaussian blur of the attention before the threshold
     mismatch_grow_px: int = 3  # the mismatch regions grown by this radius (input pixels)
     lane_band_px: int = 2  # half width of a ground-truth lane at the input size
+    relight: bool = False  # mix the illusion's light change into the image's own road instead of its pixels
 
 
 @dataclass
@@ -103,16 +104,19 @@ def bank_case(clean: list[Case], seed: int, index: int) -> Case:
 
 
 def illusion_mask(clean_rgb: np.ndarray, perturbed_rgb: np.ndarray, object_id: np.ndarray,
-                  illusion_ids: np.ndarray, unpainted_rgb: np.ndarray | None = None) -> np.ndarray:
-    """(H, W) bool: the illusion's meshes plus every pixel of the carriageway whose luminance it changes visibly
-    (not the sky, roadside or buildings a moved sun relights); with the frame rendered without lane paint
-    (``unpainted_rgb``), those road pixels less the frame's own markings and a pixel around them."""
+                  illusion_ids: np.ndarray, unpainted_rgb: np.ndarray | None = None,
+                  road_only: bool = False) -> np.ndarray:
+    """(H, W) bool: the illusion's meshes plus every pixel whose luminance it changes visibly (with ``road_only``,
+    only on the carriageway: not the sky, roadside or buildings a moved sun relights); with the frame rendered
+    without lane paint (``unpainted_rgb``), those changed pixels less the frame's own markings and a pixel around
+    them."""
     changed = np.abs(luminance(perturbed_rgb) - luminance(clean_rgb)) > CHANGED_LEVEL
-    road = changed & (object_id == ID_ROAD)
+    if road_only:
+        changed &= object_id == ID_ROAD
     if unpainted_rgb is not None:
         paint = (np.abs(luminance(clean_rgb) - luminance(unpainted_rgb)) > CHANGED_LEVEL).astype(np.uint8)
-        road &= ~cv2.dilate(paint, np.ones((3, 3), np.uint8)).astype(bool)
-    return road | np.isin(object_id, illusion_ids)
+        changed &= ~cv2.dilate(paint, np.ones((3, 3), np.uint8)).astype(bool)
+    return changed | np.isin(object_id, illusion_ids)
 
 
 GAIN_OFFSET = 8.0  # grey levels added to both renders before their ratio (keeps dark pixels' gains bounded)
@@ -127,8 +131,9 @@ def light_gain(clean_rgb: np.ndarray, perturbed_rgb: np.ndarray) -> np.ndarray:
     return np.clip(ratio, 0.0, MAX_GAIN).astype(np.float32)
 
 
-def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
-    """The bank frames of one bank case (its ``BANK_FRAMES``), at the network's input size."""
+def render_patches(case: Case, input_size: tuple[int, int], relight: bool = False) -> list[HardPatch]:
+    """The bank frames of one bank case (its ``BANK_FRAMES``), at the network's input size; with ``relight``
+    their light change and meshes too, and masks on the carriageway only."""
     clean_case = with_illusion(case, {"type": case.illusions[0].type, "severity": 1}).model_copy(
         update={"illusions": []})
     unpainted_case = clean_case.model_copy(update={"road": clean_case.road.model_copy(update={"paint": False})})
@@ -141,16 +146,19 @@ def render_patches(case: Case, input_size: tuple[int, int]) -> list[HardPatch]:
         frame = render_frame(scene, frame_index, BANK_RENDER_SIZE)
         clean = render_frame(clean_scene, frame_index, BANK_RENDER_SIZE)
         unpainted = render_frame(unpainted_scene, frame_index, BANK_RENDER_SIZE).rgb
-        mask = illusion_mask(clean.rgb, frame.rgb, frame.object_id, illusion_ids, unpainted).astype(np.float32)
+        mask = illusion_mask(clean.rgb, frame.rgb, frame.object_id, illusion_ids, unpainted,
+                             road_only=relight).astype(np.float32)
         if mask.mean() < 0.002:  # the illusion is not in this frame
             continue
         record = tusimple_record(clean_scene, frame_index, clean, "", rows)
         small_mask = cv2.resize(mask, input_size, interpolation=cv2.INTER_AREA)
         image = resized(frame.rgb, input_size)
-        objects = np.isin(frame.object_id, illusion_ids).astype(np.float32)
-        patches.append(HardPatch(image, np.clip(small_mask, 0.0, 1.0), record, BANK_RENDER_SIZE, sha,
-                                 case.illusions[0].type, gain=light_gain(resized(clean.rgb, input_size), image),
-                                 objects=np.clip(cv2.resize(objects, input_size, interpolation=cv2.INTER_AREA), 0, 1)))
+        patch = HardPatch(image, np.clip(small_mask, 0.0, 1.0), record, BANK_RENDER_SIZE, sha, case.illusions[0].type)
+        if relight:
+            objects = np.isin(frame.object_id, illusion_ids).astype(np.float32)
+            patch.gain = light_gain(resized(clean.rgb, input_size), image)
+            patch.objects = np.clip(cv2.resize(objects, input_size, interpolation=cv2.INTER_AREA), 0.0, 1.0)
+        patches.append(patch)
     return patches
 
 
@@ -160,7 +168,7 @@ def build_bank(clean_cases: list[Path], input_size: tuple[int, int], seed: int,
     clean = [load_case(path) for path in clean_cases]
     patches = []
     for index in range(settings.bank_cases):
-        patches += render_patches(bank_case(clean, seed, index), input_size)
+        patches += render_patches(bank_case(clean, seed, index), input_size, settings.relight)
     blur = settings.mask_blur_px
     for patch in patches:
         if blur > 0:

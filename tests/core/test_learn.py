@@ -208,10 +208,12 @@ def test_aam_patch_mask_leaves_out_the_bank_frames_own_paint():
     ids = np.full((10, 12), ID_ROAD, np.int32)
     ids[:2] = ID_SKY  # the sky is not the illusion's, however a moved sun changes it
     ids[8:, 5] = 20
-    assert illusion_mask(clean, perturbed, ids, np.array([20]))[2:].all()
-    mask = illusion_mask(clean, perturbed, ids, np.array([20]), unpainted)
-    assert not mask[:2].any() and mask[2:, :4].all() and mask[2:, 7:].all()
-    assert not mask[2:8, 4:7].any() and mask[8:, 5].all()
+    assert illusion_mask(clean, perturbed, ids, np.array([20])).all()
+    pasted = illusion_mask(clean, perturbed, ids, np.array([20]), unpainted)
+    assert pasted[:, :4].all() and pasted[:, 7:].all() and not pasted[:8, 4:7].any()
+    assert pasted[8:, 5].all()  # the illusion's own vehicle stays whole over the line
+    relit = illusion_mask(clean, perturbed, ids, np.array([20]), unpainted, road_only=True)
+    assert not relit[:2].any() and relit[2:, :4].all() and np.array_equal(relit[2:], pasted[2:])
 
 
 def test_mismatch_area_is_focus_off_the_lanes_and_lanes_without_focus():
@@ -267,18 +269,21 @@ def test_aam_bank_never_holds_a_test_case():
     assert {case.illusions[0].type for case in bank} == {path.name for path in SCENES.glob("[1-4]*/*/")}
 
 
-def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path):
+@pytest.mark.parametrize("relight", [False, True])
+def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path, relight):
     from lanevil_core.learn.aam import AamSettings
     from lanevil_core.learn.train import AAM_BANK_FILE, TrainSettings, train
 
     spec = ModelSpec(family="seg", **TINY_SPEC)
     settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=2, batch=2, augment="aam",
-                             val_fraction=0.5, max_steps=2, aam=AamSettings(bank_cases=2, probability=1.0))
+                             val_fraction=0.5, max_steps=2,
+                             aam=AamSettings(bank_cases=2, probability=1.0, relight=relight))
     summary = train(settings, show_progress=False)
     assert summary["augment"] == "aam" and len(summary["history"]) == 2
     bank = torch.load(tmp_path / AAM_BANK_FILE, weights_only=False)["patches"]
     assert bank and all(0.0 <= p.mask.min() and p.mask.max() <= 1.0 for p in bank)
     assert all(p.mask.mean() > 0 for p in bank)
+    assert all((p.gain is not None) == relight for p in bank)
     mixed = summary["history"][1]["aam"]  # the bank is scored, and its attention areas found, after epoch 1
     assert mixed["hard_patches"] >= 1 and 0.0 <= mixed["attention_area_share"] <= 1.0
 
