@@ -20,12 +20,11 @@
    (its lane probability, 1 - background, of the lane-mask head: the segmentation output of ``seg``, the
    auxiliary head of ``ufld``; widened to the area around the lanes by ``attention_spread_px`` and normalised to
    0..1 per image) is computed on ``x``, and a random hard patch ``(h, M, H)`` is blended where the model looks
-   and where it was misled: ``W = max(A * M, H)``, ``x' = x * (1 - W) + t * W``. The mixed-in ``t`` is ``h``
-   where the illusion's meshes are (an occluder) and elsewhere ``x`` relit by the illusion, ``x * g`` with ``g``
-   the perturbed over the clean bank render (a shadow, a glare, a crack's or a seam's albedo): the illusion falls
-   on this image's own road and paint. Labels stay those of ``x``: illusions never move the lanes, and only masked
-   pixels change (``H`` lies inside ``M``). With
-   ``mismatch_threshold = None`` the high-attention areas are left out (``W = A * M``).
+   and where it was misled: ``W = max(A * M, H)``, ``x' = x * (1 - W) + h * W``. Labels stay those of ``x``:
+   illusions never move the lanes, and only masked pixels change (``H`` lies inside ``M``). With
+   ``mismatch_threshold = None`` the high-attention areas are left out (``W = A * M``). With ``relight`` the
+   mixed-in pixels are ``h`` only where the illusion's meshes are and elsewhere ``x`` relit by the illusion,
+   ``x * g`` with ``g`` the perturbed over the clean bank render, so the illusion falls on this image's own road.
 
 Attention maps are taken with batch norm on its running statistics (``models.running_statistics``), so these
 extra forward passes do not count as training data.
@@ -245,14 +244,18 @@ class PatchBatch:
     objects: torch.Tensor
 
 
+def image_tensor(chosen: list[HardPatch]) -> torch.Tensor:
+    """(N, 3, H, W) float 0..1 of the bank patches' images."""
+    return torch.from_numpy(np.stack([p.image for p in chosen]).transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
+
+
 def patch_tensors(chosen: list[HardPatch]) -> PatchBatch:
     """The tensors of bank patches (zero areas where a patch has none; a patch without gains is pasted whole)."""
     def stacked(arrays: list[np.ndarray]) -> torch.Tensor:
         return torch.from_numpy(np.ascontiguousarray(np.stack(arrays), dtype=np.float32))
 
-    images = stacked([p.image.astype(np.float32) / 255.0 for p in chosen]).permute(0, 3, 1, 2)
     return PatchBatch(
-        images=images,
+        images=image_tensor(chosen),
         masks=stacked([p.mask for p in chosen]),
         areas=stacked([p.haa if p.haa is not None else np.zeros_like(p.mask) for p in chosen]),
         gains=stacked([p.gain if p.gain is not None else np.ones_like(p.image, np.float32)
@@ -298,8 +301,7 @@ def update_attention_areas(model: LaneNet, bank: list[HardPatch], settings: AamS
     size = model.spec.input_size
     for start in range(0, len(bank), batch):
         chunk = bank[start:start + batch]
-        images = torch.from_numpy(np.stack([p.image for p in chunk]).transpose(0, 3, 1, 2).astype(np.float32) / 255.0)
-        maps = lane_attention(model, images.to(device)).cpu().numpy()
+        maps = lane_attention(model, image_tensor(chunk).to(device)).cpu().numpy()
         for patch, attention_map in zip(chunk, maps, strict=True):
             area = mismatch_area(attention_map, patch_lanes(patch, size, settings.lane_band_px), settings)
             patch.haa = (patch.mask * area).astype(np.float32)
