@@ -6,15 +6,17 @@ A case file is JSON with a ``schema_version``. Units: metres, seconds, degrees i
 from __future__ import annotations
 
 import json
+import math
 import os
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .files import write_atomic
 from .illusions import IllusionSpec
-from .presets import preset_values
+from .presets import camera_preset_values, preset_values
 from .typed import LineType, RoadType, SceneKind, Turn
 
 SCHEMA_VERSION: Literal[1] = 1
@@ -121,17 +123,114 @@ class Sun(_Model):
     intensity: float = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
 
 
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+
+
+def _take_preset(data: Any, lookup: Callable[[str], dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    """(the data without its ``preset`` key, the preset's values), or None when ``data`` names no preset."""
+    if not isinstance(data, dict) or "preset" not in data:
+        return None
+    data = dict(data)
+    name = data.pop("preset")
+    try:
+        return data, lookup(str(name))
+    except KeyError as error:
+        raise ValueError(f"preset: {error.args[0]}") from None
+
+
+class Lens(_Model):
+    """Brown-Conrady lens distortion (OpenCV's k1, k2, p1, p2, k3) on normalised image coordinates. All zero is a
+    pinhole; k1 < 0 is the barrel distortion of a wide dash-cam lens. Labels go through the same model."""
+
+    k1: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^2 term")
+    k2: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^4 term")
+    k3: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^6 term")
+    p1: float = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
+    p2: float = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
+
+    @property
+    def coefficients(self) -> tuple[float, float, float, float, float]:
+        """OpenCV's order: (k1, k2, p1, p2, k3)."""
+        return (self.k1, self.k2, self.p1, self.p2, self.k3)
+
+
+class Bonnet(_Model):
+    """The ego's bonnet (hood) in view: a rounded front edge below and ahead of the camera. Lane labels stop
+    where it hides the road."""
+
+    reach: float = Field(1.6, ge=0.3, le=4.0, description="distance ahead of the camera to the front edge (m)")
+    drop: float = Field(0.45, ge=0.05, le=2.0, description="how far below the camera the front edge is (m)")
+    width: float = Field(1.75, ge=0.8, le=3.0, description="width of the bonnet (m)")
+    crown: float = Field(0.08, ge=0.0, le=0.5, description="how much lower its corners are than its middle (m)")
+    color: tuple[Unit, Unit, Unit] = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
+    gloss: float = Field(0.35, ge=0.0, le=1.0, description="share of the sky mirrored in the paint")
+
+
+class Sensor(_Model):
+    """What a real camera does to the light: metered auto-exposure within limits, white balance, colour and a
+    filmic response, vignetting, ISP sharpening, sensor noise (shot + read, rising with gain) and motion blur over
+    the exposure time. Deterministic per case seed and frame."""
+
+    exposure: Literal["auto", "fixed"] = Field("auto", description="auto meters every frame; fixed uses `gain`")
+    bias: float = Field(0.0, ge=-3.0, le=3.0, description="exposure compensation (EV)")
+    gain: float = Field(1.0, gt=0.0, le=64.0, description="exposure of the fixed mode (1 = scene-referred)")
+    min_gain: float = Field(0.05, gt=0.0, le=64.0, description="auto-exposure's lower limit")
+    max_gain: float = Field(16.0, gt=0.0, le=256.0, description="auto-exposure's upper limit (longest shutter, "
+                            "highest ISO)")
+    white_balance: float = Field(5600.0, ge=2000.0, le=12000.0, description="colour temperature the camera "
+                                 "balances for (K); the scene's light is daylight (5600 K)")
+    saturation: float = Field(1.45, ge=0.0, le=3.0, description="colour matrix saturation (1 = none)")
+    contrast: float = Field(1.15, ge=0.5, le=2.0, description="slope of the filmic curve's toe and middle")
+    vignetting: float = Field(0.35, ge=0.0, le=1.0, description="light lost in the image corners (0-1)")
+    sharpen: float = Field(0.6, ge=0.0, le=3.0, description="ISP unsharp-mask amount")
+    noise: float = Field(1.0, ge=0.0, le=10.0, description="sensor noise scale (1 = a typical small sensor)")
+    shutter: float = Field(0.004, ge=0.0, le=0.1, description="exposure time for motion blur (s); 0 = none")
+
+
 class Camera(_Model):
-    """Pinhole camera on the ego vehicle (x forward, z up in the vehicle frame)."""
+    """The ego's camera: intrinsics (horizontal FOV, or focal length and principal point), mount on the vehicle
+    (x forward, y left, z up), lens distortion, an optional bonnet in view and an optional sensor model.
+
+    ``{"preset": "dashcam"}`` fills the numbers of a named camera (``presets.CAMERA_PRESETS``); fields given
+    explicitly win. Without ``sensor`` the frame is the ideal tone-mapped render of the paper's CARLA captures."""
 
     width: int = Field(1280, ge=64, le=4096)
     height: int = Field(720, ge=64, le=4096)
     fov: float = Field(90.0, gt=10, lt=170, description="horizontal field of view (degrees)")
+    focal: float | None = Field(None, gt=10, le=20000, description="focal length (px at `width`); wins over fov")
+    cx: float | None = Field(None, ge=0, le=4096, description="principal point column (px); empty = centre")
+    cy: float | None = Field(None, ge=0, le=4096, description="principal point row (px); empty = centre")
     x: float = Field(1.0, ge=-5, le=5, description="mount position ahead of the vehicle origin (m)")
     y: float = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
     z: float = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
     pitch: float = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
     yaw: float = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
+    roll: float = Field(0.0, ge=-30, le=30, description="degrees about the optical axis, positive turns the "
+                        "image clockwise")
+    lens: Lens = Field(default_factory=Lens)
+    bonnet: Bonnet | None = Field(None, description="the ego's bonnet in view; empty = none")
+    sensor: Sensor | None = Field(None, description="a real camera's exposure, response and noise; empty = ideal")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _apply_preset(cls, data: Any) -> Any:
+        taken = _take_preset(data, camera_preset_values)
+        if taken is None:
+            return data
+        rest, values = taken
+        return {**values, **rest}
+
+    @property
+    def focal_px(self) -> float:
+        """Focal length in pixels at ``width`` (from ``focal``, else from the horizontal FOV)."""
+        if self.focal is not None:
+            return self.focal
+        return 0.5 * self.width / math.tan(math.radians(self.fov) / 2)
+
+    @property
+    def hfov(self) -> float:
+        """Horizontal field of view (degrees) of the pinhole part."""
+        return math.degrees(2 * math.atan(0.5 * self.width / self.focal_px))
 
 
 class Ego(_Model):
@@ -164,14 +263,10 @@ class Case(_Model):
     def _apply_preset(cls, data: Any) -> Any:
         """A ``"preset": "ClearNoon"`` key fills the weather and sun numbers it names (fields given explicitly
         win); the case then stores only the numbers."""
-        if not isinstance(data, dict) or "preset" not in data:
+        taken = _take_preset(data, preset_values)
+        if taken is None:
             return data
-        data = dict(data)
-        name = data.pop("preset")
-        try:
-            values = preset_values(str(name))
-        except KeyError as error:
-            raise ValueError(f"preset: {error.args[0]}") from None
+        data, values = taken
         for section in ("weather", "sun"):
             given = data.get(section) or {}
             if not isinstance(given, dict):

@@ -15,6 +15,7 @@ if TYPE_CHECKING:  # the case model imports the illusions, which use sun_directi
 
 
 NIGHT_EXPOSURE = 2.2
+PHOTO_DETAIL = 1.0  # surface texture of a case seen through a real camera's sensor (0 in the ideal render)
 HEADLIGHT_INTENSITY = 35.0  # radiance scale at 1 m of each of the ego's two headlights (on at night)
 
 
@@ -67,4 +68,5 @@ def environment_for(case: Case) -> Environment:
         exposure=1.0 if not night else NIGHT_EXPOSURE,
         night=night,
         headlights=HEADLIGHT_INTENSITY if night else 0.0,
+        detail=PHOTO_DETAIL if case.camera.sensor is not None else 0.0,
     )

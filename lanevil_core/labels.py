@@ -4,7 +4,8 @@ Every boundary is sampled densely along the road (``ReferenceLine.to_world`` at 
 projected with the frame's own ``PinholeCamera``, and cut with horizontal image lines. For each line the label is
 the crossing nearest to the camera (the first one walking out along the road), so crests and bends give the
 visible branch. Points are dropped when they fall outside the image, are hidden behind the road itself (a
-crest) or lie where an edge line breaks for a junction arm; dashed lines are labelled through their gaps. Points
+crest) or by the ego's own bonnet, or lie where an edge line breaks for a junction arm; dashed lines are labelled
+through their gaps. The camera's lens distortion is part of ``project``, so labels bend with the image. Points
 hidden by an object (a vehicle, a pedestrian) are kept, as TuSimple and CULane annotate lanes through occluders,
 and flagged in a ``visibility`` extension.
 
@@ -24,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .road_layout import RoadPiece
-from .scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
+from .scene import FIRST_OBJECT_ID, ID_EGO, ID_ROAD, ID_ROADSIDE, CompiledScene
 from .typed import BoolArray, FloatArray
 
 if TYPE_CHECKING:
@@ -185,6 +186,7 @@ def label_boundary(
         ids = frame.object_id[row, col]
         on_ground = (ids == ID_ROAD) | (ids == ID_ROADSIDE)
         inside &= ~(on_ground & _closer(surface_depth, depth, ROAD_HIDE_MARGIN))
+        inside &= ids != ID_EGO  # the ego's bonnet hides the road: the label stops at its edge
         occluded = (ids >= FIRST_OBJECT_ID) & _closer(surface_depth, depth, OBJECT_HIDE_MARGIN)
     nan = np.full(v_image.shape, np.nan)
     return LaneLabel(view, v_image, np.where(inside, x_image, nan), np.where(inside, s_road, nan),

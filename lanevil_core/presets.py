@@ -1,11 +1,12 @@
-"""Named weather presets (CARLA 0.9.16 numbers) that fill a case's weather and sun fields.
+"""Named weather presets (CARLA 0.9.16 numbers) that fill a case's weather and sun fields, and named cameras.
 
 A case always stores the numbers; a preset name is only a way to fill them.
 """
 
 from __future__ import annotations
 
-from typing import Final
+import copy
+from typing import Any, Final
 
 # name: (cloudiness, precipitation, precipitation_deposits, sun_altitude, fog_density, wetness)
 _TABLE: Final[dict[str, tuple[float, float, float, float, float, float]]] = {
@@ -53,3 +54,39 @@ def preset_values(name: str) -> dict[str, dict[str, float]]:
             "intensity": 0.0 if altitude <= 0 else round(1.0 - 0.7 * cloud / 100.0, 3),
         },
     }
+
+
+# Named cameras (numbers only; docs/cameras.md gives where each comes from). A case's ``"camera": {"preset": ...}``
+# fills these fields; fields given beside the preset win.
+CAMERA_PRESETS: Final[dict[str, dict[str, Any]]] = {
+    # The paper's CARLA capture camera (1280x720, 90 deg, 1 m ahead and 3 m up, level) through CARLA's RGB camera
+    # post-processing: histogram auto-exposure, filmic tone curve, motion blur over a 1/200 s shutter.
+    "carla": {"width": 1280, "height": 720, "fov": 90.0, "x": 1.0, "y": 0.0, "z": 3.0, "pitch": 0.0,
+              "sensor": {"shutter": 0.005, "vignetting": 0.25, "noise": 0.6}},
+    # A highway front camera behind the windscreen as in TuSimple's 1280x720 frames: the vanishing point near row
+    # 290, about 62 deg across, a little barrel distortion, no bonnet in view.
+    "tusimple": {"width": 1280, "height": 720, "fov": 62.0, "x": 1.6, "y": 0.0, "z": 1.55, "pitch": 3.5,
+                 "lens": {"k1": -0.06, "k2": 0.01},
+                 "sensor": {"shutter": 0.004, "vignetting": 0.3, "noise": 1.0, "saturation": 1.35}},
+    # CULane's 1640x590 frames: a wide, short image with the horizon near row 260 and the bonnet at the bottom.
+    "culane": {"width": 1640, "height": 590, "fov": 76.0, "x": 1.2, "y": 0.0, "z": 1.45, "pitch": 1.5,
+               "lens": {"k1": -0.08, "k2": 0.015},
+               "bonnet": {"reach": 2.2, "drop": 0.5},
+               "sensor": {"shutter": 0.008, "vignetting": 0.35, "noise": 1.6, "saturation": 1.3}},
+    # A typical consumer dash cam (1280x720, ~58 deg across, the horizon at rows 407-440, the bonnet from row
+    # ~672, a barrel lens, strong sharpening and compression-era noise).
+    "dashcam": {"width": 1280, "height": 720, "fov": 58.0, "x": 0.6, "y": 0.0, "z": 1.35, "pitch": -3.0,
+                "lens": {"k1": -0.12, "k2": 0.03},
+                "bonnet": {"reach": 2.3, "drop": 0.5},
+                "sensor": {"shutter": 0.008, "vignetting": 0.45, "noise": 1.5, "sharpen": 0.9,
+                           "saturation": 1.4}},
+}
+
+CAMERA_PRESET_NAMES: Final[tuple[str, ...]] = tuple(CAMERA_PRESETS)
+
+
+def camera_preset_values(name: str) -> dict[str, Any]:
+    """The camera fields a preset sets (a fresh copy). Raises KeyError naming the valid presets."""
+    if name not in CAMERA_PRESETS:
+        raise KeyError(f"unknown camera preset {name!r}; choose one of {', '.join(CAMERA_PRESET_NAMES)}")
+    return copy.deepcopy(CAMERA_PRESETS[name])

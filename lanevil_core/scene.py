@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 ID_SKY = 0
 ID_ROAD = 1  # carriageway asphalt (any road piece)
 ID_ROADSIDE = 2  # shoulders, kerbs, sidewalks, terrain
+ID_EGO = 3  # the ego's own bonnet in view
 FIRST_OBJECT_ID = 16
 
 
@@ -131,6 +132,7 @@ class Environment:
     exposure: float
     night: bool
     headlights: float = 0.0  # intensity of the ego's two headlights (0 = off)
+    detail: float = 0.0  # surface texture a photograph shows (0 = the ideal render's smooth surfaces)
 
 
 @dataclass

@@ -141,3 +141,23 @@ def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int, threads: int =
     """Box-blur a mirror image along columns in place (wet roads smear reflections vertically); the bands of
     ``threads`` split the columns."""
     run_bands(lambda band, bands: _blur_column_band(img, depth, radius, band, bands), threads)
+
+
+@kernel
+def _blend_edge_rows(hdr: np.ndarray, ids: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
+    height, width, _ = hdr.shape
+    on_edge = np.empty(width, np.bool_)
+    for row in band_rows(height, band, bands):
+        _edges(ids, row, on_edge)
+        for col in range(width):
+            for c in range(3):
+                out[row, col, c] = _edge_blend(hdr, row, col, c) if on_edge[col] else hdr[row, col, c]
+
+
+def blend_edges(hdr: np.ndarray, ids: np.ndarray, threads: int = 1) -> np.ndarray:
+    """(H, W, 3) float32 radiance with the pixels on an object-id boundary blended with their 4-neighbourhood, as
+    ``finish`` does before its tone curve (for the camera pipeline, which develops the radiance itself)."""
+    hdr = np.ascontiguousarray(hdr)
+    out = np.empty_like(hdr)
+    run_bands(lambda band, bands: _blend_edge_rows(hdr, ids, out, band, bands), threads)
+    return out

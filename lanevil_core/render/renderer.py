@@ -3,19 +3,25 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 
+import cv2
 import numpy as np
 
 from ..camera import PinholeCamera
+from ..camera.bonnet import bonnet_mask, paint_bonnet
+from ..camera.cover import cover_camera, cover_maps
+from ..camera.sensor import development
 from ..paint import MATERIAL_ALBEDO
-from ..scene import ID_SKY, CompiledScene, Environment
+from ..scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
 from .bands import run_bands
+from .develop import develop, motion_blur
 from .lighting import face_sun_terms
 from .packed import PackedScene, pack_scene
-from .post import SRGB_LUT, blur_columns, finish
+from .post import SRGB_LUT, blend_edges, blur_columns, finish
 from .raster import per_pixel, rasterize_perspective
 from .shading import (
     Geometry,
@@ -58,7 +64,7 @@ class Frame:
 
 def _env_vector(env: Environment) -> np.ndarray:
     return np.array([env.sun_intensity, env.ambient, env.wetness, env.puddles, env.fog_density, env.fog_distance,
-                     env.cloudiness, env.penumbra], np.float64)
+                     env.cloudiness, env.penumbra, env.detail], np.float64)
 
 
 def _no_shadows() -> ShadowMaps:
@@ -167,15 +173,19 @@ def _cascade_cache(scene: CompiledScene) -> CascadeCache:
 
 
 def render_frame(scene: CompiledScene, frame: int, size: tuple[int, int] | None = None, threads: int = 1) -> Frame:
-    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same FOV).
+    """Render frame ``frame`` of ``scene`` from the ego camera, optionally at another size (same lens).
 
     ``threads`` row bands of every stage run in parallel; the bytes are those of one thread.
     """
-    return render_view(scene, scene.ego.camera(frame, size), threads)
+    return render_view(scene, scene.ego.camera(frame, size), threads, frame)
 
 
-def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -> Frame:
-    """Render ``scene`` from any camera (e.g. ``camera.pose_camera`` of a vehicle driven in closed loop)."""
+def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1, frame: int = 0) -> Frame:
+    """Render ``scene`` from any camera (e.g. ``camera.pose_camera`` of a vehicle driven in closed loop).
+
+    Without a sensor, lens or bonnet in the case's camera the frame is the ideal render (Reinhard curve, no
+    noise); otherwise ``_photograph`` takes it through the camera. ``frame`` seeds the sensor noise.
+    """
     timings: dict[str, float] = {}
     clock = time.perf_counter()
 
@@ -185,6 +195,20 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
         timings[name] = (now - clock) * 1e3
         clock = now
 
+    mount = scene.ego.mount
+    if mount.sensor is not None or mount.bonnet is not None or not camera.pinhole:
+        return _photograph(scene, camera, threads, frame, lap, timings)
+    hdr, depth, object_id = _radiance(scene, camera, threads, lap)
+    k = camera.intrinsics
+    rgb = np.empty((k.height, k.width, 3), np.uint8)
+    finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
+    lap("post")
+    return Frame(rgb, depth, object_id, camera, timings)
+
+
+def _radiance(scene: CompiledScene, camera: PinholeCamera, threads: int,
+              lap: Callable[[str], None]) -> tuple[Float32Array, Float32Array, IntArray]:
+    """Linear radiance (H, W, 3) float32, depth (H, W) float32 and object ids (H, W) int32 of a pinhole camera."""
     packed = pack_scene(scene)
     k = camera.intrinsics
     env = scene.env
@@ -213,7 +237,54 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1) -
                                         sun_shadow, reflection, hdr, band, bands), threads)
     lap("shade")
     object_id = per_pixel(frags.face, packed.face_object, ID_SKY, threads)
+    return hdr, frags.depth, object_id
+
+
+def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame: int,
+                lap: Callable[[str], None], timings: dict[str, float]) -> Frame:
+    """The frame a real camera takes: pinhole radiance (through the lens's cover camera when it distorts), motion
+    blur over the shutter, the lens's resampling, the bonnet, then the sensor (or the ideal curve without one)."""
+    mount = scene.ego.mount
+    sensor = mount.sensor
+    k = camera.intrinsics
+    render_camera = camera if camera.pinhole else cover_camera(camera)
+    hdr, depth, object_id = _radiance(scene, render_camera, threads, lap)
+    travel = scene.ego.speed * sensor.shutter if sensor is not None else 0.0
+    if travel > 0.0:
+        rk = render_camera.intrinsics
+        hdr = motion_blur(hdr, depth, (rk.cx, rk.cy), travel, threads)
+    if not camera.pinhole:
+        map_u, map_v = cover_maps(camera)
+        hdr = np.asarray(cv2.remap(hdr, map_u, map_v, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE), np.float32)
+        cols = np.clip(np.rint(map_u), 0, depth.shape[1] - 1).astype(np.intp)
+        rows = np.clip(np.rint(map_v), 0, depth.shape[0] - 1).astype(np.intp)
+        depth, object_id = depth[rows, cols], object_id[rows, cols]
+    else:
+        depth, object_id = depth.copy(), object_id.copy()
+    lap("lens")
+    if mount.bonnet is not None:
+        env = scene.env
+        mask = bonnet_mask(camera, mount, mount.bonnet)
+        sky = env.ambient * 0.5 * (env.sky_zenith.astype(np.float64) + env.sky_horizon.astype(np.float64))
+        sun = env.sun_intensity * max(float(env.sun_dir_world[2]), 0.0)
+        paint_bonnet(hdr, mask, mount.bonnet, sky, sun)
+        object_id[mask] = ID_EGO
+        depth[mask] = mount.bonnet.reach
     rgb = np.empty((k.height, k.width, 3), np.uint8)
-    finish(hdr, object_id, env.exposure, SRGB_LUT, rgb, threads)
+    if sensor is None:
+        finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
+    else:
+        hdr = blend_edges(hdr, object_id, threads)
+        dev = development(hdr, sensor)
+        develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
+                sensor.saturation, _noise_seed(scene.case.seed, frame), dev.lut, rgb, threads)
+        if sensor.sharpen > 0.0:
+            soft = cv2.GaussianBlur(rgb, (0, 0), 1.0)
+            rgb = np.asarray(cv2.addWeighted(rgb, 1.0 + sensor.sharpen, soft, -sensor.sharpen, 0.0), np.uint8)
     lap("post")
-    return Frame(rgb, frags.depth, object_id, camera, timings)
+    return Frame(rgb, depth, object_id, camera, timings)
+
+
+def _noise_seed(case_seed: int, frame: int) -> int:
+    """The sensor noise stream of one frame of one case."""
+    return int(np.random.SeedSequence([case_seed, frame, 0x5E45]).generate_state(1, np.uint64)[0])

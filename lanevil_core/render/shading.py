@@ -39,7 +39,7 @@ from .surface import paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
-SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA = range(8)
+SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA, DETAIL = range(9)
 ASPHALT = MATERIALS.index("asphalt")
 PAVED = ("asphalt", "concrete", "kerb")  # hold a water film; grass, gravel and dirt soak it up
 # surface_table columns; its rows are the road MATERIALS, then one for every object
@@ -51,6 +51,10 @@ MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 STANDING_WATER_ROUGHNESS = 0.03
+OBJECT_FINE_M = 0.06  # texel of the fine texture on objects (m)
+OBJECT_COARSE_M = 0.5  # texel of the coarse stains on objects (m)
+OBJECT_GRAIN = 0.35
+OBJECT_BLOTCH = 0.3
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
@@ -232,10 +236,23 @@ def road_coordinates(faces: np.ndarray, vertex_st: np.ndarray, bary: np.ndarray,
 
 
 @kernel(inline="always")
-def albedo(surface: np.ndarray, material: int, grain: float, blotch: float) -> tuple[float, float, float]:
-    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1])."""
-    tone = (1.0 + 0.35 * grain) * (1.0 + 0.18 * blotch)
+def albedo(surface: np.ndarray, material: int, grain: float, blotch: float,
+           detail: float) -> tuple[float, float, float]:
+    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1]); ``detail``
+    (0 = the ideal render) deepens both as a photograph shows them."""
+    tone = (1.0 + 0.35 * (1.0 + detail) * grain) * (1.0 + 0.18 * (1.0 + 1.5 * detail) * blotch)
     return surface[material, ALBEDO_R] * tone, surface[material, ALBEDO_G] * tone, surface[material, ALBEDO_B] * tone
+
+
+@kernel(inline="always")
+def object_plane(px: float, py: float, pz: float, nx: float, ny: float, nz: float) -> tuple[float, float]:
+    """Two world coordinates (m) across an object's face: the pair the face's normal is least aligned with."""
+    ax, ay, az = abs(nx), abs(ny), abs(nz)
+    if az >= ax and az >= ay:
+        return px, py
+    if ax >= ay:
+        return py, pz
+    return px, pz
 
 
 @kernel(inline="always")
@@ -369,6 +386,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     refl_rgb, refl_depth = reflection
     wetness, puddles, sun_i, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[SUN_I], env_f[CLOUD], \
         env_f[PENUMBRA]
+    detail = env_f[DETAIL]
     last = stripe_index.shape[1] - 1
     width = face.shape[1]
     span = -1  # the sky samples below are those of columns span * SKY_STEP and (span + 1) * SKY_STEP
@@ -420,7 +438,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             footprint = max(fs, ft)
             s, t = road_coordinates(faces, vertex_st, bary, row, col, f)
             r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint),
-                             sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint))
+                             sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint), detail)
             if material == ASPHALT:  # only asphalt carries paint and surface layers
                 piece = vertex_piece[faces[f, 0]]
                 r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
@@ -438,6 +456,12 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             up *= sky_openness(overhead, overhead_params, px, py)  # ground under a roof sees less sky
         else:
             r, g, b = color[f, 0], color[f, 1], color[f, 2]
+            if detail > 0.0:  # weathering, grime and texture on objects, in world space on the face's plane
+                u, v = object_plane(px, py, pz, nx, ny, nz)
+                foot = dist / fx
+                tone = 1.0 + detail * (OBJECT_GRAIN * sample_noise(fine, OBJECT_FINE_M, u, v, foot)
+                                       + OBJECT_BLOTCH * sample_noise(coarse, OBJECT_COARSE_M, u, v, foot))
+                r, g, b = r * tone, g * tone, b * tone
         gloss = face_gloss[f]  # 0 on the road
         surface_wet = max(wetness * surface[kind, HOLDS_WATER], wet)  # 0 on objects
         r, g, b, roughness = wet_surface(r, g, b, surface[kind, ROUGHNESS], surface_wet, wet)

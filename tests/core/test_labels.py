@@ -283,3 +283,36 @@ def test_labels_do_not_move_when_illusions_are_added(make_case, clean_record, na
     record = L.tusimple_record(scene, 5, render_frame(scene, 5), "a.png")
     assert record["lanes"] == clean_record["lanes"]
     assert record["line_types"] == clean_record["line_types"]
+
+
+@pytest.mark.parametrize("camera", [
+    {"fov": 70.0, "z": 1.5, "pitch": -2.0, "lens": {"k1": -0.15, "k2": 0.04, "p1": 0.002}},
+    {"fov": 58.0, "z": 1.35, "pitch": -3.0, "roll": 1.5, "lens": {"k1": -0.12, "k2": 0.03},
+     "bonnet": {"reach": 2.3, "drop": 0.5}},
+])
+def test_labels_sit_on_the_paint_through_a_distorting_lens_and_a_bonnet(make_case, camera):
+    case = make_case(camera={"width": 320, "height": 180, **camera}, ego={"start_s": 20.0})
+    for frame_index in (0, 40):
+        errors = _paint_errors(case, frame_index)
+        assert len(errors) > 40
+        assert errors.max() < 2.0 and errors.mean() < 0.6, (errors.max(), errors.mean())
+
+
+def test_labels_stop_at_the_bonnet(make_case):
+    from lanevil_core.render import render_frame
+    from lanevil_core.scene import ID_EGO
+
+    case = make_case(camera={"preset": "dashcam", "width": 640, "height": 360, "sensor": None})
+    scene = compile_scene(case)
+    frame = render_frame(scene, 10)
+    assert (frame.object_id == ID_EGO).mean() > 0.01  # the bonnet is in view
+    rows = np.arange(180, 360, 2) + 0.5
+    labels = L.lane_labels(scene, frame.camera, rows, frame)
+    assert labels
+    hidden_rows = 0
+    for label in labels:
+        for j in np.flatnonzero(label.valid):
+            assert frame.object_id[int(rows[j]), int(label.x_image[j])] != ID_EGO
+        ideal = L.label_boundary(label.boundary, rows, (640, 360))  # without the frame: no bonnet test
+        hidden_rows += int((ideal.valid & ~label.valid).sum())
+    assert hidden_rows > 0  # some rows of the lines run under the bonnet and are dropped

@@ -1,4 +1,4 @@
-"""Pinhole camera: intrinsics, the ego camera pose of a frame, and projection.
+"""The ego camera: intrinsics, lens distortion, the camera pose of a frame, and projection.
 
 Camera frame is OpenCV's: +X right, +Y down, +Z forward. Image coordinates are continuous with the origin at
 the top-left corner of the top-left pixel; pixel (col, row) covers [col, col+1) x [row, row+1), so its centre
@@ -11,10 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .case import Camera, Case
-from .road_geometry import ReferenceLine
-from .road_layout import RoadNetwork
-from .typed import FloatArray
+from ..case import Camera, Case
+from ..road_geometry import ReferenceLine
+from ..road_layout import RoadNetwork
+from ..typed import FloatArray
+from .lens import NO_DISTORTION, Distortion, distort, is_pinhole
 
 
 @dataclass(frozen=True)
@@ -35,6 +36,11 @@ class Intrinsics:
         fx = round(0.5 * width / float(np.tan(np.radians(fov_deg) / 2)), 9)
         return cls(width, height, fx, fx, width / 2.0, height / 2.0)
 
+    def scaled(self, width: int, height: int) -> Intrinsics:
+        """The same lens on an image of another size (focal length and principal point scaled per axis)."""
+        sx, sy = width / self.width, height / self.height
+        return Intrinsics(width, height, self.fx * sx, self.fy * sy, self.cx * sx, self.cy * sy)
+
     @property
     def K(self) -> FloatArray:
         """(3, 3) float64 camera matrix."""
@@ -43,11 +49,20 @@ class Intrinsics:
 
 @dataclass(frozen=True)
 class PinholeCamera:
-    """Intrinsics plus pose ``T_world_camera`` (4, 4): maps camera-frame points to the world frame."""
+    """Intrinsics, lens distortion and pose ``T_world_camera`` (4, 4): maps camera-frame points to the world frame.
+
+    ``distortion`` is OpenCV's (k1, k2, p1, p2, k3) on normalised coordinates; all zero (the default) is a pinhole.
+    """
 
     intrinsics: Intrinsics
     T_world_camera: FloatArray
     near: float = 0.1
+    distortion: Distortion = NO_DISTORTION
+
+    @property
+    def pinhole(self) -> bool:
+        """Whether the lens has no distortion."""
+        return is_pinhole(self.distortion)
 
     @property
     def R_world_camera(self) -> FloatArray:
@@ -72,9 +87,10 @@ class PinholeCamera:
         depth = p_camera[..., 2]
         safe = np.where(depth > 1e-9, depth, np.nan)
         k = self.intrinsics
-        u = k.fx * p_camera[..., 0] / safe + k.cx
-        v = k.fy * p_camera[..., 1] / safe + k.cy
-        return np.stack([u, v], axis=-1), depth
+        x_norm, y_norm = p_camera[..., 0] / safe, p_camera[..., 1] / safe
+        if not self.pinhole:
+            x_norm, y_norm = distort(x_norm, y_norm, self.distortion)
+        return np.stack([k.fx * x_norm + k.cx, k.fy * y_norm + k.cy], axis=-1), depth
 
     def ray_directions_camera(self) -> FloatArray:
         """(H, W, 3) float64 camera-frame rays through pixel centres, scaled to z = 1."""
@@ -85,15 +101,27 @@ class PinholeCamera:
         return np.stack([x, y, np.ones_like(x)], axis=-1)
 
     def resized(self, width: int, height: int) -> PinholeCamera:
-        """The same pose and horizontal FOV at another image size."""
-        fov = 2 * np.degrees(np.arctan(0.5 * self.intrinsics.width / self.intrinsics.fx))
-        return PinholeCamera(Intrinsics.from_fov(width, height, fov), self.T_world_camera, self.near)
+        """The same pose and lens at another image size."""
+        k = self.intrinsics
+        if self.pinhole and k.cx == k.width / 2 and k.cy == k.height / 2 and k.fx == k.fy:
+            fov = 2 * np.degrees(np.arctan(0.5 * k.width / k.fx))
+            return PinholeCamera(Intrinsics.from_fov(width, height, fov), self.T_world_camera, self.near)
+        return PinholeCamera(k.scaled(width, height), self.T_world_camera, self.near, self.distortion)
+
+
+def _is_centred_fov(camera: Camera) -> bool:
+    return camera.focal is None and camera.cx is None and camera.cy is None
 
 
 def intrinsics_for(camera: Camera, size: tuple[int, int] | None = None) -> Intrinsics:
-    """Intrinsics of a case camera, optionally at another output size (same horizontal FOV)."""
+    """Intrinsics of a case camera, optionally at another output size (the same lens scaled)."""
     width, height = size if size is not None else (camera.width, camera.height)
-    return Intrinsics.from_fov(width, height, camera.fov)
+    if _is_centred_fov(camera):
+        return Intrinsics.from_fov(width, height, camera.fov)
+    cx = camera.cx if camera.cx is not None else camera.width / 2.0
+    cy = camera.cy if camera.cy is not None else camera.height / 2.0
+    native = Intrinsics(camera.width, camera.height, camera.focal_px, camera.focal_px, cx, cy)
+    return native if (width, height) == (camera.width, camera.height) else native.scaled(width, height)
 
 
 @dataclass(frozen=True)
@@ -177,10 +205,13 @@ def mounted_camera(cam: Camera, T_world_vehicle: FloatArray, size: tuple[int, in
     z_axis = np.cos(pitch) * forward - np.sin(pitch) * up  # optical axis, pitched down for pitch > 0
     y_axis = -(np.cos(pitch) * up + np.sin(pitch) * forward)  # image down
     x_axis = -left  # image right
+    if cam.roll:  # turn the image clockwise: its right axis tips down
+        roll = np.radians(cam.roll)
+        x_axis, y_axis = np.cos(roll) * x_axis + np.sin(roll) * y_axis, np.cos(roll) * y_axis - np.sin(roll) * x_axis
     T_world_camera = np.eye(4)
     T_world_camera[:3, 0], T_world_camera[:3, 1], T_world_camera[:3, 2] = x_axis, y_axis, z_axis
     T_world_camera[:3, 3] = p_world_camera
-    return PinholeCamera(intrinsics_for(cam, size), T_world_camera)
+    return PinholeCamera(intrinsics_for(cam, size), T_world_camera, distortion=cam.lens.coefficients)
 
 
 def ego_camera(case: Case, network: RoadNetwork, frame: int, size: tuple[int, int] | None = None) -> PinholeCamera:

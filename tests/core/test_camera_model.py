@@ -1,0 +1,137 @@
+"""The camera model: presets, intrinsics from focal length and principal point, roll, lens distortion, the
+sensor's determinism and its response to light."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lanevil_core.camera import intrinsics_for, mounted_camera
+from lanevil_core.camera.cover import cover_camera
+from lanevil_core.camera.lens import distort, undistort
+from lanevil_core.camera.sensor import KEY, development, filmic, metered_gain, white_balance_gains
+from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
+from lanevil_core.compile import compile_scene
+from lanevil_core.presets import CAMERA_PRESET_NAMES
+from lanevil_core.render import render_frame
+
+
+@pytest.mark.parametrize("name", CAMERA_PRESET_NAMES)
+def test_every_camera_preset_is_a_valid_camera(name: str) -> None:
+    camera = Camera.model_validate({"preset": name})
+    assert camera.width >= 640 and 45 <= camera.hfov <= 100
+
+
+def test_preset_fields_given_beside_it_win() -> None:
+    camera = Camera.model_validate({"preset": "dashcam", "fov": 70.0, "bonnet": None})
+    assert camera.fov == 70.0 and camera.bonnet is None and camera.lens.k1 == pytest.approx(-0.12)
+
+
+def test_unknown_camera_preset_names_the_field() -> None:
+    with pytest.raises(CaseError, match=r"camera: .*unknown camera preset 'gopro'"):
+        parse_case({"camera": {"preset": "gopro"}})
+
+
+def test_default_camera_keeps_the_papers_intrinsics() -> None:
+    k = intrinsics_for(Camera())
+    assert (k.fx, k.fy, k.cx, k.cy) == (640.0, 640.0, 640.0, 360.0)
+
+
+def test_focal_length_and_principal_point_win_over_fov_and_scale_with_size() -> None:
+    camera = Camera(focal=1000.0, cx=600.0, cy=400.0)
+    k = intrinsics_for(camera)
+    assert (k.fx, k.fy, k.cx, k.cy) == (1000.0, 1000.0, 600.0, 400.0)
+    half = intrinsics_for(camera, (640, 360))
+    assert (half.fx, half.cx, half.cy) == (500.0, 300.0, 200.0)
+
+
+def test_pitch_up_moves_the_horizon_down_and_roll_tilts_it() -> None:
+    far_ahead_world = np.array([[1000.0, -5.0, 0.0], [1000.0, 5.0, 0.0]])
+    level = mounted_camera(Camera(z=1.4, x=0.0), np.eye(4))
+    up = mounted_camera(Camera(z=1.4, x=0.0, pitch=-3.0), np.eye(4))
+    rolled = mounted_camera(Camera(z=1.4, x=0.0, roll=2.0), np.eye(4))
+    v_level = level.project(far_ahead_world)[0][:, 1]
+    v_up = up.project(far_ahead_world)[0][:, 1]
+    assert np.all(v_up > v_level + 25)  # 640 * tan(3 deg) = 33.5 px
+    uv_rolled = rolled.project(far_ahead_world)[0]
+    assert abs(uv_rolled[0, 1] - uv_rolled[1, 1]) > 0.1  # the horizon is no longer level
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(-0.8, 0.8), y=st.floats(-0.45, 0.45), k1=st.floats(-0.2, 0.05), k2=st.floats(-0.02, 0.05),
+       p1=st.floats(-0.005, 0.005), p2=st.floats(-0.005, 0.005))
+def test_undistort_inverts_distort(x: float, y: float, k1: float, k2: float, p1: float, p2: float) -> None:
+    coefficients = (k1, k2, p1, p2, 0.0)
+    x_d, y_d = distort(np.array(x), np.array(y), coefficients)
+    x_u, y_u = undistort(x_d, y_d, coefficients)
+    assert abs(float(x_u) - x) < 1e-6 and abs(float(y_u) - y) < 1e-6
+
+
+def test_cover_camera_sees_every_ray_of_a_barrel_lens() -> None:
+    camera = mounted_camera(Camera(fov=70.0, lens={"k1": -0.2, "k2": 0.05}), np.eye(4))
+    cover = cover_camera(camera)
+    assert cover.intrinsics.width > camera.intrinsics.width and cover.intrinsics.fx == camera.intrinsics.fx
+    corners_world = camera.p_world_camera + np.array([[-1.0, 0.0, 0.0]])  # any point: both see the same pose
+    assert np.allclose(cover.T_world_camera, camera.T_world_camera) and corners_world.shape == (1, 3)
+
+
+def test_metering_brings_the_frame_to_middle_grey_within_limits() -> None:
+    flat = np.full((64, 64, 3), 0.05, np.float32)
+    assert metered_gain(flat, Sensor()) == pytest.approx(KEY / 0.05, rel=1e-3)
+    assert metered_gain(flat * 1e-4, Sensor()) == Sensor().max_gain  # night: the gain limit holds
+    assert metered_gain(flat, Sensor(exposure="fixed", gain=2.5)) == 2.5
+    dark = development(flat * 0.01, Sensor())
+    bright = development(flat, Sensor())
+    assert dark.iso_gain > bright.iso_gain and dark.shot > bright.shot  # noise rises with gain in low light
+
+
+def test_filmic_curve_is_monotone_from_black_to_white_and_white_balance_is_neutral_at_daylight() -> None:
+    x = np.linspace(0, 1, 1001)
+    y = filmic(x, 1.15)
+    assert y[0] == 0.0 and y[-1] == pytest.approx(1.0) and np.all(np.diff(y) >= 0)
+    assert 0.12 < float(filmic(np.array(KEY), 1.15)) < 0.3
+    assert np.allclose(white_balance_gains(Sensor(white_balance=5600.0)), 1.0)
+    warm = white_balance_gains(Sensor(white_balance=4000.0))  # balanced for tungsten: daylight turns blue
+    assert warm[2] > 1.0 > warm[0]
+
+
+def _photo_case(make_case: Callable[..., Case], **camera: object) -> Case:
+    return make_case(camera={"preset": "dashcam", "width": 320, "height": 180, **camera})
+
+
+def test_sensor_frames_are_deterministic_per_seed_and_frame(make_case: Callable[..., Case]) -> None:
+    case = _photo_case(make_case)
+    a = render_frame(compile_scene(case), 5)
+    b = render_frame(compile_scene(case), 5)
+    assert np.array_equal(a.rgb, b.rgb) and np.array_equal(a.object_id, b.object_id)
+    other_frame = render_frame(compile_scene(case), 6)
+    other_seed = render_frame(compile_scene(case.model_copy(update={"seed": case.seed + 1})), 5)
+    assert not np.array_equal(a.rgb, other_frame.rgb) and not np.array_equal(a.rgb, other_seed.rgb)
+    threads = render_frame(compile_scene(case), 5, threads=2)
+    assert np.array_equal(a.rgb, threads.rgb)
+
+
+def test_sensor_noise_is_there_and_scales(make_case: Callable[..., Case]) -> None:
+    quiet = render_frame(compile_scene(_photo_case(make_case, sensor={"noise": 0.0, "shutter": 0.0})), 5).rgb
+    noisy = render_frame(compile_scene(_photo_case(make_case, sensor={"noise": 3.0, "shutter": 0.0})), 5).rgb
+    diff = noisy.astype(np.int16) - quiet.astype(np.int16)
+    assert 0.5 < float(diff.std()) < 30.0
+
+
+def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: Callable[..., Case]) -> None:
+    """A metered camera shows sun-lit asphalt bright and its shadow dark: the ratio of the two is lower than the
+    ideal render's, as on a photograph."""
+    from lanevil_core.scene import ID_ROAD
+
+    ratios = []
+    for sensor in (None, {"noise": 0.0, "shutter": 0.0, "vignetting": 0.0, "sharpen": 0.0}):
+        case = make_case(illusions=[{"type": "fence_shadow", "severity": 5}],
+                         camera={"width": 320, "height": 180, "sensor": sensor})
+        frame = render_frame(compile_scene(case), 5)
+        grey = frame.rgb.mean(axis=-1)[frame.object_id == ID_ROAD]
+        ratios.append(np.percentile(grey, 10) / np.percentile(grey, 90))
+    assert ratios[1] < ratios[0]
