@@ -11,9 +11,9 @@ from .base import Command, UsageError, count, output_file
 
 
 def _realism_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--real", type=Path, default=None,
+    parser.add_argument("--real", type=Path, default=None, metavar="DIR",
                         help="folder of real frames (png/jpg/jpeg, searched recursively)")
-    parser.add_argument("--ours", type=Path, default=None,
+    parser.add_argument("--ours", type=Path, default=None, metavar="DIR",
                         help="folder of rendered frames (e.g. a lanevil dataset or export folder)")
     parser.add_argument("--limit", type=count(1), default=None, metavar="N",
                         help="analyse the first N images of each folder in sorted path order (default: all)")
