@@ -12,7 +12,7 @@ from ..metrics.formats import LaneFileError
 from ..metrics.tusimple import F1_VARIANTS
 from .base import Command, UsageError
 
-METRIC_CHOICES = ("tusimple", "culane")
+METRIC_CHOICES = ("tusimple", "culane", "ego")
 
 
 def _eval_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,7 +20,9 @@ def _eval_arguments(parser: argparse.ArgumentParser) -> None:
                         help="ground truth: TuSimple JSON lines (or a split folder with its *_label.json), "
                              "or a folder of CULane .lines.txt files")
     parser.add_argument("--pred", type=Path, required=True, help="predictions in the same format as --gt")
-    parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple", help="default tusimple")
+    parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple",
+                        help="default tusimple; ego: share of the ego lane's two lines matched (>= 85 %% of their "
+                             "labelled rows within 20 px) and their mean point accuracy")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet",
                         help="TuSimple F1 variant: ganet (P = 1-FP, R = 1-FN) or clrnet (default ganet)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -30,6 +32,9 @@ def _format_eval(result: dict) -> str:
     if result["metric"] == "tusimple":
         return (f"TuSimple  images {result['images']}  Accuracy {100 * result['accuracy']:.2f} %  "
                 f"FP {result['fp']:.4f}  FN {result['fn']:.4f}  F1({result['f1_variant']}) {100 * result['f1']:.2f} %")
+    if result["metric"] == "ego":
+        return (f"Ego lines  images {result['images']}  lines {result['ego_lines']}  matched {result['matched']} "
+                f"({100 * result['match_share']:.2f} %)  point accuracy {100 * result['point_accuracy']:.2f} %")
     return (f"CULane IoU>{result['iou_threshold']}  images {result['images']}  TP {result['tp']}  FP {result['fp']}  "
             f"FN {result['fn']}  P {100 * result['precision']:.2f} %  R {100 * result['recall']:.2f} %  "
             f"F1 {100 * result['f1']:.2f} %")
@@ -128,7 +133,7 @@ def _run_report(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Command] = {
-    "eval": Command("score predictions with the TuSimple or CULane metric", _eval_arguments, _run_eval),
+    "eval": Command("score predictions with the TuSimple, CULane or ego line metric", _eval_arguments, _run_eval),
     "detect": Command("run a lane detector (learned or classical) over a split folder", _detect_arguments, _run_detect),
     "report": Command("robustness tables and plot: original vs perturbed per category, type and severity, "
                       "for one detector or several side by side",

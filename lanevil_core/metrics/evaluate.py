@@ -1,4 +1,4 @@
-"""Score a prediction file (or folder) against ground truth with the TuSimple or the CULane metric.
+"""Score a prediction file (or folder) against ground truth with the TuSimple, the CULane or the ego line metric.
 
 Inputs are recognised by what they are: a file is TuSimple JSON lines, a folder is a tree of CULane
 ``.lines.txt`` files. Both sides must have the same format (their pixel frames differ).
@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ..labels import CULANE_SIZE, IMAGE_SIZE_FIELD, TUSIMPLE_SIZE, on_tusimple_grid
-from . import culane, tusimple
+from . import culane, ego, tusimple
 from .formats import (
     CULANE_SUFFIX,
     LaneFileError,
@@ -25,8 +25,8 @@ from .formats import (
     tusimple_points,
 )
 
-Metric = Literal["tusimple", "culane"]
-METRICS: tuple[Metric, ...] = ("tusimple", "culane")
+Metric = Literal["tusimple", "culane", "ego"]
+METRICS: tuple[Metric, ...] = ("tusimple", "culane", "ego")
 
 
 @dataclass(frozen=True)
@@ -69,6 +69,20 @@ def _on_grid(record: LaneRecord, gt: LaneRecord | None = None) -> LaneRecord:
                    h_samples=rows if record is gt else record.h_samples)
 
 
+def _grid_width(gt: LaneRecord) -> float:
+    """Width of the pixel frame ``_on_grid`` leaves ``gt`` in: 1280 unless it names a non-16:9 ``image_size``."""
+    size = gt.extra.get(IMAGE_SIZE_FIELD)
+    return float(size[0]) if size and not _tusimple_shaped(size) else float(TUSIMPLE_SIZE[0])
+
+
+def score_ego_files(gt_path: Path, pred_path: Path) -> ego.EgoSummary:
+    """The ego line match over a TuSimple GT and prediction file (no ``run_time`` needed), on the 1280x720 grid
+    like ``score_tusimple_files``."""
+    pairs = pair_records(read_tusimple(gt_path, "gt"), read_tusimple(pred_path, "pred"), str(gt_path),
+                         str(pred_path), require_run_time=False)
+    return ego.summarize_ego(ego.ego_line_match(_on_grid(g), _on_grid(p, g), _grid_width(g)) for g, p in pairs)
+
+
 def _interpolated(lanes: list[Points], where: str) -> list[Points]:
     for lane in lanes:
         try:
@@ -107,7 +121,8 @@ def _culane_pairs_from_folders(gt_root: Path, pred_root: Path) -> list[tuple[lis
 
 def evaluate(gt_path: str | Path, pred_path: str | Path, metric: Metric = "tusimple",
              f1_variant: str = "ganet") -> dict[str, Any]:
-    """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``).
+    """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``; ``ego`` is
+    ``metrics.ego``'s ego line match).
 
     ``gt_path`` may also be a split folder (its ``*_label.json`` is read) when ``pred_path`` is a file.
     """
@@ -124,6 +139,10 @@ def evaluate(gt_path: str | Path, pred_path: str | Path, metric: Metric = "tusim
             raise LaneFileError(f"{gt_path}: the TuSimple metric reads TuSimple JSON-lines files, not folders")
         scores = [image.score for image in score_tusimple_files(gt_path, pred_path)]
         return {"metric": "tusimple", **tusimple.summarize(scores, f1_variant).as_dict()}
+    if metric == "ego":
+        if gt_path.is_dir():
+            raise LaneFileError(f"{gt_path}: the ego line metric reads TuSimple JSON-lines files, not folders")
+        return {"metric": "ego", **score_ego_files(gt_path, pred_path).as_dict()}
     if gt_path.is_dir():
         pairs, size = _culane_pairs_from_folders(gt_path, pred_path), CULANE_SIZE
     else:
