@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # the case model imports the illusions, which use sun_directi
 
 
 NIGHT_EXPOSURE = 2.2
-PHOTO_DETAIL = 1.0  # surface texture of a case seen through a real camera's sensor (0 in the ideal render)
+PHOTO_DETAIL = 1.5  # surface texture of a case seen through a real camera's sensor (0 in the ideal render)
 HEADLIGHT_INTENSITY = 35.0  # radiance scale at 1 m of each of the ego's two headlights (on at night)
 
 

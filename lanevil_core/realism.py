@@ -9,7 +9,7 @@ noise and edges, so compare footage of at least 1280 px width where you can). Gr
 | statistic | method | unit |
 |---|---|---|
 | saturation | mean of OpenCV's HSV S channel (uint8 image) | 0..255 |
-| edge_density | share of Canny edge pixels (thresholds 100/200) on the grey image after a 3x3 Gaussian blur | 0..1 |
+| edge_density | share of Canny edge pixels (thresholds 100/200) on the grey image | 0..1 |
 | contrast | RMS contrast: standard deviation of grey / 255 | 0..0.5 |
 | noise | sensor noise sigma, Immerkær's fast estimate over the flattest 90 % of pixels | grey levels |
 | spectrum_slope | slope of log power vs log frequency (radial mean, Hann window, 0.02..0.2 cycles/px) | ≈ -2 natural |
@@ -34,7 +34,6 @@ ANALYSIS_WIDTH = 1280
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 CANNY_LOW, CANNY_HIGH = 100, 200
-EDGE_BLUR = (3, 3)  # removes pixel noise so that the edges counted are structure, not grain
 NOISE_FLAT_SHARE = 0.9  # Immerkær's estimate over the pixels whose Sobel gradient is below this quantile
 SPECTRUM_BAND = (0.02, 0.2)  # cycles/pixel: above the frame's layout, below demosaicing and JPEG blocks
 SPECTRUM_BINS = 24  # log-spaced frequency bins in the band, so the fit weighs every octave alike
@@ -96,9 +95,9 @@ def colour_saturation(rgb: UInt8Array) -> float:
 
 
 def edge_density(grey: UInt8Array) -> float:
-    """Share of pixels of (H, W) uint8 grey that Canny (100/200, after a 3x3 Gaussian) marks as edges."""
-    blurred = cv2.GaussianBlur(grey, EDGE_BLUR, 0)
-    return float(np.count_nonzero(cv2.Canny(blurred, CANNY_LOW, CANNY_HIGH))) / grey.size
+    """Share of pixels of (H, W) uint8 grey that Canny (100/200) marks as edges (no blur first: the figures of
+    real footage we compare with are taken so)."""
+    return float(np.count_nonzero(cv2.Canny(grey, CANNY_LOW, CANNY_HIGH))) / grey.size
 
 
 def rms_contrast(grey: UInt8Array) -> float:

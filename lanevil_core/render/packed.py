@@ -47,6 +47,7 @@ class PackedScene:
     face_color: Float32Array  # (m, 3)
     face_emission: Float32Array  # (m, 3)
     face_gloss: Float32Array  # (m,)
+    face_texture: Float32Array  # (m,) strength of the photographic surface texture (``TEXTURE_BY_KIND``)
     face_normal: Float32Array  # (m, 3) world, unit
     face_grad_st: Float32Array  # (m, 6) world gradients of s and of t on each road face (0 for objects)
     camera_faces: IntArray  # faces drawn in the camera
@@ -200,6 +201,16 @@ def _casters_digest(packed: PackedScene) -> str:
     return hashlib.blake2b(np.ascontiguousarray(corners).tobytes(), digest_size=16).hexdigest()
 
 
+# How strongly the photographic surface texture (weathering, grime, leaf clumps, tufts) marks each kind of mesh
+# and each road material when the case's camera has a sensor (``Environment.detail``); 0 = flat colour.
+TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.55, "tunnel": 0.6,
+                                     "bridge": 0.5, "barrier": 0.3, "guard_rail": 0.2, "fence": 0.2, "pole": 0.3,
+                                     "streetlight": 0.15, "vehicle": 0.08, "pedestrian": 0.15, "bicycle": 0.1}
+DEFAULT_TEXTURE = 0.3
+# Per road material (index = typed.MATERIALS): asphalt, concrete, grass, gravel, kerb, dirt.
+MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8], np.float32)
+
+
 def pack_scene(scene: CompiledScene) -> PackedScene:
     """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
     cached = scene.cache.get("packed")
@@ -212,6 +223,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
     color = [MATERIAL_ALBEDO[road.material]]
     emission = [np.zeros((len(road.faces), 3), np.float32)]
     gloss = [np.zeros(len(road.faces), np.float32)]
+    texture = [MATERIAL_TEXTURE[road.material]]
     shadow, visible, mirror = [np.zeros(len(road.faces), bool)], [np.ones(len(road.faces), bool)], [
         np.zeros(len(road.faces), bool)]
     offset = len(road.vertices)
@@ -226,6 +238,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         color.append(mesh.colors)
         emission.append(mesh.emission if mesh.emission is not None else np.zeros((m, 3), np.float32))
         gloss.append(np.full(m, mesh.gloss, np.float32))
+        texture.append(np.full(m, TEXTURE_BY_KIND.get(mesh.kind, DEFAULT_TEXTURE), np.float32))
         shadow.append(np.full(m, mesh.casts_shadow, bool))
         visible.append(np.full(m, mesh.visible, bool))
         mirror.append(np.full(m, mesh.visible and mesh.kind not in ("building", "terrain"), bool))
@@ -240,6 +253,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         vertex_piece=np.concatenate(piece), face_material=np.concatenate(mat),
         face_object=np.concatenate(obj), face_color=np.concatenate(color).astype(np.float32),
         face_emission=np.concatenate(emission).astype(np.float32), face_gloss=np.concatenate(gloss),
+        face_texture=np.concatenate(texture),
         face_normal=_face_normals(all_v, all_f),
         face_grad_st=_st_gradients(all_v, all_f, np.concatenate(st), len(road.faces)),
         camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),

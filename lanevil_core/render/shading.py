@@ -51,10 +51,11 @@ MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 STANDING_WATER_ROUGHNESS = 0.03
-OBJECT_FINE_M = 0.06  # texel of the fine texture on objects (m)
-OBJECT_COARSE_M = 0.5  # texel of the coarse stains on objects (m)
-OBJECT_GRAIN = 0.35
-OBJECT_BLOTCH = 0.3
+CLUMP_TEXEL_M = 0.1  # photographic texture: texel of the clumps (leaves, tufts, stains; ~4 texels across) (m)
+MID_TEXEL_M = 0.03  # ... and of its grain (m)
+CLUMP_SHARPNESS = 4.0  # the clump noise is scaled and clipped to +-1: sharp-edged patches
+CLUMP_DEPTH = 0.6
+GRAIN_DEPTH = 0.35
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
@@ -82,6 +83,7 @@ class Geometry(NamedTuple):
     face_color: Float32Array
     face_emission: Float32Array
     face_gloss: Float32Array
+    face_texture: Float32Array
 
 
 class RoadLook(NamedTuple):
@@ -245,6 +247,14 @@ def albedo(surface: np.ndarray, material: int, grain: float, blotch: float,
 
 
 @kernel(inline="always")
+def clumps(strength: float, mid: float, fine: float) -> float:
+    """Albedo factor of the photographic texture: sharp-edged clumps (the mid-scale noise pushed towards +-1) and
+    grain, both scaled by ``strength`` (0 = none); never below 0.1."""
+    clump = min(max(CLUMP_SHARPNESS * mid, -1.0), 1.0)
+    return max(1.0 + strength * (CLUMP_DEPTH * clump + GRAIN_DEPTH * fine), 0.1)
+
+
+@kernel(inline="always")
 def object_plane(px: float, py: float, pz: float, nx: float, ny: float, nz: float) -> tuple[float, float]:
     """Two world coordinates (m) across an object's face: the pair the face's normal is least aligned with."""
     ax, ay, az = abs(nx), abs(ny), abs(nz)
@@ -378,7 +388,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     here, not from other helpers, and results are written here: measured, either nested costs 5-10 % of the
     kernel's time."""
     R, c_world, fx, fy, cx, _ = view
-    faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss = geometry
+    faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss, \
+        face_texture = geometry
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
         overhead_params = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
@@ -439,6 +450,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             s, t = road_coordinates(faces, vertex_st, bary, row, col, f)
             r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint),
                              sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint), detail)
+            if detail > 0.0:  # tufts, aggregate patches and stains at the scale a camera resolves
+                tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),
+                              sample_noise(fine, MID_TEXEL_M, s, t + 5.0, footprint))
+                r, g, b = r * tone, g * tone, b * tone
             if material == ASPHALT:  # only asphalt carries paint and surface layers
                 piece = vertex_piece[faces[f, 0]]
                 r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
@@ -456,11 +471,11 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             up *= sky_openness(overhead, overhead_params, px, py)  # ground under a roof sees less sky
         else:
             r, g, b = color[f, 0], color[f, 1], color[f, 2]
-            if detail > 0.0:  # weathering, grime and texture on objects, in world space on the face's plane
+            if detail > 0.0:  # weathering, grime and leaf clumps on objects, in world space on the face's plane
                 u, v = object_plane(px, py, pz, nx, ny, nz)
                 foot = dist / fx
-                tone = 1.0 + detail * (OBJECT_GRAIN * sample_noise(fine, OBJECT_FINE_M, u, v, foot)
-                                       + OBJECT_BLOTCH * sample_noise(coarse, OBJECT_COARSE_M, u, v, foot))
+                tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, u, v, foot),
+                              sample_noise(fine, MID_TEXEL_M, v + 3.0, u, foot))
                 r, g, b = r * tone, g * tone, b * tone
         gloss = face_gloss[f]  # 0 on the road
         surface_wet = max(wetness * surface[kind, HOLDS_WATER], wet)  # 0 on objects
