@@ -35,8 +35,8 @@ SYNC_EXPORT_FRAMES = 10  # more frames than this (~0.2 s each at 1280x720) go to
 ZIP = "application/zip"
 
 
-class JobBody(BaseModel):
-    """A background job's state (``Job.to_dict``) and its URLs; the job's inputs (``case_id`` …) come with it."""
+class JobState(BaseModel):
+    """A background job's state (``Job.to_dict``); the job's inputs (``case_id`` …) come with it."""
 
     model_config = ConfigDict(extra="allow")
 
@@ -49,6 +49,11 @@ class JobBody(BaseModel):
     error: str | None = Field(description="why the job failed, or null")
     created_at: float = Field(description="seconds since the epoch")
     finished_at: float | None = Field(description="seconds since the epoch, or null while it runs")
+
+
+class JobBody(JobState):
+    """A job's state and its URLs."""
+
     links: dict[str, str] = Field(description="self: the job's URL (and download: its zip, for an export)")
 
 
