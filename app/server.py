@@ -20,6 +20,7 @@ import uvicorn
 from .main import create_app
 from .settings import Settings
 from .state import AppState
+from .study.token import TOKEN_FILE, with_organiser_token
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,7 @@ def _http_host(host: str) -> str:
 def serve(settings: Settings) -> int:
     """Run the backend (and the editor, unless ``settings.editor`` is off) until Ctrl+C / SIGTERM."""
     sock = listen(settings.host, settings.port)  # first: a busy port fails at once, before the store is opened
+    settings, new_token = with_organiser_token(settings)
     state = AppState.open(settings)
     app = create_app(settings, state)
     api_port = sock.getsockname()[1]
@@ -97,6 +99,9 @@ def serve(settings: Settings) -> int:
     print(f"  website and API  {urls.api}  (API docs {urls.api}docs, study {urls.api}study)", file=sys.stderr)
     if urls.editor:
         print(f"  editor           {urls.editor}  (also {urls.api}editor)", file=sys.stderr, flush=True)
+    if new_token:
+        print(f"study organiser token: {settings.admin_token} (stored in {settings.data_dir / TOKEN_FILE})",
+              file=sys.stderr, flush=True)
     server = _Server(uvicorn.Config(app, log_level="info", timeout_graceful_shutdown=5))
     try:
         server.run(sockets=[sock])

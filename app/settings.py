@@ -18,7 +18,8 @@ class Settings(BaseSettings):
     editor_port: int = Field(8080, ge=0, le=65535, description="port of the viser editor (0 = any free)")
     data_dir: Path = Field(Path("data"), description="case store, exports, render cache and study database")
     scenes_dir: Path = Field(Path("scenes"), description="stock cases copied into an empty store on first start")
-    admin_token: str | None = Field(None, description="bearer token of the perception-study organiser")
+    admin_token: str | None = Field(None, description="bearer token of the perception-study organiser (unset: `lanevil "
+                                    "serve` generates one into DATA/admin_token and reuses it)")
     max_body_bytes: int = Field(2_000_000, ge=1024, description="largest JSON request body")
     max_upload_bytes: int = Field(20_000_000, ge=1024, description="largest uploaded image")
     max_width: int = Field(1920, description="largest rendered frame width")

@@ -20,9 +20,12 @@ TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<pid>\d+)\.[A-Za-z0-9_]+\.tmp$")
 SKIPPED_FOLDERS = frozenset({".git", ".venv", "node_modules", "__pycache__"})
 
 
-def write_atomic(path: Path, data: bytes) -> None:
+def write_atomic(path: Path, data: bytes, mode: int | None = None, replace: bool = True) -> None:
     """Write bytes to ``path`` via a temporary file in the same folder and an atomic rename.
 
+    ``mode``: the file's permissions (default: 0666 less the umask, as ``open`` gives). ``replace=False`` links the
+    file into place instead, so an existing ``path`` stays as it is and ``FileExistsError`` is raised (of two
+    processes creating the same file, one wins and the other reads what it wrote).
     An ``OSError`` names ``path`` (what the caller asked for), never the temporary file."""
     path = Path(path)
     try:
@@ -37,10 +40,16 @@ def write_atomic(path: Path, data: bytes) -> None:
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the file the usual permissions
-        os.replace(tmp, path)
+        os.chmod(tmp, 0o666 & ~_umask() if mode is None else mode)  # mkstemp creates 0600
+        if replace:
+            os.replace(tmp, path)
+        else:
+            os.link(tmp, path)
+            os.unlink(tmp)
     except BaseException as error:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(error, FileExistsError):
+            raise FileExistsError(error.errno, error.strerror, str(path)) from None
         if isinstance(error, OSError):
             raise OSError(error.errno, error.strerror, str(path)) from None
         raise

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
@@ -23,9 +25,21 @@ def _font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
         return ImageFont.load_default()
 
 
-def contact_sheet(size: tuple[int, int] = (320, 180), frame: int = 0, types: list[str] | None = None) -> UInt8Array:
-    """(H, W, 3) uint8 grid of renders (``size`` per cell) with row and column labels."""
-    names = types if types is not None else list(REGISTRY)
+def sheet_types(types: list[str] | None = None) -> list[str]:
+    """The rows of a sheet: ``types`` or every registered illusion type."""
+    return types if types is not None else list(REGISTRY)
+
+
+def sheet_frames(types: list[str] | None = None) -> int:
+    """How many frames a sheet of ``types`` renders (one per cell)."""
+    return len(sheet_types(types)) * (1 + len(LEVELS))
+
+
+def contact_sheet(size: tuple[int, int] = (320, 180), frame: int = 0, types: list[str] | None = None,
+                  on_frame: Callable[[], None] | None = None) -> UInt8Array:
+    """(H, W, 3) uint8 grid of renders (``size`` per cell) with row and column labels; ``on_frame`` is called
+    after each cell's render (a progress bar)."""
+    names = sheet_types(types)
     width, height = size
     columns = ["original", *[f"level {level}" for level in LEVELS]]
     sheet = Image.new("RGB", (LABEL_W + len(columns) * (width + GAP), HEADER_H + len(names) * (height + GAP)),
@@ -42,4 +56,6 @@ def contact_sheet(size: tuple[int, int] = (320, 180), frame: int = 0, types: lis
         for j, case in enumerate(cases):
             rgb = render_frame(compile_scene(case), frame, size).rgb
             sheet.paste(Image.fromarray(rgb), (LABEL_W + j * (width + GAP), y))
+            if on_frame is not None:
+                on_frame()
     return np.asarray(sheet)

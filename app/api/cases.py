@@ -17,7 +17,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Body, Header, Query, Request, Response
 from fastapi.responses import JSONResponse
-from pydantic import ValidationError
+from pydantic import BaseModel, Field, ValidationError
 
 from lanevil_core.case import Case
 from lanevil_core.illusions import CATEGORIES, REGISTRY
@@ -34,6 +34,45 @@ ENVELOPE_KEYS = frozenset({"id", "version", "case", "created_at", "updated_at", 
 CONFLICT: dict[int | str, dict[str, Any]] = {
     409: {"model": ErrorBody, "description": "stale version (the message says the current one)"}}
 NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no case with that id"}}
+
+
+
+class CaseSummary(BaseModel):
+    """One row of the case listing (``CaseRecord.summary``)."""
+
+    id: str
+    title: str
+    category: str = Field(description=f"one of {', '.join(LISTING_CATEGORIES)}")
+    type: str | None = Field(description="the first illusion's type (a stock original: its folder's), or null")
+    severity: int = Field(description="highest severity among the illusions, 0 for none")
+    version: int
+    road: str = Field(description="road type, e.g. bend")
+    frames: int
+    illusions: int = Field(description="number of illusions")
+    updated_at: float = Field(description="seconds since the epoch")
+
+
+class CaseList(BaseModel):
+    data: list[CaseSummary]
+    count: int
+
+
+class CaseEnvelope(BaseModel):
+    """A stored case with its bookkeeping: what ``GET /api/cases/{id}`` answers and every write returns."""
+
+    id: str
+    version: int = Field(description="increases by one with every write; also the ETag")
+    created_at: float = Field(description="seconds since the epoch")
+    updated_at: float = Field(description="seconds since the epoch")
+    origin: str | None = Field(description="the stock file a seeded case came from, or null")
+    case: Case
+
+
+def envelope_response(description: str) -> dict[str, Any]:
+    """An OpenAPI response of ``CaseEnvelope`` with its ``ETag`` header."""
+    return {"model": CaseEnvelope, "description": description,
+            "headers": {"ETag": {"description": 'the version, e.g. "3"', "schema": {"type": "string"}}}}
+
 
 CaseBody = Annotated[dict[str, Any], Body(description="a case document, or an envelope {id?, version?, case}",
                                           openapi_examples={"case": {"value": {"title": "my case"}}})]
@@ -101,7 +140,7 @@ def list_cases(
     state: StateDep,
     category: Annotated[str | None, Query(description=f"one of {', '.join(LISTING_CATEGORIES)}")] = None,
     type: Annotated[str | None, Query(description="an illusion type, e.g. fence_shadow")] = None,  # noqa: A002
-) -> dict[str, Any]:
+) -> CaseList:
     """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type."""
     if category is not None and category not in LISTING_CATEGORIES:
         raise ApiError(422, f"unknown category {category!r} (choose from {', '.join(LISTING_CATEGORIES)})",
@@ -109,10 +148,11 @@ def list_cases(
     if type is not None and type not in REGISTRY:
         raise ApiError(422, f"unknown illusion type {type!r} (see GET /api/illusions)", "type")
     rows = [record.summary() for record in state.store.list(category, type)]
-    return {"data": rows, "count": len(rows)}
+    return CaseList.model_validate({"data": rows, "count": len(rows)})
 
 
-@router.post("", status_code=201, summary="Create a case", responses={409: {"model": ErrorBody}})
+@router.post("", status_code=201, summary="Create a case",
+             responses={201: envelope_response("the stored case"), 409: {"model": ErrorBody}})
 def create_case(body: CaseBody, state: StateDep, request: Request) -> JSONResponse:
     """Store a new case at version 1; its id is the envelope's ``id`` or one derived from the title."""
     document, case_id, _ = split_body(body, allow_version=False)
@@ -126,7 +166,8 @@ def create_case(body: CaseBody, state: StateDep, request: Request) -> JSONRespon
     return record_response(record, 201, {"Location": str(request.url_for("get_case", case_id=record.id))})
 
 
-@router.get("/{case_id}", summary="Read a case", responses={**NOT_FOUND, 304: {"description": "not modified"}})
+@router.get("/{case_id}", summary="Read a case", responses={200: envelope_response("the stored case"), **NOT_FOUND,
+                                                            304: {"description": "not modified"}})
 def get_case(record: RecordDep, if_none_match: Annotated[str | None, Header(alias="If-None-Match")] = None
              ) -> Response:
     """The stored envelope ``{id, version, created_at, updated_at, origin, case}``; ``ETag`` is the version."""
@@ -135,7 +176,8 @@ def get_case(record: RecordDep, if_none_match: Annotated[str | None, Header(alia
     return record_response(record)
 
 
-@router.put("/{case_id}", summary="Replace a case", responses={**NOT_FOUND, **CONFLICT})
+@router.put("/{case_id}", summary="Replace a case",
+            responses={200: envelope_response("the case at its new version"), **NOT_FOUND, **CONFLICT})
 def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
     """Replace the case; ``If-Match`` or the body's ``version`` guards against overwriting someone else's change."""
     document, body_id, body_version = split_body(body, allow_version=True)
@@ -147,7 +189,8 @@ def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfM
     return record_response(state.store.update(case_id, case, expected_version=version))
 
 
-@router.patch("/{case_id}", summary="Merge-patch a case (RFC 7396)", responses={**NOT_FOUND, **CONFLICT},
+@router.patch("/{case_id}", summary="Merge-patch a case (RFC 7396)",
+              responses={200: envelope_response("the case at its new version"), **NOT_FOUND, **CONFLICT},
               openapi_extra={"requestBody": {"content": {"application/merge-patch+json": {
                   "schema": {"type": "object"}}}}})
 def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:

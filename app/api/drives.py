@@ -24,6 +24,7 @@ from ..jobs import Job, drive_job
 from .deps import StateDep
 from .detectors import checked_detector
 from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
+from .exports import JobBody
 from .params import image_size
 
 router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -31,6 +32,18 @@ router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPON
 MEDIA_TYPES = {TRACE_FILE: "text/csv", SUMMARY_FILE: "application/json", TRACE_PLOT_FILE: "image/png",
                PATH_PLOT_FILE: "image/png", "drive.mp4": "video/mp4", "drive.gif": "image/gif"}
 JOB_NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no such drive job"}}
+
+
+class DriveJob(JobBody):
+    case_id: str
+    detector: str
+    controller: str
+    files: dict[str, str] | None = Field(None, description="once done: file name -> URL")
+    summary: dict[str, Any] | None = Field(None, description="once done: summary.json (the ASR criterion, "
+                                                              "max deviation, departures)")
+
+
+DRIVE_JOB: dict[int | str, dict[str, Any]] = {200: {"model": DriveJob}, **JOB_NOT_FOUND}
 
 
 class DriveRequest(BaseModel):
@@ -69,7 +82,8 @@ def _drive_job(state: StateDep, job_id: str) -> Job:
 
 
 @router.post("/drives", status_code=202, summary="Start a closed-loop drive",
-             responses={202: {"description": "drive queued: poll the Location (GET /api/drives/{job_id})"},
+             responses={202: {"model": DriveJob,
+                              "description": "drive queued: poll the Location (GET /api/drives/{job_id})"},
                         404: {"model": ErrorBody, "description": "no case with that id"}, **TOO_MANY})
 def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONResponse:
     """Drive a stored case with a detector in the loop; poll the returned job for its summary and files."""
@@ -90,14 +104,14 @@ def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONR
     return JSONResponse(payload, status_code=202, headers={"Location": payload["links"]["self"]})
 
 
-@router.get("/drives/{job_id}", summary="State of a drive job", responses=JOB_NOT_FOUND)
+@router.get("/drives/{job_id}", summary="State of a drive job", response_model=None, responses=DRIVE_JOB)
 def get_drive(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
     """``status``, ``done``/``total`` steps; once ``done`` also ``summary`` (the ASR criterion, max deviation,
     departures) and ``files``."""
     return drive_body(_drive_job(state, job_id), request)
 
 
-@router.delete("/drives/{job_id}", summary="Cancel a drive job", responses=JOB_NOT_FOUND)
+@router.delete("/drives/{job_id}", summary="Cancel a drive job", response_model=None, responses=DRIVE_JOB)
 def cancel_drive(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
     """Stop a queued or running drive (it ends as ``cancelled`` after its current step)."""
     _drive_job(state, job_id)

@@ -17,12 +17,12 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import FileResponse, JSONResponse
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field
 
 from lanevil_core.benchmark_layout import case_folder
 
 from ..frames import case_hash
-from ..jobs import Job, export_zip
+from ..jobs import Job, JobStatus, export_zip
 from ..state import AppState
 from ..store import CaseRecord
 from .deps import RecordDep, StateDep
@@ -33,8 +33,40 @@ router = APIRouter(tags=["exports"], route_class=ApiRoute, responses=ERROR_RESPO
 
 SYNC_EXPORT_FRAMES = 10  # more frames than this (~0.2 s each at 1280x720) go to a background job
 ZIP = "application/zip"
+
+
+class JobState(BaseModel):
+    """A background job's state (``Job.to_dict``); the job's inputs (``case_id`` …) come with it."""
+
+    model_config = ConfigDict(extra="allow")
+
+    id: str
+    kind: str
+    status: JobStatus
+    done: int = Field(description="steps done (frames of an export, steps of a drive)")
+    total: int
+    progress: float = Field(description="done / total, 0..1")
+    error: str | None = Field(description="why the job failed, or null")
+    created_at: float = Field(description="seconds since the epoch")
+    finished_at: float | None = Field(description="seconds since the epoch, or null while it runs")
+
+
+class JobBody(JobState):
+    """A job's state and its URLs."""
+
+    links: dict[str, str] = Field(description="self: the job's URL (and download: its zip, for an export)")
+
+
+class ExportJob(JobBody):
+    case_id: str
+    case_version: int
+    frames: str = Field(description="START:STOP, half-open")
+    folder: str = Field(description="Category/Type/<case id> inside the zip")
+
+
 JOB_ACCEPTED: dict[int | str, dict[str, Any]] = {
-    202: {"description": "export queued as a job (or the job of an identical export): poll the Location "
+    202: {"model": ExportJob,
+          "description": "export queued as a job (or the job of an identical export): poll the Location "
                         "(GET /api/exports/{job_id})",
           "headers": {"Location": {"description": "the job's URL", "schema": {"type": "string"}}}},
     **TOO_MANY,
@@ -107,15 +139,15 @@ def create_export(body: ExportRequest, state: StateDep, request: Request) -> JSO
     return submit_export(state, record, chosen, request)
 
 
-@router.get("/exports/{job_id}", summary="State of an export job",
-            responses={404: {"model": ErrorBody, "description": "no such job"}})
+@router.get("/exports/{job_id}", summary="State of an export job", response_model=None,
+            responses={200: {"model": ExportJob}, 404: {"model": ErrorBody, "description": "no such job"}})
 def get_export(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
     """``status`` (queued, running, done, failed, cancelled), ``done``/``total`` frames, ``progress`` 0..1 and links."""
     return job_body(state.jobs.get(job_id), request)
 
 
-@router.delete("/exports/{job_id}", summary="Cancel an export job",
-               responses={404: {"model": ErrorBody, "description": "no such job"}})
+@router.delete("/exports/{job_id}", summary="Cancel an export job", response_model=None,
+               responses={200: {"model": ExportJob}, 404: {"model": ErrorBody, "description": "no such job"}})
 def cancel_export(job_id: str, state: StateDep, request: Request) -> dict[str, Any]:
     """Stop a queued or running export (it ends as ``cancelled`` after its current frame); a finished job is
     left as it is."""

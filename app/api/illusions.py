@@ -6,6 +6,7 @@ from functools import cache
 from typing import Any
 
 from fastapi import APIRouter
+from pydantic import BaseModel, Field
 
 from lanevil_core.case import case_schema
 from lanevil_core.cli.library import illusion_info
@@ -14,6 +15,21 @@ from lanevil_core.illusions import CATEGORIES, REGISTRY
 from .errors import ApiRoute
 
 router = APIRouter(tags=["illusions"], route_class=ApiRoute)
+
+
+class IllusionInfo(BaseModel):
+    name: str
+    category: str
+    description: str
+    parameters: dict[str, dict[str, Any]] = Field(description="field -> type, range, default, description")
+    severity: list[dict[str, Any]] = Field(description="the five-row severity table, level 1 first")
+
+
+class IllusionRegistry(BaseModel):
+    data: list[IllusionInfo]
+    count: int
+    categories: dict[str, list[str]] = Field(description="category -> its illusion types")
+    case_schema: dict[str, Any] = Field(description="the JSON schema of case documents")
 
 
 @cache
@@ -26,7 +42,8 @@ def registry_document() -> dict[str, Any]:
     return {"data": infos, "count": len(infos), "categories": by_category, "case_schema": case_schema()}
 
 
-@router.get("/illusions", summary="The illusion registry and the case schema")
+@router.get("/illusions", summary="The illusion registry and the case schema", response_model=None,
+            responses={200: {"model": IllusionRegistry}})
 def get_illusions() -> dict[str, Any]:
     """``{"data": [{name, category, description, parameters, severity}, ...], "count", "categories",
     "case_schema"}``."""

@@ -164,12 +164,13 @@ class Editor:
         return self._current().case
 
     def open_case(self, case_id: str) -> None:
-        """Show a stored case (its shared session, with any unsaved edits another tab made)."""
+        """Show a stored case (its shared session, with any unsaved edits another tab made), its first illusion
+        selected so that its severity and parameters show at once."""
         if case_id not in self.state.store:
             raise EditError(f"case_id: no case {case_id!r} in the store")
         with self._lock:
             self.session = self.sessions.open(case_id)
-            self.selected = None
+            self.selected = 0 if self.session.case.illusions else None
             self.frame = min(self.frame, self.session.case.ego.frames - 1)
         self._changed(f"opened {case_id}")
 

@@ -24,6 +24,16 @@ from ..api.errors import ApiError, ApiRoute, ErrorBody, first_error
 from ..api.json_body import BodyError, check_json_type, is_json_type, parse_json
 from ..state import AppState, get_state
 from .auth import AdminDep
+from .bodies import (
+    Completed,
+    OpenStudy,
+    ParticipantPlan,
+    PublicStudy,
+    RatingBody,
+    StudyDetail,
+    StudyResults,
+    StudyRow,
+)
 from .create import SpecError, create_study, items_folder
 from .db import connect, db_path
 from .images import CheckedUpload, UploadError, check_upload
@@ -118,11 +128,12 @@ def answers() -> Iterator[None]:
 # --- organiser ---------------------------------------------------------------------------------------------------
 
 @router.post("/studies", status_code=201, summary="Create a study (organiser)", openapi_extra=CREATE_BODY,
-             responses={201: {"description": "the study, ready: `id`, `status`, `participant_url`, `items` (each "
-                                             "with its `image_url`) and `job`: null",
-                              "content": {"application/json": {"schema": {"type": "object"}}}},
-                        202: {"description": "the study, still `rendering`, and its render `job`",
-                              "content": {"application/json": {"schema": {"type": "object"}}}}, **ORGANISER,
+             responses={201: {"model": StudyDetail,
+                              "description": "the study, ready: `id`, `status`, `participant_url`, `items` (each "
+                                             "with its `image_url`) and `job`: null"},
+                        202: {"model": StudyDetail,
+                              "description": "the study, still `rendering`, and its render `job`"},
+                        **ORGANISER,
                         413: _error("an upload over `max_upload_bytes` (`field`: `files.<n>`), or the request over "
                                     "the server's body limit")})
 async def post_study(request: Request, state: StateDep, _: AdminDep) -> JSONResponse:
@@ -209,12 +220,14 @@ def _study_detail(db: sqlite3.Connection, study: Study) -> dict[str, Any]:
     }
 
 
-@router.get("/studies", summary="List studies (organiser)", responses=ORGANISER)
+@router.get("/studies", summary="List studies (organiser)", response_model=None,
+            responses={200: {"model": list[StudyRow]}, **ORGANISER})
 def get_studies(db: DbDep, _: AdminDep) -> list[dict[str, Any]]:
     return [study.to_dict() | {"participants": len(study_participants(db, study.id))} for study in list_studies(db)]
 
 
-@router.get("/studies/{study_id}", summary="A study with its items (organiser)", responses={**ORGANISER, **NO_STUDY})
+@router.get("/studies/{study_id}", summary="A study with its items (organiser)", response_model=None,
+            responses={200: {"model": StudyDetail}, **ORGANISER, **NO_STUDY})
 def get_study_detail(study_id: str, db: DbDep, state: StateDep, _: AdminDep) -> dict[str, Any]:
     with answers():
         study = get_study(db, study_id)
@@ -240,7 +253,7 @@ def _results(db: sqlite3.Connection, study_id: str) -> tuple[Study, dict[str, An
 
 
 @router.get("/studies/{study_id}/results", summary="MOS with 95% CI and rater screening (organiser)",
-            responses={**ORGANISER, **NO_STUDY})
+            response_model=None, responses={200: {"model": StudyResults}, **ORGANISER, **NO_STUDY})
 def get_results(study_id: str, db: DbDep, _: AdminDep) -> dict[str, Any]:
     study, summary = _results(db, study_id)
     return {"study": study.to_dict()} | summary
@@ -277,7 +290,8 @@ def _counts(db: sqlite3.Connection, study_id: str) -> dict[str, int]:
             "rated_items": sum(item.scored for item in items)}
 
 
-@router.get("/open", summary="Studies open to participants (for the /study page)")
+@router.get("/open", summary="Studies open to participants (for the /study page)", response_model=None,
+            responses={200: {"model": list[OpenStudy]}})
 def get_open_studies(db: DbDep) -> list[dict[str, Any]]:
     """Every study that is ready, newest first: what the ``/study`` page lists for people who want to take part."""
     ready = [study for study in reversed(list_studies(db)) if study.status == "ready"]
@@ -285,7 +299,8 @@ def get_open_studies(db: DbDep) -> list[dict[str, Any]]:
              "participant_url": f"/study/{study.id}", **_counts(db, study.id)} for study in ready]
 
 
-@router.get("/studies/{study_id}/public", summary="What a participant sees before consenting", responses=NO_STUDY)
+@router.get("/studies/{study_id}/public", summary="What a participant sees before consenting", response_model=None,
+            responses={200: {"model": PublicStudy}, **NO_STUDY})
 def get_public(study_id: str, db: DbDep, state: StateDep) -> dict[str, Any]:
     """Also ``preparing`` (``{"done", "total"}`` images) while the study's images are still being rendered."""
     with answers():
@@ -314,7 +329,7 @@ def _plan(db: sqlite3.Connection, study: Study, participant_id: str) -> dict[str
 
 
 @router.post("/studies/{study_id}/participants", status_code=201, summary="Consent and join a study",
-             responses={**NO_STUDY, **NOT_READY})
+             response_model=None, responses={201: {"model": ParticipantPlan}, **NO_STUDY, **NOT_READY})
 def post_participant(study_id: str, consent: ConsentIn, db: DbDep) -> dict[str, Any]:
     """Creates the participant (a random id) only when ``consent`` is true; returns the item order."""
     with answers():
@@ -327,7 +342,7 @@ def post_participant(study_id: str, consent: ConsentIn, db: DbDep) -> dict[str, 
 
 
 @router.get("/studies/{study_id}/participants/{participant_id}", summary="A participant's order and progress",
-            responses=NO_STUDY)
+            response_model=None, responses={200: {"model": ParticipantPlan}, **NO_STUDY})
 def get_participant_plan(study_id: str, participant_id: str, db: DbDep) -> dict[str, Any]:
     with answers():
         return _plan(db, get_study(db, study_id), participant_id)
@@ -335,7 +350,8 @@ def get_participant_plan(study_id: str, participant_id: str, db: DbDep) -> dict[
 
 @router.post("/studies/{study_id}/participants/{participant_id}/ratings", status_code=201,
              summary="Rate one item (once; a second rating of the same item is refused with 409)",
-             responses={**NO_STUDY, 409: _error("this participant rated the item already (`field`: `item_id`)")})
+             response_model=None, responses={201: {"model": RatingBody}, **NO_STUDY, 409: _error(
+                 "this participant rated the item already (`field`: `item_id`)")})
 def post_rating(study_id: str, participant_id: str, rating: RatingIn, db: DbDep) -> dict[str, Any]:
     with answers():
         study = get_study(db, study_id)
@@ -350,7 +366,8 @@ def post_rating(study_id: str, participant_id: str, rating: RatingIn, db: DbDep)
 
 
 @router.post("/studies/{study_id}/participants/{participant_id}/complete", summary="Finish the session",
-             responses={**NO_STUDY, 409: _error("items are still unrated (`field`: `ratings`)")})
+             response_model=None, responses={200: {"model": Completed}, **NO_STUDY,
+                                             409: _error("items are still unrated (`field`: `ratings`)")})
 def post_complete(study_id: str, participant_id: str, db: DbDep) -> dict[str, Any]:
     """409 while any item is unrated; otherwise marks the participant complete (idempotent)."""
     with answers():

@@ -17,6 +17,7 @@ from .records import NotFound, get_study
 
 STATIC_STUDY = Path(__file__).resolve().parents[2] / "static" / "study"
 NOT_FOUND_PAGE = """<!doctype html><html lang="en"><head><meta charset="utf-8"><title>Study not found</title>
+<link rel="icon" href="/static/img/lanes.svg" type="image/svg+xml">
 <link rel="stylesheet" href="/static/study/study.css"></head><body><main class="card"><h1>Study not found</h1>
 <p>This link does not lead to a study. Please check the address you were given.</p></main></body></html>"""
 

@@ -65,8 +65,9 @@ def _run_dataset(args: argparse.Namespace) -> int:
         print(f"interrupted: frames written so far are kept; rerun the same command to resume into {args.out}",
               file=sys.stderr)
         return 130
-    print(f"{summary.total} frames in {summary.out_dir} ({summary.rendered} rendered, {summary.kept} kept) "
-          f"in {summary.seconds:.1f} s, {summary.frames_per_second:.2f} frames/s")
+    print(f"{summary.total} frames in {summary.out_dir} ({summary.rendered} rendered, {summary.kept} kept); "
+          f"rendering {summary.render_seconds:.1f} s, {summary.frames_per_second:.2f} frames/s; "
+          f"total wall time {summary.seconds:.1f} s (with worker start-up, planning, label files and manifest)")
     return 0
 
 

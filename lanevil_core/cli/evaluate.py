@@ -17,8 +17,8 @@ METRIC_CHOICES = ("tusimple", "culane", "ego")
 
 def _eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--gt", type=Path, required=True,
-                        help="ground truth: TuSimple JSON lines (or a split folder with its *_label.json), "
-                             "or a folder of CULane .lines.txt files")
+                        help="ground truth: TuSimple JSON lines (or a split folder with its *_label.json, or a "
+                             "dataset folder: its test split), or a folder of CULane .lines.txt files")
     parser.add_argument("--pred", type=Path, required=True, help="predictions in the same format as --gt")
     parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple",
                         help="default tusimple; ego: share of the ego lane's two lines matched (>= 85 %% of their "
@@ -52,7 +52,8 @@ def _run_eval(args: argparse.Namespace) -> int:
 
 
 def _detect_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or images")
+    parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or "
+                                                 "images; a dataset folder stands for its test split")
     parser.add_argument("--method", choices=("ufld", "seg", "hough", "birdseye"), required=True,
                         help="learned (ufld: row anchors, seg: segmentation; ONNX) or classical baseline")
     parser.add_argument("--weights", type=Path, default=None,
@@ -79,7 +80,8 @@ def _run_detect(args: argparse.Namespace) -> int:
 
 
 def _report_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--gt", type=Path, required=True, help="split folder (e.g. DATASET/test)")
+    parser.add_argument("--gt", type=Path, required=True,
+                        help="dataset folder (its test split) or split folder (e.g. DATASET/test)")
     parser.add_argument("--pred", type=Path, required=True, action="append",
                         help="predictions (TuSimple JSON lines); repeat for several detectors side by side")
     parser.add_argument("--name", action="append", default=None,

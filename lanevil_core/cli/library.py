@@ -66,11 +66,13 @@ def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--size", type=parse_size, default=(320, 180), help="cell size WIDTHxHEIGHT (default 320x180)")
     parser.add_argument("--frame", type=int, default=0, help="frame of every case (default 0)")
     parser.add_argument("--types", default=None, help="comma-separated illusion types (default: all 14)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def _run_sheet(args: argparse.Namespace) -> int:
+    from ..dataset.progress import progress_bar
     from ..encode import png_bytes
-    from ..sheet import contact_sheet
+    from ..sheet import contact_sheet, sheet_frames
 
     types = None
     if args.types:
@@ -80,7 +82,9 @@ def _run_sheet(args: argparse.Namespace) -> int:
             raise UsageError(f"--types: unknown illusion type {unknown[0]!r}; see 'lanevil illusions'")
     if not 0 <= args.frame < 50:
         raise UsageError("--frame must lie in 0..49 (every stock case has at least 50 frames)")
-    write_atomic(args.out, png_bytes(contact_sheet(args.size, args.frame, types)))
+    with progress_bar(sheet_frames(types), 0, not args.quiet) as bar:
+        rgb = contact_sheet(args.size, args.frame, types, on_frame=bar.update)
+    write_atomic(args.out, png_bytes(rgb))
     print(args.out)
     return 0
 

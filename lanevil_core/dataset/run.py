@@ -37,18 +37,22 @@ Executor = Callable[[Sequence[RenderTask], TaskDone], None]
 
 @dataclass(frozen=True)
 class RunSummary:
-    """What a run did: frames in the plan, frames rendered now, frames kept from disk, wall time (s)."""
+    """What a run did: frames in the plan, frames rendered now, frames kept from disk, the wall time (s) of the
+    whole run (worker start-up, planning, resume checks, label files and manifest included) and of its rendering
+    alone (from the first task handed out to the last one written)."""
 
     out_dir: Path
     total: int
     rendered: int
     kept: int
     seconds: float
+    render_seconds: float
 
     @property
     def frames_per_second(self) -> float:
-        """Rendered frames per second of wall time (0 when nothing was rendered)."""
-        return self.rendered / self.seconds if self.rendered and self.seconds > 0 else 0.0
+        """Rendered frames per second of rendering wall time (0 when nothing was rendered): the progress bar's
+        rate, averaged over the whole rendering."""
+        return self.rendered / self.render_seconds if self.rendered and self.render_seconds > 0 else 0.0
 
 
 class _Sidecars:
@@ -128,8 +132,11 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
                 sidecars.store(task, results)
                 bar.update(len(results))
 
+            render_start = time.perf_counter()
             executor(tasks, on_done)
+            render_seconds = time.perf_counter() - render_start
     finally:
         getattr(executor, "close", lambda: None)()
     _finish(plan, folder, sidecars, versions, code_sha256)
-    return RunSummary(out_dir, plan.total_frames, plan.total_frames - kept, kept, time.perf_counter() - start)
+    return RunSummary(out_dir, plan.total_frames, plan.total_frames - kept, kept, time.perf_counter() - start,
+                      render_seconds)

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 
 from ..labels import h_samples_for
-from ..metrics.formats import LaneFileError, read_tusimple, split_labels
+from ..metrics.formats import LaneFileError, read_tusimple, split_folder, split_labels
 from ..typed import UInt8Array
 from .birdseye import detect_birdseye
 from .hough import detect_hough
@@ -80,7 +80,7 @@ def detect_split(split_dir: str | Path, method: str, progress: Progress | None =
     ``fixed_run_time_ms`` replaces the measured time (for byte-reproducible files); everything else is
     deterministic.
     """
-    split_dir = Path(split_dir)
+    split_dir = split_folder(split_dir)  # a dataset folder: its test split, whose label file names the images
     detector = detector_for(method, weights)
     items = split_images(split_dir)
     records = []

@@ -189,11 +189,21 @@ def tusimple_points(lane: list[float], h_samples: list[float]) -> Points:
 
 
 LABEL_SUFFIX = "_label.json"
+DATASET_SPLIT = "test"  # the split a dataset folder (written by ``lanevil dataset``) stands for
+
+
+def split_folder(path: str | Path) -> Path:
+    """``path``, or its ``test`` split when ``path`` is a dataset folder (no label file of its own, a ``test/``)."""
+    path = Path(path)
+    if path.is_dir() and not any(path.glob(f"*{LABEL_SUFFIX}")) and (path / DATASET_SPLIT).is_dir():
+        return path / DATASET_SPLIT
+    return path
 
 
 def split_labels(split_dir: str | Path) -> Path:
-    """The TuSimple label file of a split folder: ``<split>/<split name>_label.json`` or its only ``*_label.json``."""
-    split_dir = Path(split_dir)
+    """The TuSimple label file of a split folder: ``<split>/<split name>_label.json`` or its only ``*_label.json``;
+    a dataset folder stands for its ``test`` split."""
+    split_dir = split_folder(split_dir)
     if not split_dir.is_dir():
         raise LaneFileError(f"{split_dir}: not a split folder")
     named = split_dir / f"{split_dir.name}{LABEL_SUFFIX}"
@@ -201,5 +211,6 @@ def split_labels(split_dir: str | Path) -> Path:
         return named
     found = sorted(split_dir.glob(f"*{LABEL_SUFFIX}"))
     if len(found) != 1:
-        raise LaneFileError(f"{split_dir}: expected one *{LABEL_SUFFIX} file, found {len(found)}")
+        raise LaneFileError(f"{split_dir}: expected one *{LABEL_SUFFIX} file, found {len(found)}; give a split "
+                            f"folder (e.g. DATASET/{DATASET_SPLIT}) or a dataset folder with a {DATASET_SPLIT}/ split")
     return found[0]

@@ -237,3 +237,13 @@ def test_bounded_argument_types_name_the_range():
                                  (count(1), "0", "must be at least 1")):
         with pytest.raises(argparse.ArgumentTypeError, match=message):
             parse(text)
+
+
+def test_sheet_shows_progress_per_rendered_frame(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "sheet.png"
+    assert cli.main(["sheet", "--out", str(out), "--size", "64x64", "--types", "fence_shadow"]) == 0
+    captured = capsys.readouterr()
+    assert out.read_bytes()[:4] == b"\x89PNG" and captured.out.strip() == str(out)
+    assert "6/6" in captured.err and "frame" in captured.err  # one bar step per cell: the original and 5 levels
+    assert cli.main(["sheet", "--out", str(out), "--size", "64x64", "--types", "fence_shadow", "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

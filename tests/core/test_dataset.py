@@ -206,6 +206,8 @@ def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Pat
     summary = generate_dataset(cases_dir, out, settings, functools.partial(run_local, workers=1),
                                show_progress=False)
     assert (summary.kept, summary.rendered) == (len(written), 9 - len(written))
+    assert 0 < summary.render_seconds < summary.seconds  # planning, resume check and manifest are not rendering
+    assert summary.frames_per_second == pytest.approx(summary.rendered / summary.render_seconds)
     assert tree(out) == tree(dataset)
 
 
@@ -215,7 +217,8 @@ def test_frames_from_other_settings_are_not_reused(dataset: Path, cases_dir: Pat
     shutil.copytree(dataset, out)
     assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "1", "--size", "128x72",
                    "--frames-per-case", "1", "--quiet") == 0
-    assert "(3 rendered, 0 kept)" in capsys.readouterr().out
+    line = capsys.readouterr().out
+    assert "(3 rendered, 0 kept); rendering " in line and " frames/s; total wall time " in line
     with Image.open(out / "test/Shadow/Fence/00_original/000000.png") as image:
         assert image.size == (128, 72)
     manifest = json.loads((out / "manifest.json").read_text())

@@ -122,6 +122,28 @@ def test_end_to_end_detect_eval_report(tiny_split, tmp_path, capsys):
                  str(both)]) == 2  # two detectors of one name
 
 
+def test_a_dataset_folder_stands_for_its_test_split(tiny_split, tmp_path, capsys):
+    dataset = tiny_split.parent  # what `lanevil dataset --out` was given
+    preds = tmp_path / "root.json"
+    assert main(["detect", str(dataset), "--method", "birdseye", "--out", str(preds), "--fixed-run-time", "1"]) == 0
+    split_preds = tmp_path / "split.json"
+    assert main(["detect", str(tiny_split), "--method", "birdseye", "--out", str(split_preds),
+                 "--fixed-run-time", "1"]) == 0
+    assert preds.read_bytes() == split_preds.read_bytes()  # the test split's images, named as its labels name them
+    capsys.readouterr()
+    assert main(["eval", "--gt", str(dataset), "--pred", str(preds), "--json"]) == 0
+    assert main(["eval", "--gt", str(tiny_split), "--pred", str(preds), "--json"]) == 0
+    from_root, from_split = capsys.readouterr().out.strip().splitlines()[-2:]
+    assert from_root == from_split
+    assert main(["report", "--gt", str(dataset), "--pred", str(preds), "--out", str(tmp_path / "report")]) == 0
+    assert (tmp_path / "report" / "report.md").is_file()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["report", "--gt", str(empty), "--pred", str(preds), "--out", str(tmp_path / "r2")]) == 2
+    err = capsys.readouterr().err
+    assert "found 0" in err and "DATASET/test" in err
+
+
 def test_paint_free_control_and_several_detectors(tmp_path):
     from lanevil_core.report_compare import Detector, write_comparison
     from lanevil_core.report_compare import markdown as compare_markdown

@@ -35,6 +35,28 @@ def test_list_returns_summaries(client) -> None:
     assert [row["id"] for row in body["data"]] == sorted(row["id"] for row in body["data"])
 
 
+def test_openapi_describes_the_listing_and_the_envelope(client) -> None:
+    schema = client.get("/openapi.json").json()
+    components, paths = schema["components"]["schemas"], schema["paths"]
+
+    def body_schema(path: str, method: str, status: str) -> dict:
+        ref = paths[path][method]["responses"][status]["content"]["application/json"]["schema"]["$ref"]
+        return components[ref.rsplit("/", 1)[1]]
+
+    listing = body_schema("/api/cases", "get", "200")
+    assert set(listing["required"]) == {"data", "count"}
+    row_schema = components[listing["properties"]["data"]["items"]["$ref"].rsplit("/", 1)[1]]
+    rows = client.get("/api/cases").json()["data"]
+    assert all(set(row) == set(row_schema["properties"]) == set(row_schema["required"]) for row in rows)
+    envelope = client.get(f"/api/cases/{SHADOW_ID}").json()
+    for path, method, status in [("/api/cases/{case_id}", "get", "200"), ("/api/cases", "post", "201"),
+                                 ("/api/cases/{case_id}", "put", "200"), ("/api/cases/{case_id}", "patch", "200")]:
+        described = body_schema(path, method, status)
+        assert set(described["properties"]) == set(envelope), (path, method)
+        assert described["properties"]["case"] == {"$ref": "#/components/schemas/Case"}
+        assert "ETag" in paths[path][method]["responses"][status]["headers"]
+
+
 @pytest.mark.parametrize(("query", "expected"), [
     ("category=clean", {"clean-00_straight_urban", "clean-01_bend_suburban"}),
     ("category=shadow", {"fence_shadow-00_original", "fence_shadow-01_level1", SHADOW_ID, "fence_shadow-05_level5"}),

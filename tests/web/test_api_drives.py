@@ -6,6 +6,8 @@ import time
 
 import pytest
 
+from app.api.drives import DriveJob
+
 CASE_ID = "clean-01_bend_suburban"
 
 
@@ -27,6 +29,7 @@ def test_a_drive_job_reports_its_summary_and_serves_its_files(client) -> None:
     assert job["kind"] == "drive" and job["case_id"] == CASE_ID and job["total"] == 10
     body = _wait(client, response.headers["Location"])
     assert body["status"] == "done", body
+    assert DriveJob.model_validate(body).model_dump() == body and DriveJob.model_validate(job)
     summary = body["summary"]
     assert summary["steps"] == 10 and summary["detector"] == "gt" and summary["max_abs_deviation"] < 0.1
     assert {"trace.csv", "summary.json", "trace.png", "path.png"} <= set(body["files"])

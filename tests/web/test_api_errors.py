@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from app.api.illusions import IllusionRegistry
 from app.api.json_body import MAX_DEPTH, line_column
 
 ADMIN = {"Authorization": "Bearer test-admin"}
@@ -152,6 +153,24 @@ def test_openapi_documents_the_error_body_and_statuses(client) -> None:
     exports = paths["/api/exports"]["post"]["responses"]
     assert "429" in exports and "Retry-After" in exports["429"]["headers"]
     assert "429" in paths["/api/cases/{case_id}/export.zip"]["get"]["responses"]
+
+
+def test_every_json_answer_of_the_api_has_a_named_schema(client) -> None:
+    schema = client.get("/openapi.json").json()
+    undescribed = []
+    for path, method, operation in operations(schema):
+        for status, response in operation["responses"].items():
+            body = response.get("content", {}).get("application/json")
+            if not status.startswith("2") or body is None:
+                continue
+            named = body.get("schema") or {}
+            if "$ref" not in named and "$ref" not in named.get("items", {}):  # a model, or a list of one
+                undescribed.append((method, path, status))
+    # Files served as they are: labels.json and a drive's summary.json.
+    assert {(method, path) for method, path, _ in undescribed} <= {
+        ("get", "/api/cases/{case_id}/labels"), ("get", "/api/drives/{job_id}/files/{name}")}, undescribed
+    illusions = client.get("/api/illusions").json()
+    assert IllusionRegistry.model_validate(illusions).model_dump() == illusions
 
 
 def test_openapi_describes_study_creation(client) -> None:

@@ -65,6 +65,8 @@ def test_long_export_becomes_a_job(client, monkeypatch) -> None:
     assert seen[-1]["status"] == "done" and seen[-1]["done"] == 3 and seen[-1]["progress"] == 1.0
     progress = [state["progress"] for state in seen]
     assert progress == sorted(progress)
+    for body in (job, *seen):  # what the OpenAPI document says the job looks like, no field more or less
+        assert exports.ExportJob.model_validate(body).model_dump() == body
     archive = zipfile.ZipFile(io.BytesIO(client.get(job["links"]["download"]).content))
     assert len([name for name in archive.namelist() if name.endswith(".png")]) == 3
 

@@ -51,6 +51,16 @@ def test_launch_serves_on_the_real_port_and_shows_a_preview(editor: Editor) -> N
     assert editor.view.surface is not None  # the 3D view has the road
 
 
+def test_a_case_opens_with_its_first_illusion_selected(editor: Editor) -> None:
+    editor.panel.case_id.value = SHADOW  # one illusion
+    assert editor.selected == 0 and editor.panel.selected.value == editor.panel.selected.options[1]
+    assert not editor.panel.severity.disabled and editor.panel.severity.value == 3
+    assert not editor.panel.delete.disabled
+    editor.panel.case_id.value = "clean-00_straight_urban"  # none: nothing to select
+    assert editor.selected is None and editor.panel.severity.disabled
+    settle(editor)
+
+
 def test_severity_slider_changes_the_case_and_the_preview(editor: Editor) -> None:
     before = open_shadow(editor)
     assert editor.selected == 0 and not editor.panel.severity.disabled

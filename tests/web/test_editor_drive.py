@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import time
 
 from app.editor import Editor
+from lanevil_core.drive.outputs import SUMMARY_FILE
 
 WAIT_S = 120.0
 
@@ -34,3 +36,14 @@ def _wait_for_playback(editor: Editor) -> None:
     deadline = time.monotonic() + 10
     while not editor.drive.frames and time.monotonic() < deadline:
         time.sleep(0.1)
+
+
+def test_the_drive_plot_is_titled_after_the_edited_case(editor: Editor) -> None:
+    editor.panel.title.value = "Edited, not saved"
+    assert editor.session.dirty and editor.state.store.get(editor.session.case_id).case.title != "Edited, not saved"
+    editor.drive.seconds.value = 1.0
+    job = editor.drive.start()
+    assert job is not None and job.finished.wait(WAIT_S) and job.status == "done", job.error
+    summary = json.loads((job.result / SUMMARY_FILE).read_text())
+    assert summary["title"] == "Edited, not saved"  # what the deviation plot's title starts with
+    _wait_for_playback(editor)

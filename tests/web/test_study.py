@@ -16,9 +16,11 @@ import pytest
 from fastapi import FastAPI
 from fastapi.testclient import TestClient
 from PIL import Image
+from pydantic import TypeAdapter
 
 from app.main import create_app
 from app.state import AppState
+from app.study import bodies
 from app.study.db import db_path
 from app.study.order import participant_order
 from app.study.records import StudyItem
@@ -208,6 +210,30 @@ def test_participant_flow(client) -> None:
     with sqlite3.connect(db_path(client.app.state.lanevil.settings.data_dir)) as db:
         rows = db.execute("SELECT rating FROM ratings WHERE participant_id = ? AND item_id = ?", (pid, first))
         assert rows.fetchall() == [(4,)]  # the refused resubmission changed nothing
+
+
+def test_every_json_answer_matches_its_openapi_model(client) -> None:
+    """The models the OpenAPI document names (``app/study/bodies.py``) describe the bodies, no field more or less."""
+
+    def same(model: Any, body: Any) -> None:
+        adapter = TypeAdapter(model)
+        assert adapter.dump_python(adapter.validate_python(body), mode="json") == body
+
+    study = small_study(client)
+    sid = study["id"]
+    same(bodies.StudyDetail, study)
+    same(list[bodies.StudyRow], client.get("/api/study/studies", headers=ADMIN).json())
+    same(bodies.StudyDetail, client.get(f"/api/study/studies/{sid}", headers=ADMIN).json())
+    same(list[bodies.OpenStudy], client.get("/api/study/open").json())
+    same(bodies.PublicStudy, client.get(f"/api/study/studies/{sid}/public").json())
+    plan = join(client, sid)
+    same(bodies.ParticipantPlan, plan)
+    pid = plan["participant_id"]
+    for entry in plan["items"]:
+        same(bodies.RatingBody, rate(client, sid, pid, entry["item_id"], 3).json())
+    same(bodies.Completed, client.post(f"/api/study/studies/{sid}/participants/{pid}/complete").json())
+    same(bodies.ParticipantPlan, client.get(f"/api/study/studies/{sid}/participants/{pid}").json())
+    same(bodies.StudyResults, client.get(f"/api/study/studies/{sid}/results", headers=ADMIN).json())
 
 
 def _item(item_id: int, role: str, position: int) -> StudyItem:
