@@ -124,7 +124,8 @@ def plan_view(pieces: list[Piece], x: float, y: float, heading: float) -> xodr.P
 
 def elevation_records(line: ReferenceLine, s0: float = 0.0, s1: float | None = None) -> list[tuple[float, ...]]:
     """(s, a, b, c, d) cubic records of the height over [s0, s1] (s relative to s0): Hermite cubics through the
-    height and grade at knots ``ELEVATION_STEP_M`` apart; one record for a road of constant grade."""
+    height and grade at knots ``ELEVATION_STEP_M`` apart, a straight stretch as one record (one for a road of
+    constant grade)."""
     s1 = line.length if s1 is None else s1
     grade = line.grade_at(np.array([s0, s1]))
     if np.ptp(line.grade) == 0.0:
@@ -137,8 +138,17 @@ def elevation_records(line: ReferenceLine, s0: float = 0.0, s1: float | None = N
         dz = z[i + 1] - z[i]
         c = (3 * dz - (2 * g[i] + g[i + 1]) * h) / h**2
         d = ((g[i] + g[i + 1]) * h - 2 * dz) / h**3
-        records.append((float(knots[i] - s0), float(z[i]), float(g[i]), float(c), float(d)))
+        record = (float(knots[i] - s0), float(z[i]), float(g[i]), float(c), float(d))
+        if not records or not _continues(records[-1], record):
+            records.append(record)
     return records
+
+
+def _continues(previous: tuple[float, ...], record: tuple[float, ...], tol: float = 1e-9) -> bool:
+    """Whether ``record`` is the straight continuation of a straight ``previous`` (a redundant record)."""
+    s, a, b, c, d = previous
+    straight = max(abs(c), abs(d), abs(record[3]), abs(record[4])) < tol
+    return straight and abs(record[2] - b) < tol and abs(a + b * (record[0] - s) - record[1]) < 1e-6
 
 
 # ---------------------------------------------------------------------------------------------- objects

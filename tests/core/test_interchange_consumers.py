@@ -271,3 +271,13 @@ def test_independent_readers_accept_the_exports_when_installed(exports, tmp_path
     for xodr_root, xosc_root in exports.values():
         assert not list(odr.iter_errors(xodr_root))
         assert not list(osc.iter_errors(xosc_root))
+
+
+def test_a_straight_grade_is_one_elevation_record():
+    from lanevil_core.interchange.opendrive import elevation_records
+
+    case = load_case(SCENES / "00_clean/03_uphill_highway.json")
+    records = elevation_records(compile_scene(case).network.main.line)
+    for previous, record in zip(records, records[1:]):
+        straight = previous[3] == record[3] == previous[4] == record[4] == 0.0
+        assert not (straight and record[2] == pytest.approx(previous[2], abs=1e-9))
