@@ -42,6 +42,8 @@ class Mesh:
         emission: (m, 3) float32 emitted linear radiance per face (lamps, headlights), or None.
         visible: drawn in the camera (False = shadow caster only, e.g. a structure above the view).
         source: the illusion index that added it, or -1 for the road and roadside.
+        heading: world yaw (radians, counter-clockwise from +X) of a traffic participant's forward axis, set where it
+            is placed (exports need it: a footprint's long axis cannot tell front from back, nor a person's facing).
     """
 
     vertices: FloatArray
@@ -54,6 +56,7 @@ class Mesh:
     emission: Float32Array | None = None
     visible: bool = True
     source: int = -1
+    heading: float | None = None
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64)

@@ -64,14 +64,20 @@ def load_world(client, xodr_text: str):  # noqa: ANN001, ANN201 - carla types
     return client.generate_opendrive_world(xodr_text, parameters)
 
 
+def carla_sun_azimuth(case_azimuth: float) -> float:
+    """CARLA's ``sun_azimuth_angle`` (degrees) for the case's sun azimuth (degrees counter-clockwise from world +X):
+    the OpenSCENARIO azimuth (clockwise from north = world +Y), which is what scenario_runner hands CARLA unchanged
+    from ``scenario.xosc``, so that both ways of running a case put the sun in the same place."""
+    return (90.0 - case_azimuth) % 360.0
+
+
 def apply_case(world, case: dict) -> None:  # noqa: ANN001
-    """The case's weather numbers and sun. CARLA's frame is left-handed (its y is the OpenDRIVE y mirrored), so the
-    case's azimuth, counter-clockwise from +X, becomes 360 - azimuth there."""
+    """The case's weather numbers and sun (azimuth as in ``carla_sun_azimuth``)."""
     import carla
 
     weather = carla.WeatherParameters(**{key: float(case["weather"][key]) for key in WEATHER_FIELDS})
     weather.sun_altitude_angle = float(case["sun"]["altitude"])
-    weather.sun_azimuth_angle = float((360.0 - case["sun"]["azimuth"]) % 360.0)
+    weather.sun_azimuth_angle = carla_sun_azimuth(float(case["sun"]["azimuth"]))
     world.set_weather(weather)
 
 

@@ -215,6 +215,7 @@ class TrafficIllusion(Illusion):
             T_world_local = T_world_local @ np.array([[c, 0, -s, 0], [0, 1, 0, 0], [s, 0, c, 0], [0, 0, 0, 1.0]])
         placed = transformed(mesh, T_world_local)
         placed.name = f"{self.type} {index + 1}"
+        placed.heading = float(line.heading_at(slot.s)) + slot.yaw
         ctx.add_mesh(placed)
 
 

@@ -15,7 +15,7 @@ from lanevil_core import cli
 from lanevil_core.case import load_case, save_case
 from lanevil_core.compile import compile_scene
 from lanevil_core.interchange import write_interchange
-from lanevil_core.interchange.opendrive import MARK_TYPES, opendrive, xodr_text
+from lanevil_core.interchange.opendrive import MARK_TYPES, junction_radius, opendrive, xodr_text
 from lanevil_core.interchange.openscenario import EGO_NAME, participants
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -60,7 +60,7 @@ def test_opendrive_matches_the_case_within_a_centimetre(exported, path):
     header = root.find("header")
     assert header.get("revMajor") == "1" and int(header.get("revMinor")) >= 6
     mains = _main_roads(root)
-    reach = network.main.half_width if len(mains) == 2 else 0.0
+    reach = junction_radius(network) if len(mains) == 2 else 0.0
     assert sum(float(road.get("length")) for road in mains) + 2 * reach == pytest.approx(case.road.length, abs=CM)
     # The reference line: every geometry starts where the case's line is, and the last one ends where it ends.
     line = network.main.line
