@@ -185,6 +185,8 @@ class Sensor(_Model):
     sharpen: float = Field(0.6, ge=0.0, le=3.0, description="ISP unsharp-mask amount")
     noise: float = Field(1.0, ge=0.0, le=10.0, description="sensor noise scale (1 = a typical small sensor)")
     shutter: float = Field(0.004, ge=0.0, le=0.1, description="exposure time for motion blur (s); 0 = none")
+    compression: int | None = Field(None, ge=10, le=100, description="JPEG quality of the recording (a dash "
+                                    "cam's compressed video); empty = none")
 
 
 class Camera(_Model):

@@ -13,6 +13,7 @@ from ..typed import FloatArray
 Distortion = tuple[float, float, float, float, float]
 NO_DISTORTION: Distortion = (0.0, 0.0, 0.0, 0.0, 0.0)
 UNDISTORT_ITERATIONS = 20
+VALID_MARGIN = 1.15  # projected points are kept up to this factor past the image corners' radius
 
 
 def is_pinhole(distortion: Distortion) -> bool:
@@ -28,6 +29,17 @@ def distort(x: FloatArray, y: FloatArray, distortion: Distortion) -> tuple[Float
     x_d = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
     y_d = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
     return x_d, y_d
+
+
+def valid_radius2(distortion: Distortion, corner_r2: float) -> float:
+    """Largest squared ideal radius the lens model may map: a margin past the image's corners (``corner_r2``), and
+    never past the radius where the polynomial turns back (beyond it, points far outside the view would fold
+    back into the image)."""
+    k1, k2, _, _, k3 = distortion
+    r2 = np.linspace(0.0, 4.0 * max(corner_r2, 1e-6), 4001)
+    slope = 1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2**2 + 7.0 * k3 * r2**3  # d(r * radial(r)) / dr
+    turning = r2[np.argmax(slope <= 0.05)] if np.any(slope <= 0.05) else np.inf
+    return float(min(VALID_MARGIN**2 * corner_r2, turning))
 
 
 def undistort(x_d: FloatArray, y_d: FloatArray, distortion: Distortion) -> tuple[FloatArray, FloatArray]:

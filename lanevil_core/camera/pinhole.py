@@ -8,6 +8,7 @@ is at (col + 0.5, row + 0.5).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from ..case import Camera, Case
 from ..road_geometry import ReferenceLine
 from ..road_layout import RoadNetwork
 from ..typed import FloatArray
-from .lens import NO_DISTORTION, Distortion, distort, is_pinhole
+from .lens import NO_DISTORTION, Distortion, distort, is_pinhole, undistort, valid_radius2
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,11 @@ class PinholeCamera:
         return is_pinhole(self.distortion)
 
     @property
+    def valid_radius2(self) -> float:
+        """Squared ideal (undistorted) radius up to which ``project`` maps points through the lens."""
+        return _valid_radius2(self.intrinsics, self.distortion)
+
+    @property
     def R_world_camera(self) -> FloatArray:
         return self.T_world_camera[:3, :3]
 
@@ -89,7 +95,9 @@ class PinholeCamera:
         k = self.intrinsics
         x_norm, y_norm = p_camera[..., 0] / safe, p_camera[..., 1] / safe
         if not self.pinhole:
+            outside = x_norm**2 + y_norm**2 > self.valid_radius2  # where the lens model stops holding
             x_norm, y_norm = distort(x_norm, y_norm, self.distortion)
+            x_norm, y_norm = np.where(outside, np.nan, x_norm), np.where(outside, np.nan, y_norm)
         return np.stack([k.fx * x_norm + k.cx, k.fy * y_norm + k.cy], axis=-1), depth
 
     def ray_directions_camera(self) -> FloatArray:
@@ -107,6 +115,15 @@ class PinholeCamera:
             fov = 2 * np.degrees(np.arctan(0.5 * k.width / k.fx))
             return PinholeCamera(Intrinsics.from_fov(width, height, fov), self.T_world_camera, self.near)
         return PinholeCamera(k.scaled(width, height), self.T_world_camera, self.near, self.distortion)
+
+
+@lru_cache(maxsize=64)
+def _valid_radius2(intrinsics: Intrinsics, distortion: Distortion) -> float:
+    k = intrinsics
+    u = np.array([0.0, k.width, 0.0, k.width])
+    v = np.array([0.0, 0.0, k.height, k.height])
+    x, y = undistort((u - k.cx) / k.fx, (v - k.cy) / k.fy, distortion)
+    return valid_radius2(distortion, float(np.max(x * x + y * y)))
 
 
 def _is_centred_fov(camera: Camera) -> bool:

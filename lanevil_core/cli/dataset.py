@@ -8,6 +8,7 @@ import os
 import sys
 from pathlib import Path
 
+from ..presets import CAMERA_PRESET_NAMES
 from .base import Command, UsageError, count, parse_size
 
 
@@ -35,6 +36,12 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-paint", action="store_true",
                         help="also render every original test case with its lane paint removed "
                              "(<case>_nopaint folders, records with \"paint\": false): the paint-free control")
+    parser.add_argument("--camera", choices=CAMERA_PRESET_NAMES, default=None,
+                        help="see every case through this camera preset (lens, bonnet, sensor; default: each case's "
+                        "own camera)")
+    parser.add_argument("--vary-camera", action="store_true",
+                        help="train variations draw their camera and sensor: HFOV 45-100, height 1.2-3.5 m, pitch "
+                        "-2..6, roll +-2, bonnet on/off, lens, exposure, noise, blur, colour, compression")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -56,7 +63,7 @@ def _run_dataset(args: argparse.Namespace) -> int:
         executor = LocalPool(args.workers)
     settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
                         train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint,
-                        sampling=args.sampling)
+                        sampling=args.sampling, camera=args.camera, vary_camera=args.vary_camera)
     try:
         summary = generate_dataset(args.cases, args.out, settings, executor, show_progress=not args.quiet)
     except (PlanError, SchedulerError) as error:

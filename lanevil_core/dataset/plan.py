@@ -26,9 +26,10 @@ from typing import Any
 import numpy as np
 
 from ..benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, case_folder, case_illusion_type, frame_file
+from ..camera.variation import random_camera
 from ..case import Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
-from ..presets import PRESET_NAMES, preset_values
+from ..presets import PRESET_NAMES, camera_preset_values, preset_values
 from ..typed import LineType
 
 TEST_SPLIT = "test"
@@ -74,6 +75,8 @@ class Settings:
     seed: int = 0
     no_paint: bool = False  # also render every original with its lane paint removed (the paint-free control)
     sampling: str = "in_view"  # test frames: "in_view" of each type's level-5 illusion, or "even" over the drive
+    camera: str | None = None  # a camera preset every case is seen through (None: each case's own camera)
+    vary_camera: bool = False  # train variations draw their camera and sensor (camera.variation.random_camera)
 
     @property
     def suffix(self) -> str:
@@ -260,6 +263,16 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
 NO_PAINT_SUFFIX = "_nopaint"
 
 
+def seen_through(planned: PlannedCase, preset: str) -> PlannedCase:
+    """The same case and frames seen through the named camera preset (``--camera``)."""
+    data = parse_case(planned.case_text).model_dump()
+    try:
+        data["camera"] = camera_preset_values(preset)
+    except KeyError as error:
+        raise PlanError(f"camera: {error.args[0]}") from None
+    return replace(planned, case_text=case_json(parse_case(data)), source={**planned.source, "camera": preset})
+
+
 def paint_free(planned: PlannedCase) -> PlannedCase:
     """The same case and frames with every lane marking removed from the world, in ``<folder>_nopaint``."""
     data = parse_case(planned.case_text).model_dump()
@@ -299,8 +312,9 @@ def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
     return camera
 
 
-def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, Any]]:
-    """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``."""
+def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False) -> tuple[Case, dict[str, Any]]:
+    """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``; with
+    ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same)."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -316,23 +330,29 @@ def train_variation(base: Case, seed: int, index: int) -> tuple[Case, dict[str, 
     start_s = round(float(rng.uniform(0.0, latest_start)), 1)
     case_seed = int(rng.integers(0, 2**32))
     camera = _camera_mount(base, rng)
+    markings = _markings(lanes_per_direction, rng)
+    if vary_camera:
+        camera = {**random_camera(rng), "width": base.camera.width, "height": base.camera.height}
     data = base.model_dump()
     data["camera"] = camera
     data["weather"] = values["weather"]
     data["sun"] = {**values["sun"], "azimuth": azimuth, "altitude": round(altitude, 1)}
     data["road"].update(lanes_per_direction=lanes_per_direction, lane_width=lane_width,
-                        markings=_markings(lanes_per_direction, rng))
+                        markings=markings)
     data["ego"].update(lane=lane, start_s=start_s)
     data["seed"] = case_seed
     data["title"] = f"{base.title} ({preset}, variation {index})"
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
                   "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
-                  "lane_width": lane_width, "camera": {k: camera[k] for k in ("y", "z", "pitch", "yaw")},
+                  "lane_width": lane_width,
+                  "camera": {k: camera[k] for k in (("fov", "x", "y", "z", "pitch", "yaw", "roll") if vary_camera
+                                                   else ("y", "z", "pitch", "yaw")) if k in camera},
                   "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters
 
 
-def train_cases(clean: list[SourceCase], train_frames: int, seed: int) -> list[PlannedCase]:
+def train_cases(clean: list[SourceCase], train_frames: int, seed: int,
+                vary_camera: bool = False) -> list[PlannedCase]:
     """``train_frames`` frames over variations of the clean cases (bases taken in turn, so every road type,
     scene and line type of the clean library recurs)."""
     if train_frames <= 0:
@@ -342,7 +362,7 @@ def train_cases(clean: list[SourceCase], train_frames: int, seed: int) -> list[P
     planned = []
     for index in range(math.ceil(train_frames / TRAIN_FRAMES_PER_VARIANT)):
         base = clean[index % len(clean)]
-        case, parameters = train_variation(base.case, seed, index)
+        case, parameters = train_variation(base.case, seed, index, vary_camera)
         count = min(TRAIN_FRAMES_PER_VARIANT, train_frames - index * TRAIN_FRAMES_PER_VARIANT)
         folder = PurePosixPath(f"{index:05d}_{base.relative.stem}_{parameters['preset']}")
         planned.append(PlannedCase(
@@ -378,7 +398,10 @@ def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = t
                                  chosen.get(str(source.relative.parent))) for source in typed]
     if settings.no_paint:
         planned += [paint_free(case) for case in planned if case.severity == 0]
-    planned += train_cases(clean, settings.train_frames, settings.seed)
+    planned += train_cases(clean, settings.train_frames, settings.seed, settings.vary_camera)
+    if settings.camera is not None:  # every case through one camera; drawn train cameras stay drawn
+        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, settings.camera)
+                   for case in planned]
     if not planned:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
     _check_unique(planned)

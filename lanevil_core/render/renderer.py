@@ -282,8 +282,19 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
         if sensor.sharpen > 0.0:
             soft = cv2.GaussianBlur(rgb, (0, 0), 1.0)
             rgb = np.asarray(cv2.addWeighted(rgb, 1.0 + sensor.sharpen, soft, -sensor.sharpen, 0.0), np.uint8)
+        if sensor.compression is not None:
+            rgb = recompressed(rgb, sensor.compression)
     lap("post")
     return Frame(rgb, depth, object_id, camera, timings)
+
+
+def recompressed(rgb: UInt8Array, quality: int) -> UInt8Array:
+    """(H, W, 3) uint8 through a JPEG encoder at ``quality`` and back: the blocks and ringing of compressed video."""
+    ok, data = cv2.imencode(".jpg", np.ascontiguousarray(rgb[..., ::-1]), [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
+    decoded = cv2.imdecode(data, cv2.IMREAD_COLOR) if ok else None
+    if decoded is None:  # pragma: no cover - OpenCV always encodes and decodes a uint8 image
+        raise RuntimeError("JPEG round trip failed")
+    return np.ascontiguousarray(np.asarray(decoded, np.uint8)[..., ::-1])
 
 
 def _noise_seed(case_seed: int, frame: int) -> int:

@@ -135,3 +135,30 @@ def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: C
         grey = frame.rgb.mean(axis=-1)[frame.object_id == ID_ROAD]
         ratios.append(np.percentile(grey, 10) / np.percentile(grey, 90))
     assert ratios[1] < ratios[0]
+
+
+def test_points_beyond_the_lens_models_reach_are_not_projected_into_the_image() -> None:
+    """A strong barrel polynomial turns back far off axis; points there must not fold back into the image."""
+    camera = mounted_camera(Camera(fov=100.0, x=0.0, z=1.5, lens={"k1": -0.22, "k2": 0.0}), np.eye(4))
+    angles = np.radians(np.arange(-89.0, 90.0, 1.0))
+    p_world = np.stack([np.cos(angles) * 10.0, np.sin(angles) * 10.0, np.full_like(angles, 1.5)], axis=1)
+    uv, _ = camera.project(p_world)
+    inside = np.isfinite(uv[:, 0]) & (uv[:, 0] >= 0) & (uv[:, 0] < camera.intrinsics.width)
+    assert np.all(np.abs(np.degrees(angles[inside])) < 55.0)  # half the 100-degree view, plus the margin
+    u = uv[np.isfinite(uv[:, 0]), 0]
+    assert np.all(np.diff(u) < 0)  # left to right in the world is right to left in y: monotone, no fold
+
+
+def test_vary_camera_draws_cameras_within_the_ranges_and_keeps_the_rest_of_the_variation() -> None:
+    from lanevil_core.dataset.plan import train_variation
+
+    base = Case()
+    for index in range(12):
+        plain, plain_parameters = train_variation(base, 3, index)
+        varied, parameters = train_variation(base, 3, index, vary_camera=True)
+        assert varied.sun == plain.sun and varied.road == plain.road and varied.seed == plain.seed
+        camera = varied.camera
+        assert 45.0 <= camera.fov <= 100.0 and 1.2 <= camera.z <= 3.5 and -2.0 <= camera.pitch <= 6.0
+        assert -2.0 <= camera.roll <= 2.0 and camera.sensor is not None
+        assert parameters["camera"]["fov"] == camera.fov and plain_parameters["camera"].keys() == {"y", "z", "pitch",
+                                                                                                   "yaw"}

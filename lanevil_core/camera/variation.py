@@ -1,0 +1,60 @@
+"""Random cameras for a train split that sees every camera a detector may meet: a preset as the base (its lens,
+bonnet and sensor), then the mount, field of view, lens, bonnet, exposure, noise, blur, colour and compression
+drawn from ranges around real dash and front cameras. Every call makes the same number of draws, so what a caller
+draws afterwards does not shift."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..presets import CAMERA_PRESET_NAMES, camera_preset_values
+
+HFOV_DEG = (45.0, 100.0)
+HEIGHT_M = (1.2, 3.5)
+AHEAD_M = (0.4, 2.0)
+PITCH_DEG = (-2.0, 6.0)  # positive looks down
+ROLL_DEG = (-2.0, 2.0)
+YAW_DEG = (-2.0, 2.0)
+BONNET_SHARE = 0.4
+BONNET_REACH_M = (1.8, 2.8)
+BONNET_DROP_M = (0.35, 0.7)
+K1 = (-0.22, 0.0)
+K2 = (0.0, 0.05)
+EXPOSURE_BIAS_EV = (-0.8, 0.8)
+NOISE = (0.3, 3.0)
+SHUTTER_S = (0.0, 0.012)
+VIGNETTING = (0.0, 0.55)
+SATURATION = (1.05, 1.75)
+CONTRAST = (0.95, 1.3)
+WHITE_BALANCE_K = (4500.0, 7500.0)
+SHARPEN = (0.0, 1.2)
+COMPRESSION_SHARE = 0.6
+JPEG_QUALITY = (35, 95)
+DRAWS = 23
+
+
+def _pick(u: float, lo_hi: tuple[float, float], digits: int = 3) -> float:
+    lo, hi = lo_hi
+    return round(lo + (hi - lo) * u, digits)
+
+
+def random_camera(rng: np.random.Generator) -> dict[str, Any]:
+    """Camera fields (a dict for ``Case.camera``) drawn from the ranges above, always ``DRAWS`` uniform draws."""
+    u = rng.uniform(0.0, 1.0, DRAWS)
+    camera = camera_preset_values(CAMERA_PRESET_NAMES[int(u[0] * len(CAMERA_PRESET_NAMES))])
+    camera.update(fov=_pick(u[1], HFOV_DEG, 1), z=_pick(u[2], HEIGHT_M, 2), x=_pick(u[3], AHEAD_M, 2),
+                  pitch=_pick(u[4], PITCH_DEG, 2), roll=_pick(u[5], ROLL_DEG, 2), yaw=_pick(u[6], YAW_DEG, 2),
+                  lens={"k1": _pick(u[7], K1, 4), "k2": _pick(u[8], K2, 4)})
+    camera["bonnet"] = ({"reach": _pick(u[10], BONNET_REACH_M, 2), "drop": _pick(u[11], BONNET_DROP_M, 2)}
+                        if u[9] < BONNET_SHARE else None)
+    camera["sensor"] = {
+        "bias": _pick(u[12], EXPOSURE_BIAS_EV, 2), "noise": _pick(u[13], NOISE, 2),
+        "shutter": _pick(u[14], SHUTTER_S, 4), "vignetting": _pick(u[15], VIGNETTING, 2),
+        "saturation": _pick(u[16], SATURATION, 2), "contrast": _pick(u[17], CONTRAST, 2),
+        "white_balance": _pick(u[18], WHITE_BALANCE_K, 0), "sharpen": _pick(u[19], SHARPEN, 2),
+        "compression": int(round(_pick(u[21], JPEG_QUALITY, 0))) if u[20] < COMPRESSION_SHARE else None,
+    }
+    # u[22] is kept for the next field a variation gains, so adding it will not shift the others.
+    return camera
