@@ -50,7 +50,7 @@ test-browser: $(STAMP)
 MODELS_DATA ?= out/models-data
 SHIPPED := lanevil_core/detect/models
 models: $(STAMP)
-	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA) --train-frames 4000 --size 640x360
+	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA) --train-frames 4000 --size 640x360 --vary-camera
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
 	for family in ufld seg; do mkdir -p $(SHIPPED)/$$family && \

@@ -47,6 +47,7 @@ SUN_ALTITUDE_JITTER_DEG = 10.0
 # mount (lateral offset in the lane, height, pitch, yaw), lane count and width vary, and lines go unpainted: an
 # edge line, the lane lines of a variation, or (rarely) every line. An unpainted boundary has no label.
 CAMERA_JITTER_SHARE = 0.5
+VARIED_CAMERA_SHARE = 0.75  # --vary-camera: share of train variations seen through a drawn camera
 CAMERA_Y_RANGE_M = (-0.7, 0.7)
 CAMERA_Z_RANGE_M = (1.4, 3.2)
 CAMERA_PITCH_RANGE_DEG = (0.0, 4.0)
@@ -314,7 +315,8 @@ def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
 
 def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False) -> tuple[Case, dict[str, Any]]:
     """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``; with
-    ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same)."""
+    ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same), and
+    used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's)."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -331,8 +333,9 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     case_seed = int(rng.integers(0, 2**32))
     camera = _camera_mount(base, rng)
     markings = _markings(lanes_per_direction, rng)
-    if vary_camera:
-        camera = {**random_camera(rng), "width": base.camera.width, "height": base.camera.height}
+    drawn = {**random_camera(rng), "width": base.camera.width, "height": base.camera.height} if vary_camera else None
+    if drawn is not None and rng.uniform() < VARIED_CAMERA_SHARE:
+        camera = drawn
     data = base.model_dump()
     data["camera"] = camera
     data["weather"] = values["weather"]
@@ -345,8 +348,7 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
                   "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
                   "lane_width": lane_width,
-                  "camera": {k: camera[k] for k in (("fov", "x", "y", "z", "pitch", "yaw", "roll") if vary_camera
-                                                   else ("y", "z", "pitch", "yaw")) if k in camera},
+                  "camera": {k: camera[k] for k in ("fov", "x", "y", "z", "pitch", "yaw", "roll") if k in camera},
                   "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters
 

@@ -153,12 +153,16 @@ def test_vary_camera_draws_cameras_within_the_ranges_and_keeps_the_rest_of_the_v
     from lanevil_core.dataset.plan import train_variation
 
     base = Case()
-    for index in range(12):
+    drawn = 0
+    for index in range(24):
         plain, plain_parameters = train_variation(base, 3, index)
         varied, parameters = train_variation(base, 3, index, vary_camera=True)
         assert varied.sun == plain.sun and varied.road == plain.road and varied.seed == plain.seed
         camera = varied.camera
+        if camera.sensor is None:  # one of the variations kept on the base's camera
+            assert camera == plain.camera
+            continue
+        drawn += 1
         assert 45.0 <= camera.fov <= 100.0 and 1.2 <= camera.z <= 3.5 and -2.0 <= camera.pitch <= 6.0
-        assert -2.0 <= camera.roll <= 2.0 and camera.sensor is not None
-        assert parameters["camera"]["fov"] == camera.fov and plain_parameters["camera"].keys() == {"y", "z", "pitch",
-                                                                                                   "yaw"}
+        assert -2.0 <= camera.roll <= 2.0 and parameters["camera"]["fov"] == camera.fov
+    assert 12 <= drawn < 24
