@@ -19,11 +19,11 @@ import numpy as np
 import viser
 
 from lanevil_core.camera import ego_camera
-from lanevil_core.case import Case, CaseError, parse_case
+from lanevil_core.case import Bonnet, Case, CaseError, Sensor, parse_case
 from lanevil_core.compile import roadside_key
 from lanevil_core.illusions import REGISTRY, Illusion
 from lanevil_core.metrics.formats import LaneFileError
-from lanevil_core.presets import preset_values
+from lanevil_core.presets import camera_preset_values, preset_values
 from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.scene import CompiledScene
 
@@ -32,7 +32,7 @@ from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
 from .detection import chosen_detector, detection_text, unavailable_text
 from .drive_panel import DrivePanel
-from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
+from .panel import CUSTOM_CAMERA, CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
 from .scene_view import SceneView
@@ -129,7 +129,17 @@ class Editor:
                  "sun_azimuth": lambda e: self.set_sun(azimuth=float(e.target.value)),
                  "sun_altitude": lambda e: self.set_sun(altitude=float(e.target.value)),
                  "sun_intensity": lambda e: self.set_sun(intensity=float(e.target.value)),
-                 "weather": lambda e: self.set_weather_preset(str(e.target.value))}
+                 "weather": lambda e: self.set_weather_preset(str(e.target.value)),
+                 "camera_preset": lambda e: self.set_camera_preset(str(e.target.value)),
+                 "camera_fov": lambda e: self.set_camera(fov=float(e.target.value)),
+                 "camera_height": lambda e: self.set_camera(z=float(e.target.value)),
+                 "camera_pitch": lambda e: self.set_camera(pitch=float(e.target.value)),
+                 "camera_roll": lambda e: self.set_camera(roll=float(e.target.value)),
+                 "camera_k1": lambda e: self.set_lens(k1=float(e.target.value)),
+                 "camera_bonnet": lambda e: self.set_camera_part("bonnet", bool(e.target.value)),
+                 "camera_sensor": lambda e: self.set_camera_part("sensor", bool(e.target.value)),
+                 "camera_exposure": lambda e: self.set_sensor(bias=float(e.target.value)),
+                 "camera_noise": lambda e: self.set_sensor(noise=float(e.target.value))}
         for name, action in value.items():
             getattr(p, name).on_update(self._guarded(action))
         clicks = {"save": lambda e: self.save(), "save_copy": lambda e: self.save_as_new(),
@@ -328,6 +338,45 @@ class Editor:
         data["sun"].update({k: v for k, v in values["sun"].items() if k != "azimuth"})
         self._edit(data, f"weather {name}")
 
+    def set_camera_preset(self, name: str) -> None:
+        """See the case through a named camera (its mount, field of view, lens, bonnet and sensor)."""
+        if name == CUSTOM_CAMERA:
+            return
+        try:
+            values = camera_preset_values(name)
+        except KeyError as error:
+            raise EditError(f"camera: {error.args[0]}") from None
+        data = self._data()
+        data["camera"] = {**data["camera"], "lens": {}, "bonnet": None, "sensor": None, **values}
+        self._edit(data, f"camera {name}")
+
+    def set_camera(self, **changes: float) -> None:
+        """Change camera fields (``fov``, ``z``, ``pitch``, ``roll`` ...)."""
+        data = self._data()
+        data["camera"].update(changes)
+        self._edit(data, "camera " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+
+    def set_lens(self, **changes: float) -> None:
+        data = self._data()
+        data["camera"]["lens"].update(changes)
+        self._edit(data, "lens " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+
+    def set_camera_part(self, part: str, on: bool) -> None:
+        """Put the ``bonnet`` or the ``sensor`` in (with its defaults) or take it out."""
+        data = self._data()
+        if on == (data["camera"][part] is not None):
+            return
+        defaults = {"bonnet": Bonnet, "sensor": Sensor}[part]
+        data["camera"][part] = defaults().model_dump(mode="json") if on else None
+        self._edit(data, f"{part} {'on' if on else 'off'}")
+
+    def set_sensor(self, **changes: float) -> None:
+        data = self._data()
+        if data["camera"]["sensor"] is None:
+            raise EditError("sensor: tick Real sensor first")
+        data["camera"]["sensor"].update(changes)
+        self._edit(data, "sensor " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+
     # ------------------------------------------------------------------------------------------ view
 
     def set_frame(self, frame: int) -> None:
@@ -463,6 +512,17 @@ class Editor:
             p.sun_azimuth.value = _wrap_degrees(case.sun.azimuth)
             p.sun_altitude.value = float(np.clip(case.sun.altitude, p.sun_altitude.min, p.sun_altitude.max))
             p.sun_intensity.value = case.sun.intensity
+            camera = case.camera
+            for handle, value in ((p.camera_fov, camera.hfov), (p.camera_height, camera.z),
+                                  (p.camera_pitch, camera.pitch), (p.camera_roll, camera.roll),
+                                  (p.camera_k1, camera.lens.k1)):
+                handle.value = float(np.clip(value, handle.min, handle.max))
+            p.camera_bonnet.value = camera.bonnet is not None
+            p.camera_sensor.value = camera.sensor is not None
+            p.camera_exposure.disabled = p.camera_noise.disabled = camera.sensor is None
+            if camera.sensor is not None:
+                p.camera_exposure.value = camera.sensor.bias
+                p.camera_noise.value = float(np.clip(camera.sensor.noise, p.camera_noise.min, p.camera_noise.max))
             p.frame.max = case.ego.frames - 1
             p.frame.value = self.frame
             p.undo.disabled, p.redo.disabled = not session.can_undo, not session.can_redo

@@ -12,7 +12,7 @@ import numpy as np
 import viser
 
 from lanevil_core.illusions import ILLUSION_TYPES
-from lanevil_core.presets import PRESET_NAMES
+from lanevil_core.presets import CAMERA_PRESET_NAMES, PRESET_NAMES
 from lanevil_core.typed import ROAD_TYPES, SCENE_KINDS
 
 from .detection import DETECTOR_CHOICES, NO_DETECTOR
@@ -22,6 +22,7 @@ from .preview import PREVIEW_SIZE
 PLACE_OFF = "(pick a type, then click the road)"
 NO_SELECTION = "(none)"
 CUSTOM_WEATHER = "(as in the case)"
+CUSTOM_CAMERA = "(the case's camera)"
 HELP = """**LanEvil editor** — build a lane-detection test case in 3D.
 
 1. *Case*: open a stored case or create one from a road template.
@@ -56,6 +57,16 @@ class Panel:
     sun_altitude: viser.GuiSliderHandle
     sun_intensity: viser.GuiSliderHandle
     weather: viser.GuiDropdownHandle
+    camera_preset: viser.GuiDropdownHandle
+    camera_fov: viser.GuiSliderHandle
+    camera_height: viser.GuiSliderHandle
+    camera_pitch: viser.GuiSliderHandle
+    camera_roll: viser.GuiSliderHandle
+    camera_k1: viser.GuiSliderHandle
+    camera_bonnet: viser.GuiCheckboxHandle
+    camera_sensor: viser.GuiCheckboxHandle
+    camera_exposure: viser.GuiSliderHandle
+    camera_noise: viser.GuiSliderHandle
     frame: viser.GuiSliderHandle
     play: viser.GuiCheckboxHandle
     overlay: viser.GuiCheckboxHandle
@@ -113,6 +124,21 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         sun_intensity = gui.add_slider("Sun intensity", 0.0, 3.0, 0.05, 1.0, hint="1 = clear noon")
         weather = gui.add_dropdown("Weather preset", [CUSTOM_WEATHER, *PRESET_NAMES],
                                    hint="fills cloud, rain, puddles, fog and the sun's height")
+    with gui.add_folder("Camera", expand_by_default=False):
+        camera_preset = gui.add_dropdown("Camera preset", [CUSTOM_CAMERA, *CAMERA_PRESET_NAMES],
+                                         hint="the paper's CARLA camera, a TuSimple- or CULane-like front camera or "
+                                              "a dash cam: field of view, mount, lens, bonnet and sensor")
+        camera_fov = gui.add_slider("Field of view", 30.0, 120.0, 0.5, 90.0, hint="horizontal, degrees")
+        camera_height = gui.add_slider("Mount height", 0.5, 6.0, 0.05, 3.0, hint="above the road (m)")
+        camera_pitch = gui.add_slider("Pitch", -10.0, 15.0, 0.1, 0.0, hint="degrees, positive looks down")
+        camera_roll = gui.add_slider("Roll", -10.0, 10.0, 0.1, 0.0, hint="degrees about the optical axis")
+        camera_k1 = gui.add_slider("Lens k1", -0.3, 0.1, 0.005, 0.0,
+                                   hint="radial distortion (negative: a wide lens's barrel); labels follow it")
+        camera_bonnet = gui.add_checkbox("Bonnet in view", False, hint="the ego's hood; labels stop at its edge")
+        camera_sensor = gui.add_checkbox("Real sensor", False,
+                                         hint="auto-exposure, filmic response, noise, motion blur, texture")
+        camera_exposure = gui.add_slider("Exposure bias", -3.0, 3.0, 0.1, 0.0, hint="EV (real sensor)")
+        camera_noise = gui.add_slider("Sensor noise", 0.0, 5.0, 0.1, 1.0, hint="1 = a typical small sensor")
     with gui.add_folder("Export", expand_by_default=False):
         export_case = gui.add_button("Case JSON", icon=viser.Icon.FILE_DOWNLOAD)
         export_frame = gui.add_button("Current frame (PNG + labels)", icon=viser.Icon.PHOTO)
@@ -123,6 +149,9 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
                  selected=selected, severity=severity, delete=delete,
                  params=ParamInputs(gui, params_folder, lambda name, value: None),
                  sun_azimuth=sun_azimuth, sun_altitude=sun_altitude, sun_intensity=sun_intensity, weather=weather,
-                 frame=frame, play=play, overlay=overlay, detector=detector, preview=preview,
+                 camera_preset=camera_preset, camera_fov=camera_fov, camera_height=camera_height,
+                 camera_pitch=camera_pitch, camera_roll=camera_roll, camera_k1=camera_k1, camera_bonnet=camera_bonnet,
+                 camera_sensor=camera_sensor, camera_exposure=camera_exposure, camera_noise=camera_noise, frame=frame,
+                 play=play, overlay=overlay, detector=detector, preview=preview,
                  preview_info=preview_info, detection=detection,
                  export_case=export_case, export_frame=export_frame, export_sequence=export_sequence)

@@ -320,3 +320,22 @@ def test_partial_recompile_equals_a_full_compile(illusion: dict) -> None:
         np.testing.assert_array_equal(a.rgba, b.rgba)
     np.testing.assert_allclose(partial.env.sun_dir_world, full.env.sun_dir_world)
     assert partial.env.sun_intensity == full.env.sun_intensity and len(partial.lights) == len(full.lights)
+
+
+def test_camera_controls_change_the_case_camera_and_the_preview(editor: Editor) -> None:
+    before = settle(editor)
+    editor.panel.camera_preset.value = "dashcam"
+    after = settle(editor)
+    camera = editor.case.camera
+    assert camera.fov == 58.0 and camera.bonnet is not None and camera.sensor is not None and camera.lens.k1 < 0
+    assert editor.panel.camera_bonnet.value and editor.panel.camera_sensor.value
+    assert np.abs(after.astype(int) - before.astype(int)).mean() > 5.0
+    editor.panel.camera_fov.value = 70.0
+    editor.panel.camera_roll.value = 1.5
+    editor.panel.camera_exposure.value = 1.0
+    assert (editor.case.camera.fov, editor.case.camera.roll, editor.case.camera.sensor.bias) == (70.0, 1.5, 1.0)
+    editor.panel.camera_bonnet.value = False
+    editor.panel.camera_sensor.value = False
+    settle(editor)
+    assert editor.case.camera.bonnet is None and editor.case.camera.sensor is None
+    assert editor.panel.camera_exposure.disabled

@@ -119,3 +119,27 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     time.sleep(1)
     page.screenshot(path=str(screenshot_dir / "editor_4_detector.png"), timeout=SHOT_MS)
     page.close()
+
+
+def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, screenshot_dir: Path) -> None:
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(SHOT_MS)
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    preview = page.locator("img[src^='blob:']").first
+    preview.wait_for(timeout=WAIT_S * 1000)
+    assert editor.preview.wait_idle(WAIT_S)
+    time.sleep(2)
+    before = preview.screenshot(timeout=SHOT_MS)
+    page.get_by_text("Camera", exact=True).first.click()  # open the folder
+    pick(page, "(the case's camera)", "dashcam")
+    wait_for(lambda: editor.case.camera.bonnet is not None, "the dash cam's bonnet in the case")
+    assert editor.preview.wait_idle(WAIT_S)
+    time.sleep(2)
+    after = preview.screenshot(timeout=SHOT_MS)
+    assert after != before, "the preview did not change with the camera preset"
+    assert page.get_by_label("Bonnet in view").is_checked()
+    page.mouse.move(400, 450)
+    time.sleep(1)
+    page.screenshot(path=str(screenshot_dir / "editor_5_camera.png"), timeout=SHOT_MS)
+    page.close()
