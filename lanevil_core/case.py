@@ -222,6 +222,19 @@ class Camera(_Model):
         rest, values = taken
         return {**values, **rest}
 
+    @model_validator(mode="after")
+    def _check_lens(self) -> Camera:
+        from .camera.lens import covers  # the camera package builds on this model
+
+        f = self.focal_px
+        cx = self.cx if self.cx is not None else self.width / 2
+        cy = self.cy if self.cy is not None else self.height / 2
+        corner = math.hypot(max(cx, self.width - cx) / f, max(cy, self.height - cy) / f)
+        if not covers(self.lens.coefficients, corner):
+            raise ValueError("lens: this distortion turns back inside the image at this field of view "
+                             "(weaken k1/k2/k3 or narrow the view)")
+        return self
+
     @property
     def focal_px(self) -> float:
         """Focal length in pixels at ``width`` (from ``focal``, else from the horizontal FOV)."""

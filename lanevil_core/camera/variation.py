@@ -5,11 +5,13 @@ draws afterwards does not shift."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from ..presets import CAMERA_PRESET_NAMES, camera_preset_values
+from .lens import covers
 
 HFOV_DEG = (45.0, 100.0)
 HEIGHT_M = (1.2, 3.5)
@@ -57,4 +59,16 @@ def random_camera(rng: np.random.Generator) -> dict[str, Any]:
         "compression": int(round(_pick(u[21], JPEG_QUALITY, 0))) if u[20] < COMPRESSION_SHARE else None,
     }
     # u[22] is kept for the next field a variation gains, so adding it will not shift the others.
+    camera["lens"] = _within_view(camera["lens"], camera["fov"], camera["width"], camera["height"])
     return camera
+
+
+def _within_view(lens: dict[str, float], fov: float, width: int, height: int) -> dict[str, float]:
+    """The drawn lens, weakened by halves until it covers the whole image at ``fov`` (a strong barrel on a wide
+    view would turn back inside the image)."""
+    focal = 0.5 * width / math.tan(math.radians(fov) / 2)
+    corner = math.hypot(width / 2, height / 2) / focal
+    k1, k2 = lens["k1"], lens["k2"]
+    while not covers((k1, k2, 0.0, 0.0, 0.0), corner):
+        k1, k2 = round(k1 / 2, 4), round(k2 / 2, 4)
+    return {"k1": k1, "k2": k2}

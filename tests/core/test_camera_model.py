@@ -139,12 +139,12 @@ def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: C
 
 def test_points_beyond_the_lens_models_reach_are_not_projected_into_the_image() -> None:
     """A strong barrel polynomial turns back far off axis; points there must not fold back into the image."""
-    camera = mounted_camera(Camera(fov=100.0, x=0.0, z=1.5, lens={"k1": -0.22, "k2": 0.0}), np.eye(4))
+    camera = mounted_camera(Camera(fov=70.0, x=0.0, z=1.5, lens={"k1": -0.15, "k2": 0.0}), np.eye(4))
     angles = np.radians(np.arange(-89.0, 90.0, 1.0))
     p_world = np.stack([np.cos(angles) * 10.0, np.sin(angles) * 10.0, np.full_like(angles, 1.5)], axis=1)
     uv, _ = camera.project(p_world)
     inside = np.isfinite(uv[:, 0]) & (uv[:, 0] >= 0) & (uv[:, 0] < camera.intrinsics.width)
-    assert np.all(np.abs(np.degrees(angles[inside])) < 55.0)  # half the 100-degree view, plus the margin
+    assert np.all(np.abs(np.degrees(angles[inside])) < 45.0)  # half the 70-degree view, plus the margin
     u = uv[np.isfinite(uv[:, 0]), 0]
     assert np.all(np.diff(u) < 0)  # left to right in the world is right to left in y: monotone, no fold
 
@@ -166,3 +166,15 @@ def test_vary_camera_draws_cameras_within_the_ranges_and_keeps_the_rest_of_the_v
         assert 45.0 <= camera.fov <= 100.0 and 1.2 <= camera.z <= 3.5 and -2.0 <= camera.pitch <= 6.0
         assert -2.0 <= camera.roll <= 2.0 and parameters["camera"]["fov"] == camera.fov
     assert 12 <= drawn < 24
+
+
+def test_a_lens_that_turns_back_inside_the_image_is_refused_and_drawn_lenses_cover_their_view() -> None:
+    from lanevil_core.camera.cover import cover_camera
+    from lanevil_core.camera.variation import random_camera
+
+    with pytest.raises(CaseError, match=r"camera: lens: .*turns back inside the image"):
+        parse_case({"camera": {"fov": 100.0, "lens": {"k1": -0.3}}})
+    for index in range(40):
+        camera = Camera.model_validate(random_camera(np.random.default_rng([7, index])))
+        cover = cover_camera(mounted_camera(camera, np.eye(4), (320, 180))).intrinsics
+        assert cover.width * cover.height < 4 * 320 * 180
