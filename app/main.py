@@ -8,6 +8,7 @@ from fastapi.responses import RedirectResponse
 from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
+from .api.allow import AllowMiddleware
 from .api.errors import error_response, handle_exception
 from .docs import mount_docs
 from .jobs import JobNotFound
@@ -27,6 +28,7 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
                   description="Editable 3D lane-detection robustness cases: store, render, export, study. Errors of "
                               "`/api` answer `{\"detail\": \"<field>: <message>\", \"field\": \"<field>\"}`.")
     app.state.lanevil = state
+    app.add_middleware(AllowMiddleware)
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes,
                        max_upload_bytes=settings.max_upload_bytes)
     for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route

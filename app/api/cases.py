@@ -25,7 +25,7 @@ from lanevil_core.illusions import CATEGORIES, REGISTRY
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id
 from .deps import CaseIdPath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
-from .params import etag_matches, parse_version
+from .params import VERSION_PATTERN, etag_matches, parse_version
 
 router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
@@ -37,7 +37,8 @@ NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "descrip
 
 CaseBody = Annotated[dict[str, Any], Body(description="a case document, or an envelope {id?, version?, case}",
                                           openapi_examples={"case": {"value": {"title": "my case"}}})]
-IfMatch = Annotated[str | None, Header(alias="If-Match", description='the version the change is based on: "3"')]
+IfMatch = Annotated[str | None, Header(alias="If-Match", description='the version the change is based on: "3"',
+                                       json_schema_extra={"pattern": VERSION_PATTERN})]
 
 
 def record_response(record: CaseRecord, status_code: int = 200, headers: dict[str, str] | None = None) -> JSONResponse:
@@ -102,7 +103,9 @@ def list_cases(
     category: Annotated[str | None, Query(description=f"one of {', '.join(LISTING_CATEGORIES)}")] = None,
     type: Annotated[str | None, Query(description="an illusion type, e.g. fence_shadow")] = None,  # noqa: A002
 ) -> dict[str, Any]:
-    """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type."""
+    """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type (an empty
+    value is no filter)."""
+    category, type = category or None, type or None  # noqa: A001 - ``?category=`` as a form sends "no filter"
     if category is not None and category not in LISTING_CATEGORIES:
         raise ApiError(422, f"unknown category {category!r} (choose from {', '.join(LISTING_CATEGORIES)})",
                        "category")
