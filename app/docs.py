@@ -16,6 +16,8 @@ from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html, get_swagge
 from fastapi.responses import HTMLResponse
 from fastapi.staticfiles import StaticFiles
 
+from .headers import inline_script_policy
+
 ASSETS_DIR = Path(fastapi_offline.__file__).resolve().parent / "static"
 ASSETS_URL = "/docs-assets"
 DOCS_URL, REDOC_URL, OAUTH2_REDIRECT_URL = "/docs", "/redoc", "/docs/oauth2-redirect"
@@ -32,25 +34,31 @@ def _asset(request: Request, name: str) -> str:
     return f"{request.scope.get('root_path', '')}{ASSETS_URL}/{name}"
 
 
+def with_inline_scripts_allowed(page: HTMLResponse) -> HTMLResponse:
+    """``page`` with a Content-Security-Policy that lets exactly its own inline start-up scripts run."""
+    page.headers["Content-Security-Policy"] = inline_script_policy(bytes(page.body).decode("utf-8"))
+    return page
+
+
 @router.get(DOCS_URL)
 def swagger_ui(request: Request) -> HTMLResponse:
-    return get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    return with_inline_scripts_allowed(get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                                swagger_js_url=_asset(request, "swagger-ui-bundle.js"),
                                swagger_css_url=_asset(request, "swagger-ui.css"),
                                swagger_favicon_url=_asset(request, "favicon.png"),
-                               oauth2_redirect_url=OAUTH2_REDIRECT_URL, swagger_ui_parameters=SWAGGER_PARAMETERS)
+                               oauth2_redirect_url=OAUTH2_REDIRECT_URL, swagger_ui_parameters=SWAGGER_PARAMETERS))
 
 
 @router.get(OAUTH2_REDIRECT_URL)
 def swagger_ui_redirect() -> HTMLResponse:
-    return get_swagger_ui_oauth2_redirect_html()
+    return with_inline_scripts_allowed(get_swagger_ui_oauth2_redirect_html())
 
 
 @router.get(REDOC_URL)
 def redoc(request: Request) -> HTMLResponse:
-    return get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    return with_inline_scripts_allowed(get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                           redoc_js_url=_asset(request, "redoc.standalone.js"),
-                          redoc_favicon_url=_asset(request, "favicon.png"), with_google_fonts=False)
+                          redoc_favicon_url=_asset(request, "favicon.png"), with_google_fonts=False))
 
 
 def mount_docs(app: FastAPI) -> None:
