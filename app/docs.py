@@ -42,11 +42,12 @@ def with_inline_scripts_allowed(page: HTMLResponse) -> HTMLResponse:
 
 @router.get(DOCS_URL)
 def swagger_ui(request: Request) -> HTMLResponse:
-    return with_inline_scripts_allowed(get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    page = get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                                swagger_js_url=_asset(request, "swagger-ui-bundle.js"),
                                swagger_css_url=_asset(request, "swagger-ui.css"),
                                swagger_favicon_url=_asset(request, "favicon.png"),
-                               oauth2_redirect_url=OAUTH2_REDIRECT_URL, swagger_ui_parameters=SWAGGER_PARAMETERS))
+                               oauth2_redirect_url=OAUTH2_REDIRECT_URL, swagger_ui_parameters=SWAGGER_PARAMETERS)
+    return with_inline_scripts_allowed(page)
 
 
 @router.get(OAUTH2_REDIRECT_URL)
@@ -56,9 +57,10 @@ def swagger_ui_redirect() -> HTMLResponse:
 
 @router.get(REDOC_URL)
 def redoc(request: Request) -> HTMLResponse:
-    return with_inline_scripts_allowed(get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    page = get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                           redoc_js_url=_asset(request, "redoc.standalone.js"),
-                          redoc_favicon_url=_asset(request, "favicon.png"), with_google_fonts=False))
+                          redoc_favicon_url=_asset(request, "favicon.png"), with_google_fonts=False)
+    return with_inline_scripts_allowed(page)
 
 
 def mount_docs(app: FastAPI) -> None:

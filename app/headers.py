@@ -12,7 +12,9 @@ import hashlib
 import re
 
 from starlette.datastructures import MutableHeaders
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from starlette.types import Message, Receive, Scope, Send
+
+from .asgi import HttpMiddleware, editing_start
 
 SCRIPT_SRC = "'self'"
 
@@ -42,22 +44,14 @@ def inline_script_policy(html: str) -> str:
     return content_security_policy(" ".join([SCRIPT_SRC, *(f"'sha256-{digest}'" for digest in hashes)]))
 
 
-class SecurityHeadersMiddleware:
+def add_security_headers(start: Message) -> None:
+    headers = MutableHeaders(scope=start)
+    for name, value in SECURITY_HEADERS.items():
+        headers.setdefault(name, value)
+
+
+class SecurityHeadersMiddleware(HttpMiddleware):
     """Adds ``SECURITY_HEADERS`` to every response that does not set them itself."""
 
-    def __init__(self, app: ASGIApp) -> None:
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-
-        async def send_with_headers(message: Message) -> None:
-            if message["type"] == "http.response.start":
-                headers = MutableHeaders(scope=message)
-                for name, value in SECURITY_HEADERS.items():
-                    headers.setdefault(name, value)
-            await send(message)
-
-        await self.app(scope, receive, send_with_headers)
+    async def handle(self, scope: Scope, receive: Receive, send: Send) -> None:
+        await self.app(scope, receive, editing_start(send, add_security_headers))

@@ -10,7 +10,9 @@ from __future__ import annotations
 from starlette.datastructures import MutableHeaders
 from starlette.responses import Response
 from starlette.routing import BaseRoute, Match, Mount
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from starlette.types import Message, Receive, Scope, Send
+
+from ..asgi import HttpMiddleware, editing_start
 
 METHODS = ("GET", "HEAD", "POST", "PUT", "PATCH", "DELETE")
 
@@ -29,16 +31,10 @@ def allow_header(methods: set[str]) -> str:
     return ", ".join(sorted(methods | {"OPTIONS"}))
 
 
-class AllowMiddleware:
+class AllowMiddleware(HttpMiddleware):
     """204 with ``Allow`` for ``OPTIONS`` on a routed path; a 405's ``Allow`` lists every method of the path."""
 
-    def __init__(self, app: ASGIApp) -> None:
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
+    async def handle(self, scope: Scope, receive: Receive, send: Send) -> None:
         methods = allowed_methods(scope["app"].router.routes, scope)
         if not methods:
             await self.app(scope, receive, send)
@@ -47,9 +43,8 @@ class AllowMiddleware:
             await Response(status_code=204, headers={"Allow": allow_header(methods)})(scope, receive, send)
             return
 
-        async def send_with_allow(message: Message) -> None:
-            if message["type"] == "http.response.start" and message["status"] == 405:
-                MutableHeaders(scope=message)["Allow"] = allow_header(methods)
-            await send(message)
+        def fix_allow(start: Message) -> None:
+            if start["status"] == 405:
+                MutableHeaders(scope=start)["Allow"] = allow_header(methods)
 
-        await self.app(scope, receive, send_with_allow)
+        await self.app(scope, receive, editing_start(send, fix_allow))
