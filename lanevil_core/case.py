@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
 
 from .files import write_atomic
 from .illusions import IllusionSpec
@@ -36,9 +36,9 @@ class Marking(_Model):
     """The paint on one lane boundary."""
 
     type: LineType = "white_dashed"
-    width: float = Field(PAINT_WIDTH_M, gt=0.02, le=0.6, description="paint width of one line (m)")
-    dash: float = Field(DASH_M, gt=0.1, le=50, description="dash length (m)")
-    gap: float = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
+    width: StrictFloat = Field(PAINT_WIDTH_M, gt=0.02, le=0.6, description="paint width of one line (m)")
+    dash: StrictFloat = Field(DASH_M, gt=0.1, le=50, description="dash length (m)")
+    gap: StrictFloat = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
 
     @model_validator(mode="before")
     @classmethod
@@ -63,19 +63,19 @@ class Road(_Model):
     """
 
     type: RoadType = "straight"
-    length: float = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
-    lanes_per_direction: int = Field(2, ge=1, le=4)
-    lane_width: float = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
-    radius: float = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")
+    length: StrictFloat = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
+    lanes_per_direction: StrictInt = Field(2, ge=1, le=4)
+    lane_width: StrictFloat = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
+    radius: StrictFloat = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")
     turn: Turn = Field("left", description="direction of the (first) bend")
-    grade: float = Field(0.06, ge=0.0, le=0.15, description="slope of uphill/downhill roads (rise/run)")
-    junction_s: float = Field(70.0, ge=20.0, description="distance along the road of a junction's centre (m)")
+    grade: StrictFloat = Field(0.06, ge=0.0, le=0.15, description="slope of uphill/downhill roads (rise/run)")
+    junction_s: StrictFloat = Field(70.0, ge=20.0, description="distance along the road of a junction's centre (m)")
     markings: list[Marking] = Field(
         default_factory=list,
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults)",
     )
-    paint: bool = Field(
+    paint: StrictBool = Field(
         True,
         description="false removes every lane marking from the world (the paint-free control: the lane labels "
         "stay, so a detector that still finds the lanes reads the road's layout, not its paint)",
@@ -99,49 +99,49 @@ class Scene(_Model):
     """What stands beside the road."""
 
     kind: SceneKind = "suburban"
-    density: float = Field(1.0, ge=0.0, le=3.0, description="how many roadside props (1 = typical)")
+    density: StrictFloat = Field(1.0, ge=0.0, le=3.0, description="how many roadside props (1 = typical)")
 
 
 class Weather(_Model):
     """The numeric fields of CARLA's WeatherParameters (0-100 except distances)."""
 
-    cloudiness: float = Field(5.0, ge=0, le=100)
-    precipitation: float = Field(0.0, ge=0, le=100)
-    precipitation_deposits: float = Field(0.0, ge=0, le=100, description="puddles")
-    wetness: float = Field(0.0, ge=0, le=100)
-    fog_density: float = Field(2.0, ge=0, le=100)
-    fog_distance: float = Field(0.0, ge=0, le=1000, description="distance where fog starts (m)")
+    cloudiness: StrictFloat = Field(5.0, ge=0, le=100)
+    precipitation: StrictFloat = Field(0.0, ge=0, le=100)
+    precipitation_deposits: StrictFloat = Field(0.0, ge=0, le=100, description="puddles")
+    wetness: StrictFloat = Field(0.0, ge=0, le=100)
+    fog_density: StrictFloat = Field(2.0, ge=0, le=100)
+    fog_distance: StrictFloat = Field(0.0, ge=0, le=1000, description="distance where fog starts (m)")
 
 
 class Sun(_Model):
     """The sun: azimuth counter-clockwise from world +X (the road's start heading), altitude above the horizon."""
 
-    azimuth: float = Field(30.0, ge=-360, le=360, description="degrees, 0 = ahead at the start, 90 = left")
-    altitude: float = Field(45.0, ge=-90, le=90, description="degrees above the horizon")
-    intensity: float = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
+    azimuth: StrictFloat = Field(30.0, ge=-360, le=360, description="degrees, 0 = ahead at the start, 90 = left")
+    altitude: StrictFloat = Field(45.0, ge=-90, le=90, description="degrees above the horizon")
+    intensity: StrictFloat = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
 
 
 class Camera(_Model):
     """Pinhole camera on the ego vehicle (x forward, z up in the vehicle frame)."""
 
-    width: int = Field(1280, ge=64, le=4096)
-    height: int = Field(720, ge=64, le=4096)
-    fov: float = Field(90.0, gt=10, lt=170, description="horizontal field of view (degrees)")
-    x: float = Field(1.0, ge=-5, le=5, description="mount position ahead of the vehicle origin (m)")
-    y: float = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
-    z: float = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
-    pitch: float = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
-    yaw: float = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
+    width: StrictInt = Field(1280, ge=64, le=4096)
+    height: StrictInt = Field(720, ge=64, le=4096)
+    fov: StrictFloat = Field(90.0, gt=10, lt=170, description="horizontal field of view (degrees)")
+    x: StrictFloat = Field(1.0, ge=-5, le=5, description="mount position ahead of the vehicle origin (m)")
+    y: StrictFloat = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
+    z: StrictFloat = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
+    pitch: StrictFloat = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
+    yaw: StrictFloat = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
 
 
 class Ego(_Model):
     """The ego vehicle drives its lane at constant speed."""
 
-    lane: int = Field(0, ge=0, description="lane of the ego's direction, 0 = next to the centre line")
-    start_s: float = Field(10.0, ge=0, description="start position along the road (m)")
-    speed: float = Field(10.0, ge=0, le=60, description="m/s")
-    fps: float = Field(10.0, gt=0, le=120)
-    frames: int = Field(100, ge=50, le=300)
+    lane: StrictInt = Field(0, ge=0, description="lane of the ego's direction, 0 = next to the centre line")
+    start_s: StrictFloat = Field(10.0, ge=0, description="start position along the road (m)")
+    speed: StrictFloat = Field(10.0, ge=0, le=60, description="m/s")
+    fps: StrictFloat = Field(10.0, gt=0, le=120)
+    frames: StrictInt = Field(100, ge=50, le=300)
 
 
 class Case(_Model):
@@ -157,7 +157,7 @@ class Case(_Model):
     camera: Camera = Field(default_factory=Camera)
     ego: Ego = Field(default_factory=Ego)
     illusions: list[IllusionSpec] = Field(default_factory=list)
-    seed: int = Field(0, ge=0, le=2**32 - 1)
+    seed: StrictInt = Field(0, ge=0, le=2**32 - 1)
 
     @model_validator(mode="before")
     @classmethod

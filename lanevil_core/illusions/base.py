@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -69,9 +69,9 @@ class Illusion(BaseModel):
     SEVERITY: ClassVar[tuple[Level, ...]]
 
     type: str
-    severity: int = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
-    seed: int = Field(0, ge=0, le=2**32 - 1)
-    s: float | None = Field(
+    severity: StrictInt = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
+    seed: StrictInt = Field(0, ge=0, le=2**32 - 1)
+    s: StrictFloat | None = Field(
         None, ge=0, description="distance along the road where it starts (m); empty = just ahead of the ego start"
     )
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, cast
 
 import numpy as np
 import trimesh
-from pydantic import Field
+from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
 from .. import props
 from ..primitives import pose_on_road, rotation_z, to_mesh, transformed
@@ -40,7 +40,7 @@ NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, 
 GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
 GREY = (0.3, 0.3, 0.3)
 
-Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 RGB = tuple[Unit, Unit, Unit]
 # Footprint and height (length, width, height) of each procedural vehicle (m).
 VEHICLE_SIZE: dict[str, tuple[float, float, float]] = {"car": (4.5, 1.8, 1.45), "van": (5.2, 2.0, 2.3),
@@ -120,11 +120,11 @@ class TrafficIllusion(Illusion):
 
     CATEGORY: ClassVar[Category] = "traffic"
 
-    count: int | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
-    distance: float | None = Field(
+    count: StrictInt | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
+    distance: StrictFloat | None = Field(
         None, ge=3, le=300, description="distance of the first one ahead of the ego start (m); empty = severity table"
     )
-    spacing: float | None = Field(
+    spacing: StrictFloat | None = Field(
         None, gt=0, le=200,
         description="distance between successive groups along the road (m); empty = spread over the drive",
     )
@@ -279,12 +279,12 @@ class Pedestrian(TrafficIllusion):
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
-    group: int | None = Field(None, ge=1, le=12, description="people per group; empty = the level-5 crowd's")
-    on_lines: float | None = Field(
+    group: StrictInt | None = Field(None, ge=1, le=12, description="people per group; empty = the level-5 crowd's")
+    on_lines: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of people standing on a lane line; empty = severity table"
     )
     shirt_colors: list[RGB] | None = Field(None, description="shirt colours (linear RGB), cycled; empty = random")
-    height: float = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
+    height: StrictFloat = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
 
     def level(self) -> CrowdLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -324,8 +324,8 @@ class Bicycle(TrafficIllusion):
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
-    group: int | None = Field(None, ge=1, le=12, description="cyclists per group; empty = the level-5 crowd's")
-    on_lines: float | None = Field(
+    group: StrictInt | None = Field(None, ge=1, le=12, description="cyclists per group; empty = the level-5 crowd's")
+    on_lines: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
     )
     frame_colors: list[RGB] | None = Field(None, description="bicycle frame colours (linear RGB), cycled")
@@ -380,12 +380,12 @@ class Vehicle(TrafficIllusion):
 
     type: Literal["vehicle"] = "vehicle"
     kind: Literal["mixed", "car", "van", "truck"] = Field("mixed", description="vehicle type; mixed = by severity")
-    per_row: int | None = Field(None, ge=1, le=8, description="vehicles side by side; empty = severity table")
-    lane_change: float | None = Field(
+    per_row: StrictInt | None = Field(None, ge=1, le=8, description="vehicles side by side; empty = severity table")
+    lane_change: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of vehicles straddling a lane line; empty = severity table"
     )
     colors: list[RGB] | None = Field(None, description="body colours (linear RGB), cycled; empty = random")
-    lights_on: bool = Field(False, description="headlights and tail lights glow")
+    lights_on: StrictBool = Field(False, description="headlights and tail lights glow")
     mesh_file: str | None = Field(
         None, description="glTF/GLB/OBJ model used instead of the procedural bodies, scaled to the vehicle size"
     )
