@@ -14,6 +14,7 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Generic, Literal, TypeVar
 
 import numpy as np
@@ -154,7 +155,8 @@ class EncodedImage:
 class FrameService:
     """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
 
-    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0) -> None:
+    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0, meshes_dir: Path | None = None) -> None:
+        self.meshes_dir = meshes_dir  # where a vehicle's ``mesh_file`` is read from
         self.threads = threads or all_cores()  # one frame's row bands on every core (0): a request waits on one frame
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
         self.roadsides: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
@@ -185,7 +187,7 @@ class FrameService:
         if scene is None:
             side_key = roadside_key(case)
             reuse = self.roadsides.get(side_key)
-            scene = compile_scene(case, reuse=reuse)
+            scene = compile_scene(case, reuse=reuse, meshes_dir=self.meshes_dir)
             if reuse is None:
                 self.full_compiles += 1
             else:

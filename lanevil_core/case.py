@@ -209,6 +209,14 @@ class Case(_Model):
         return self.model_copy(update={"weather": Weather(**values["weather"]), "sun": Sun(**sun)})
 
 
+MESHES_FOLDER = "meshes"
+
+
+def case_meshes_dir(case_path: str | Path) -> Path:
+    """Where the library and the CLI read a case file's user meshes from: the ``meshes/`` folder beside it."""
+    return Path(case_path).parent / MESHES_FOLDER
+
+
 class CaseError(ValueError):
     """A case file that cannot be read; the message names the field."""
 

@@ -20,8 +20,10 @@ from fastapi.responses import JSONResponse
 from pydantic import ValidationError
 
 from lanevil_core.case import Case
-from lanevil_core.illusions import CATEGORIES, REGISTRY
+from lanevil_core.compile import check_mesh_files
+from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
 
+from ..state import AppState
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id
 from .deps import CaseIdPath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
@@ -68,13 +70,18 @@ def split_body(body: dict[str, Any], allow_version: bool) -> tuple[dict[str, Any
     return document, case_id, version
 
 
-def validate_case(document: dict[str, Any], prefix: str) -> Case:
-    """A ``Case`` from a JSON document; a 422 naming the first bad field (under ``prefix``) otherwise."""
+def validate_case(document: dict[str, Any], prefix: str, state: AppState) -> Case:
+    """A ``Case`` from a JSON document whose mesh files are uploaded; a 422 naming the first bad field (under
+    ``prefix``) otherwise."""
     try:
-        return Case.model_validate(document)
+        case = Case.model_validate(document)
+        check_mesh_files(case, state.meshes_dir)
     except ValidationError as error:
         field, message = first_error(error.errors(), prefix)
         raise ApiError(422, message, field) from None
+    except MeshFileError as error:
+        raise ApiError(422, error.message, f"{prefix}.{error.field}" if prefix else error.field) from None
+    return case
 
 
 def expected_version(if_match: str | None, body_version: int | None) -> int | None:
@@ -119,7 +126,7 @@ def list_cases(
 def create_case(body: CaseBody, state: StateDep, request: Request) -> JSONResponse:
     """Store a new case at version 1; its id is the envelope's ``id`` or one derived from the title."""
     document, case_id, _ = split_body(body, allow_version=False)
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     if case_id is not None:
         try:
             check_id(case_id)
@@ -146,7 +153,7 @@ def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfM
         raise ApiError(422, f"{body_id!r} differs from the id in the URL ({case_id!r})", "id")
     version = expected_version(if_match, body_version)
     state.store.get(case_id)  # 404 before 422 for an unknown case
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     return record_response(state.store.update(case_id, case, expected_version=version))
 
 
@@ -163,7 +170,7 @@ def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: I
     if version is not None and version != current.version:
         raise VersionConflict(case_id, version, current.version)
     merged = merge_patch(current.case.model_dump(mode="json"), patch)
-    case = validate_case(merged, "case" if "case" in body else "")
+    case = validate_case(merged, "case" if "case" in body else "", state)
     # the patch applies to ``current``: only write if nobody changed the case since it was read
     return record_response(state.store.update(case_id, case, expected_version=current.version))
 

@@ -19,6 +19,7 @@ from fastapi.routing import APIRoute
 from pydantic import BaseModel, ValidationError
 
 from lanevil_core.case import CaseError
+from lanevil_core.illusions import MeshFileError
 
 from ..jobs import JobLimit, JobNotFound
 from ..store import CaseExists, CaseNotFound, InvalidId, StoreError, VersionConflict
@@ -96,6 +97,8 @@ def exception_response(error: Exception) -> JSONResponse | None:
         return error_response(429, str(error), None, {"Retry-After": str(error.retry_after_s)})
     if isinstance(error, BodyError):
         return error_response(error.status, f"{error.field}: {error}", error.field)
+    if isinstance(error, MeshFileError):
+        return error_response(422, str(error), error.field)
     if isinstance(error, CaseError):
         return error_response(422, str(error), "case")
     return None

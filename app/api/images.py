@@ -70,7 +70,7 @@ def render_case(
 ) -> Response:
     """Render an unsaved case (e.g. the editor's working copy); same query parameters as the frame route."""
     document, _, _ = split_body(body, allow_version=True)
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     check_frame(case, frame)
     # the ETag is a content hash: an equal case renders the same bytes, so clients may cache by it
     return image_response(state, case, frame, query, fmt, if_none_match, "private, max-age=3600")

@@ -8,6 +8,7 @@ into real scene elements (meshes, road-surface layers, lights, sun and wetness c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
@@ -36,6 +37,7 @@ class CompileContext:
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)
     source: int = -1  # index of the illusion being compiled
+    meshes_dir: Path | None = None  # the folder user meshes (``vehicle.mesh_file``) come from; None = no meshes
 
     def rng(self, seed: int) -> np.random.Generator:
         """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""
@@ -52,6 +54,15 @@ class CompileContext:
     def add_light(self, light: PointLight) -> None:
         light.source = self.source
         self.lights.append(light)
+
+
+class MeshFileError(ValueError):
+    """A ``mesh_file`` that names no readable model in the meshes folder; ``field`` is its path in the case."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(f"{field}: {message}")
+        self.field = field
+        self.message = message
 
 
 @dataclass(frozen=True)
