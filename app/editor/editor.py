@@ -37,6 +37,7 @@ from .placement import anchor_road, field_bounds, placement_fields, ray_surface_
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
 from .scene_view import SceneView
 from .session import CaseSession, SessionRegistry
+from .text import escape_markdown
 
 SELECT_RADIUS_M = 8.0  # a click this close to an illusion's handle selects it
 SUN_FIELDS = ("azimuth", "altitude", "intensity")
@@ -429,11 +430,11 @@ class Editor:
         session = self.session
         if session is None:
             return "No case open."
-        facts = [f"**{session.case_id}** · version {session.version}"]
+        facts = [f"**{escape_markdown(session.case_id)}** · version {session.version}"]
         facts.append("unsaved changes" if session.dirty else "saved")
         if session.remote_version is not None:
             facts.append(f"version {session.remote_version} in the store")
-        line = f"\n\n{'⚠ ' if error else ''}{self.message}" if self.message else ""
+        line = f"\n\n{'⚠ ' if error else ''}{escape_markdown(self.message)}" if self.message else ""
         return " · ".join(facts) + line
 
     def _report(self, message: str, error: bool = False) -> None:

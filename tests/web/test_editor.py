@@ -310,3 +310,34 @@ def test_partial_recompile_equals_a_full_compile(illusion: dict) -> None:
         np.testing.assert_array_equal(a.rgba, b.rgba)
     np.testing.assert_allclose(partial.env.sun_dir_world, full.env.sun_dir_world)
     assert partial.env.sun_intensity == full.env.sun_intensity and len(partial.lights) == len(full.lights)
+
+
+INJECTION = '<iframe srcdoc="<script>alert(1)</script>"> <script>alert(2)</script> [x](javascript:alert(3))'
+
+
+def markdown_texts(editor: Editor) -> list[str]:
+    return [editor.panel.status.content, editor.panel.preview_info.content, editor.panel.detection.content,
+            editor.drive.status.content]
+
+
+def test_case_text_and_errors_are_escaped_in_the_markdown(editor: Editor, state: AppState, monkeypatch) -> None:
+    case = parse_case({"title": INJECTION, "description": INJECTION})
+    record = state.store.create(case, case_id="injected")
+    editor.panel.case_id.value = record.id
+    settle(editor)
+    assert editor.panel.title.value == INJECTION  # a text input shows the title as typed
+
+    def fail(*args, **kwargs):
+        raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
+
+    monkeypatch.setattr(state.frames, "frame", fail)
+    editor.panel.frame.value = 3
+    assert editor.preview.wait_idle(WAIT_S)
+    status = editor.panel.status.content
+    assert "Preview failed" in status and "obstacle model not found" in status
+    assert "&lt;iframe srcdoc\\=&quot;&lt;script&gt;" in status
+    editor.drive.status.content = ""
+    monkeypatch.setattr(editor.drive, "current", fail)
+    editor.drive.start()
+    for text in markdown_texts(editor):
+        assert "<" not in text and "](" not in text and '"' not in text, text
