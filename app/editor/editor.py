@@ -27,6 +27,7 @@ from lanevil_core.presets import preset_values
 from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.scene import CompiledScene
 
+from ..meshes import MeshUploadError, store_mesh
 from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
@@ -142,6 +143,7 @@ class Editor:
                   "export_sequence": lambda e: self.export_sequence(e.client)}
         for name, action in clicks.items():
             getattr(p, name).on_click(self._guarded(action))
+        p.upload_mesh.on_upload(self._guarded(lambda e: self.upload_mesh(e.target.value.name, e.target.value.content)))
         self.server.gui.add_command("Undo", hotkey="Z", modifier="cmd/ctrl",
                                     description="undo the last change").on_trigger(self._guarded(lambda e: self.undo()))
         self.server.gui.add_command("Redo", hotkey="Z", modifier="cmd/ctrl+shift",
@@ -294,6 +296,19 @@ class Editor:
     def set_field(self, name: str, value: Any) -> None:
         illusion = self._illusion(self.selected)
         self._edit_illusion(self.selected, {name: value}, f"{illusion.type} {name}")
+
+    def upload_mesh(self, filename: str, data: bytes) -> str:
+        """Store a model in the server's uploads folder (as ``POST /api/meshes`` does) and make it the selected
+        vehicle's ``mesh_file``; returns the name it is stored under."""
+        illusion = self._illusion(self.selected)
+        if "mesh_file" not in type(illusion).model_fields:
+            raise EditError(f"a {illusion.type} takes no mesh: select a vehicle, then upload its model")
+        try:
+            name = store_mesh(self.state.meshes_dir, filename, data, self.state.settings.max_upload_bytes)
+        except MeshUploadError as error:
+            raise EditError(f"mesh not stored: {error}") from None
+        self.set_field("mesh_file", name)
+        return name
 
     def delete_selected(self) -> None:
         illusion = self._illusion(self.selected)

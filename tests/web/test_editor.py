@@ -12,6 +12,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import trimesh
 
 from app.editor import EditError, Editor
 from app.editor.detection import rate_text
@@ -341,3 +342,23 @@ def test_case_text_and_errors_are_escaped_in_the_markdown(editor: Editor, state:
     editor.drive.start()
     for text in markdown_texts(editor):
         assert "<" not in text and "](" not in text and '"' not in text, text
+
+
+def test_upload_mesh_stores_the_model_and_sets_the_vehicles_mesh_file(editor: Editor, state: AppState) -> None:
+
+
+    case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1, "kind": "van"}]})
+    editor.panel.case_id.value = state.store.create(case, case_id="vans").id
+    settle(editor)
+    editor.panel.selected.value = editor.panel.selected.options[1]
+    glb = trimesh.Scene(trimesh.creation.box((4.0, 2.0, 1.5))).export(file_type="glb")
+    assert editor.upload_mesh("../My Van.glb", glb) == "My_Van.glb"
+    settle(editor)
+    assert editor.case.illusions[0].mesh_file == "My_Van.glb"
+    assert (state.meshes_dir / "My_Van.glb").read_bytes() == glb
+    assert "⚠" not in editor.panel.status.content
+    with pytest.raises(EditError, match="mesh not stored"):
+        editor.upload_mesh("notes.txt", b"hello")
+    open_shadow(editor)
+    with pytest.raises(EditError, match="takes no mesh"):
+        editor.upload_mesh("van.glb", glb)
