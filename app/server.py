@@ -88,7 +88,7 @@ def serve(settings: Settings) -> int:
     if settings.editor:
         from .editor import launch_editor
 
-        editor = launch_editor(state, host=settings.host, port=settings.editor_port)
+        editor = launch_editor(state, host=settings.host, port=settings.editor_port, api_port=api_port)
         app.state.editor_port = editor.port
         app.state.open_in_editor = editor.open_case
     urls = Urls(api=f"http://{_http_host(settings.host)}:{api_port}/",

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Annotated
 
-from pydantic import Field
-from pydantic_settings import BaseSettings, SettingsConfigDict
+from pydantic import Field, field_validator
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 
 class Settings(BaseSettings):
@@ -28,3 +29,14 @@ class Settings(BaseSettings):
     frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
     render_threads: int = Field(0, ge=0, description="threads per rendered frame (0 = every core this process may use)")
     editor: bool = Field(True, description="start the viser editor beside the API")
+    allowed_origins: Annotated[list[str], NoDecode] = Field(
+        default_factory=list, description="more origins whose pages may open the editor's websocket, comma-separated "
+        "(`http://studio.example:8080`; `*` = any); always allowed: the editor's and the API's ports on localhost, "
+        "127.0.0.1, [::1] and the bound host")
+
+    @field_validator("allowed_origins", mode="before")
+    @classmethod
+    def _comma_separated(cls, value: object) -> object:
+        if isinstance(value, str):
+            return [origin.strip() for origin in value.split(",") if origin.strip()]
+        return value

@@ -33,6 +33,7 @@ from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
 from .detection import chosen_detector, detection_text, unavailable_text
 from .drive_panel import DrivePanel
+from .origins import OriginCheck, checking_origins
 from .panel import CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
@@ -589,7 +590,15 @@ class Editor:
         return job
 
 
-def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080) -> Editor:
-    """Start the viser editor on ``host:port`` (0 = any free port) over ``state``; ``editor.port`` is the real one."""
-    server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
+def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080, api_port: int | None = None) -> Editor:
+    """Start the viser editor on ``host:port`` (0 = any free port) over ``state``; ``editor.port`` is the real one.
+
+    Its websocket takes pages of its own and the API's port (``api_port``, default the settings') on loopback and
+    ``host``, and ``state.settings.allowed_origins`` (``origins.py``); other origins get a 403."""
+    bound: list[int] = []
+    ports = {state.settings.port if api_port is None else api_port}
+    check = OriginCheck(host, lambda: {*bound, *ports}, state.settings.allowed_origins)
+    with checking_origins(check):
+        server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
+    bound.append(server.get_port())
     return Editor(state, server)
