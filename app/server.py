@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import uvicorn
 
 from .main import create_app
+from .memory import limit_malloc_arenas
 from .settings import Settings
 from .state import AppState
 
@@ -80,6 +81,7 @@ def _http_host(host: str) -> str:
 
 def serve(settings: Settings) -> int:
     """Run the backend (and the editor, unless ``settings.editor`` is off) until Ctrl+C / SIGTERM."""
+    limit_malloc_arenas(settings.malloc_arenas)  # before any thread starts (memory.py)
     sock = listen(settings.host, settings.port)  # first: a busy port fails at once, before the store is opened
     state = AppState.open(settings)
     app = create_app(settings, state)

@@ -38,7 +38,9 @@ class AppState:
         if len(store) == 0 and Path(settings.scenes_dir).is_dir():
             store.seed_from(Path(settings.scenes_dir))
         uploads_dir(settings).mkdir(exist_ok=True)
-        frames = FrameService(settings.frame_cache_bytes, settings.render_threads, meshes_dir=uploads_dir(settings))
+        frames = FrameService(settings.frame_cache_bytes, settings.render_threads, meshes_dir=uploads_dir(settings),
+                              scene_cache_bytes=settings.scene_cache_bytes, max_renders=settings.max_renders,
+                              max_render_queue=settings.max_render_queue)
         return cls(settings=settings, store=store, frames=frames,
                    jobs=JobManager(data_dir, max_unfinished=settings.max_jobs,
                                    max_per_client=settings.max_jobs_per_client))

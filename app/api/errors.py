@@ -21,6 +21,7 @@ from pydantic import BaseModel, ValidationError
 from lanevil_core.case import CaseError
 from lanevil_core.illusions import MeshFileError
 
+from ..frames import RenderBusy
 from ..jobs import JobLimit, JobNotFound
 from ..store import CaseExists, CaseNotFound, InvalidId, StoreError, VersionConflict
 from .json_body import BodyError, check_json_type, parse_json
@@ -95,6 +96,8 @@ def exception_response(error: Exception) -> JSONResponse | None:
         return error_response(404, f"job_id: {error}", "job_id")
     if isinstance(error, JobLimit):
         return error_response(429, str(error), None, {"Retry-After": str(error.retry_after_s)})
+    if isinstance(error, RenderBusy):
+        return error_response(503, str(error), None, {"Retry-After": str(error.retry_after_s)})
     if isinstance(error, BodyError):
         return error_response(error.status, f"{error.field}: {error}", error.field)
     if isinstance(error, MeshFileError):
