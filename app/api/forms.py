@@ -1,4 +1,4 @@
-"""Multipart form bodies read with the API's errors: a malformed form (no boundary, a broken part) is a 400 naming
+"""Multipart form bodies read with the API's errors: a malformed form (no boundary, a broken part) is a 422 naming
 ``Content-Type`` or ``body``, never Starlette's bare ``{"detail": ...}``."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from .errors import ApiError
 
 
 async def read_form(request: Request, max_files: int = 1000) -> FormData:
-    """The parsed form of ``request``; ``ApiError`` (400) whose field says what is malformed."""
+    """The parsed form of ``request``; ``ApiError`` (422, as malformed JSON is) whose field says what is malformed."""
     try:
         return await request.form(max_files=max_files)
     except StarletteHTTPException as error:
@@ -19,4 +19,4 @@ async def read_form(request: Request, max_files: int = 1000) -> FormData:
             raise
         message = str(error.detail)
         field = "Content-Type" if "boundary" in message.lower() else "body"
-        raise ApiError(400, f"malformed multipart form: {message}", field) from None
+        raise ApiError(422, f"malformed multipart form: {message}", field) from None

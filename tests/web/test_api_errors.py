@@ -210,5 +210,5 @@ def test_options_and_405_list_every_method_of_the_path(client, path: str, method
 def test_multipart_without_boundary_names_content_type(client) -> None:
     response = client.post("/api/study/studies", content=b"x",
                            headers={**ADMIN, "content-type": "multipart/form-data"})
-    assert response.status_code == 400
+    assert response.status_code == 422
     assert response.json()["field"] == "Content-Type"
