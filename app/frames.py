@@ -14,7 +14,7 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Generic, Literal, TypeVar
 
@@ -222,7 +222,7 @@ class FrameService:
         self.meshes_dir = meshes_dir  # where a vehicle's ``mesh_file`` is read from
         self.threads = threads or all_cores()  # one frame's row bands on every core (0): a request waits on one frame
         self.slots = RenderSlots(max_renders, max_render_queue)
-        # Scenes (and the roadsides reused from them, mostly the same objects) are bounded by their arrays' bytes.
+        # Scenes and the roadsides reused from them are bounded by their arrays' bytes.
         self.scenes: LRUCache[str, CompiledScene] = LRUCache(scene_cache_bytes, CompiledScene.nbytes)
         self.roadsides: LRUCache[str, CompiledScene] = LRUCache(scene_cache_bytes // 2, CompiledScene.nbytes)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
@@ -259,7 +259,9 @@ class FrameService:
             else:
                 self.partial_compiles += 1
             self.scenes.put(key, scene)
-            self.roadsides.put(side_key, scene)
+            # Without the renderer's cache (packed arrays, shadow cascades: tens of MB once frames are drawn), which
+            # a reuse never reads: what the roadside cache keeps is what it weighed.
+            self.roadsides.put(side_key, replace(scene, cache={}))
         return scene
 
     @staticmethod

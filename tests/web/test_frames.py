@@ -12,6 +12,7 @@ from pydantic import ValidationError
 
 from app.frames import FrameService, RenderBusy, RenderSlots, apply_overrides, case_hash
 from lanevil_core.case import load_case
+from lanevil_core.compile import roadside_key
 from lanevil_core.illusions import REGISTRY
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -87,3 +88,13 @@ def test_the_scene_cache_is_bounded_by_bytes() -> None:
     other = case.model_copy(update={"seed": 7})
     service.frame(other, 0, (160, 90))
     assert service.scenes.total <= 10_000_000 and len(service.scenes) == 1
+
+
+def test_the_roadside_cache_keeps_no_render_caches() -> None:
+    case = load_case(SCENES / "00_clean" / "00_straight_urban.json")
+    service = FrameService(cache_bytes=0, threads=1)
+    for frame in (0, 9):
+        service.frame(case, frame, (160, 90))
+    roadside = service.roadsides.get(roadside_key(case))
+    assert roadside is not None and roadside.cache == {}
+    assert service.roadsides.total == roadside.nbytes() < service.scenes.total
