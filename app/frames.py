@@ -36,7 +36,7 @@ from lanevil_core.scene import CompiledScene
 ImageFormat = Literal["png", "jpg"]
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
 JPEG_QUALITY = 90
-SCENE_CACHE_BYTES = 200_000_000  # compiled scenes kept for reuse (a stock scene: about 7 MB once rendered)
+SCENE_CACHE_BYTES = 128_000_000  # compiled scenes kept for reuse (a stock scene: 7 to 170 MB once rendered)
 MAX_RENDERS = 2  # frames rendered at once (each on every core); a render's buffers are the server's peak memory
 MAX_RENDER_QUEUE = 32  # requests waiting for a render slot before the next is told to come back later
 CULANE_CACHE_ENTRIES = 2048  # label texts are small (< 1 kB)

@@ -29,7 +29,7 @@ class Settings(BaseSettings):
     frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
     max_renders: int = Field(2, ge=1, description="frames rendered at once; more requests wait for a slot")
     max_render_queue: int = Field(32, ge=0, description="requests waiting for a render slot before clients get 503")
-    scene_cache_bytes: int = Field(200_000_000, ge=0, description="memory budget of the compiled-scene cache")
+    scene_cache_bytes: int = Field(128_000_000, ge=0, description="memory budget of the compiled-scene cache")
     malloc_arenas: int = Field(2, ge=0, description="glibc malloc arenas of the server process (0 = glibc's default); "
                                "fewer arenas keep the resident memory of concurrent renders down")
     render_threads: int = Field(0, ge=0, description="threads per rendered frame (0 = every core this process may use)")
