@@ -11,6 +11,7 @@ import os
 import re
 import tempfile
 from pathlib import Path, PurePosixPath, PureWindowsPath
+from typing import Any
 
 from lanevil_core.illusions.traffic import MESH_NAME_RULE, MESH_SUFFIXES, is_mesh_name, load_obstacle
 
@@ -28,6 +29,22 @@ def mesh_name(filename: str) -> str:
     ``.``, ``_``, ``-`` as ``_``, leading dots and dashes dropped."""
     base = PureWindowsPath(PurePosixPath(filename or "").name).name
     return re.sub(r"[^A-Za-z0-9._-]", "_", base).lstrip("._-")
+
+
+def legacy_mesh_files(document: Any) -> Any:
+    """A stored case document whose ``mesh_file`` paths (written before it became a name) are turned into names:
+    the sanitised base name, ``.glb`` added when it names no model format. Such a case still opens; its frames
+    answer 422 until a model of that name is uploaded."""
+    if not isinstance(document, dict) or not isinstance(document.get("illusions"), list):
+        return document
+    illusions = []
+    for illusion in document["illusions"]:
+        name = illusion.get("mesh_file") if isinstance(illusion, dict) else None
+        if isinstance(name, str) and not is_mesh_name(name):
+            fixed = mesh_name(name).replace("..", "_") or "mesh"
+            illusion = {**illusion, "mesh_file": fixed if is_mesh_name(fixed) else f"{fixed[:95]}.glb"}
+        illusions.append(illusion)
+    return {**document, "illusions": illusions}
 
 
 def list_meshes(uploads: Path) -> list[str]:

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import io
+import json
 from pathlib import Path
 
 import pytest
 import trimesh
+from fastapi.testclient import TestClient
+
+from app.main import create_app
+from app.state import AppState
 
 JSON = {"content-type": "application/json"}
 FIELD = "illusions.0.vehicle.mesh_file"
@@ -94,3 +99,25 @@ def test_a_stored_case_whose_mesh_is_missing_answers_4xx(client, state) -> None:
         assert response.status_code == 422, (url, response.text)
         assert response.json()["field"] == FIELD
     assert client.get(f"/api/cases/{case_id}").status_code == 200
+
+
+@pytest.mark.parametrize("old_path", ["/etc/passwd", "../../etc/hostname",
+                                      '<iframe srcdoc="<script>alert(1)</script>">'])
+def test_a_case_stored_with_a_mesh_path_still_opens_and_answers_422(settings, old_path: str) -> None:
+    """Cases written before ``mesh_file`` became a name: the store opens, the case reads, its frames are a 422."""
+    first = AppState.open(settings)
+    record = first.store.create(first.store.get("clean-00_straight_urban").case, case_id="old-van")
+    first.jobs.shutdown()
+    path = settings.data_dir / "cases" / "old-van.json"
+    stored = json.loads(path.read_text())
+    stored["case"]["illusions"] = [{**VEHICLE, "mesh_file": old_path}]
+    path.write_text(json.dumps(stored))
+    state = AppState.open(settings)
+    try:
+        with TestClient(create_app(settings, state)) as client:
+            assert client.get(f"/api/cases/{record.id}").status_code == 200
+            frame = client.get(f"/api/cases/{record.id}/frames/0.png?width=160&height=90")
+            assert (frame.status_code, frame.json()["field"]) == (422, FIELD)
+            assert "upload it first" in frame.json()["detail"]
+    finally:
+        state.jobs.shutdown()
