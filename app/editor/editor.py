@@ -20,8 +20,8 @@ import viser
 
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, CaseError, parse_case
-from lanevil_core.compile import roadside_key
-from lanevil_core.illusions import REGISTRY, Illusion
+from lanevil_core.compile import check_mesh_files, roadside_key
+from lanevil_core.illusions import REGISTRY, Illusion, MeshFileError
 from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.presets import preset_values
 from lanevil_core.road_layout import RoadNetwork
@@ -188,6 +188,7 @@ class Editor:
     def save(self) -> CaseRecord | None:
         """Write the edited case through the store's version check; a conflict is reported and the edits kept."""
         session = self._current()
+        self._check_meshes(session.case)
         try:
             record = session.save(self.state.store)
         except VersionConflict as error:
@@ -200,9 +201,17 @@ class Editor:
     def save_as_new(self) -> str:
         """Store the edited case under a fresh id and continue there."""
         case = self.case
+        self._check_meshes(case)
         record = self.state.store.create(case)
         self.open_case(record.id)
         return record.id
+
+    def _check_meshes(self, case: Case) -> None:
+        """What the REST API refuses is not stored from here either: a ``mesh_file`` that is not uploaded."""
+        try:
+            check_mesh_files(case, self.state.meshes_dir)
+        except MeshFileError as error:
+            raise EditError(f"Not saved: {error} (use Upload vehicle mesh)") from None
 
     def reload(self) -> None:
         session = self._current()

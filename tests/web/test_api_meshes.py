@@ -121,3 +121,13 @@ def test_a_case_stored_with_a_mesh_path_still_opens_and_answers_422(settings, ol
             assert "upload it first" in frame.json()["detail"]
     finally:
         state.jobs.shutdown()
+
+
+def test_a_study_of_a_case_whose_mesh_is_missing_is_a_422(client, state) -> None:
+    name = upload(client, "van.glb", box_glb()).json()["name"]
+    case_id = client.post("/api/cases", json=vehicle_case(name)).json()["id"]
+    (state.meshes_dir / name).unlink()
+    spec = {"title": "vans", "width": 160, "height": 90, "generated": {"cases": [case_id]}}
+    response = client.post("/api/study/studies", json=spec, headers={"Authorization": "Bearer test-admin"})
+    assert response.status_code == 422, response.text
+    assert response.json()["field"].endswith("mesh_file")

@@ -362,3 +362,17 @@ def test_upload_mesh_stores_the_model_and_sets_the_vehicles_mesh_file(editor: Ed
     open_shadow(editor)
     with pytest.raises(EditError, match="takes no mesh"):
         editor.upload_mesh("van.glb", glb)
+
+
+def test_a_mesh_file_that_is_not_uploaded_is_not_saved(editor: Editor, state: AppState) -> None:
+    case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1}]})
+    editor.panel.case_id.value = state.store.create(case, case_id="vans").id
+    settle(editor)
+    editor.panel.selected.value = editor.panel.selected.options[1]
+    editor.set_field("mesh_file", "nowhere.glb")
+    assert editor.preview.wait_idle(WAIT_S)
+    with pytest.raises(EditError, match="nowhere.glb"):
+        editor.save()
+    with pytest.raises(EditError, match="Not saved"):
+        editor.save_as_new()
+    assert state.store.get("vans").version == 1
