@@ -171,6 +171,11 @@ BODY_RESPONSES: dict[int | str, dict[str, Any]] = {
     413: {"model": ErrorBody, "description": "the body is over the server's limit (`field`: `body`)"},
     415: {"model": ErrorBody, "description": "the body is not sent as JSON (`field`: `Content-Type`)"},
 }
+# What every route that renders frames may answer when the render queue is full (``frames.RenderSlots``).
+RENDER_BUSY: dict[int | str, dict[str, Any]] = {
+    503: {"model": ErrorBody, "description": "too many frames waiting to render: try again after `Retry-After` seconds",
+          "headers": {"Retry-After": {"description": "seconds to wait", "schema": {"type": "integer"}}}},
+}
 TOO_MANY: dict[int | str, dict[str, Any]] = {
     429: {"model": ErrorBody, "description": "too many jobs queued: try again after `Retry-After` seconds",
           "headers": {"Retry-After": {"description": "seconds to wait", "schema": {"type": "integer"}}}},

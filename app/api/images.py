@@ -17,7 +17,7 @@ from ..state import AppState
 from .cases import split_body, validate_case
 from .deps import RecordDep, StateDep
 from .detectors import checked_detector, detector_errors
-from .errors import ERROR_RESPONSES, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
 from .params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
 
 router = APIRouter(tags=["frames"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -28,6 +28,7 @@ IMAGE_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"content": {"image/png": {}, "image/jpeg": {}}, "description": "the rendered frame"},
     304: {"description": "not modified (If-None-Match matched the ETag)"},
     404: {"model": ErrorBody, "description": "no such case or frame"},
+    **RENDER_BUSY,
 }
 IfNoneMatch = Annotated[str | None, Header(alias="If-None-Match")]
 

@@ -98,3 +98,10 @@ def test_the_roadside_cache_keeps_no_render_caches() -> None:
     roadside = service.roadsides.get(roadside_key(case))
     assert roadside is not None and roadside.cache == {}
     assert service.roadsides.total == roadside.nbytes() < service.scenes.total
+
+
+def test_openapi_documents_the_503_of_rendering_routes(client) -> None:
+    paths = client.get("/openapi.json").json()["paths"]
+    for path in ("/api/cases/{case_id}/frames/{frame}.{fmt}", "/api/render", "/api/cases/{case_id}/labels"):
+        operation = next(iter(paths[path].values()))
+        assert "Retry-After" in operation["responses"]["503"]["headers"], path
