@@ -20,6 +20,7 @@ from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html, get_swagge
 from fastapi.responses import HTMLResponse, Response
 from fastapi.staticfiles import StaticFiles
 
+from .headers import inline_script_policy
 from .site import FAVICON_URL, STATIC_DIR
 
 ASSETS_DIR = Path(fastapi_offline.__file__).resolve().parent / "static"
@@ -52,25 +53,33 @@ def offline_redoc_js() -> bytes:
     return bundle.replace(REDOC_BADGE_URL.encode(), b"data:image/svg+xml;base64," + base64.b64encode(icon))
 
 
+def with_inline_scripts_allowed(page: HTMLResponse) -> HTMLResponse:
+    """``page`` with a Content-Security-Policy that lets exactly its own inline start-up scripts run."""
+    page.headers["Content-Security-Policy"] = inline_script_policy(bytes(page.body).decode("utf-8"))
+    return page
+
+
 @router.get(DOCS_URL)
 def swagger_ui(request: Request) -> HTMLResponse:
-    return get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    page = get_swagger_ui_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                                swagger_js_url=_asset(request, "swagger-ui-bundle.js"),
                                swagger_css_url=_asset(request, "swagger-ui.css"),
                                swagger_favicon_url=_favicon(request),
                                oauth2_redirect_url=OAUTH2_REDIRECT_URL, swagger_ui_parameters=SWAGGER_PARAMETERS)
+    return with_inline_scripts_allowed(page)
 
 
 @router.get(OAUTH2_REDIRECT_URL)
 def swagger_ui_redirect() -> HTMLResponse:
-    return get_swagger_ui_oauth2_redirect_html()
+    return with_inline_scripts_allowed(get_swagger_ui_oauth2_redirect_html())
 
 
 @router.get(REDOC_URL)
 def redoc(request: Request) -> HTMLResponse:
-    return get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
+    page = get_redoc_html(openapi_url=_openapi_url(request), title=f"{request.app.title} API",
                           redoc_js_url=_asset(request, REDOC_JS), redoc_favicon_url=_favicon(request),
                           with_google_fonts=False)
+    return with_inline_scripts_allowed(page)
 
 
 # Declared before the assets are mounted, so this route answers for the bundle instead of the package's file.

@@ -12,8 +12,10 @@ from __future__ import annotations
 import hashlib
 import threading
 from collections import OrderedDict
-from collections.abc import Callable, Hashable
-from dataclasses import dataclass
+from collections.abc import Callable, Hashable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any, Generic, Literal, TypeVar
 
 import numpy as np
@@ -34,7 +36,9 @@ from lanevil_core.scene import CompiledScene
 ImageFormat = Literal["png", "jpg"]
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
 JPEG_QUALITY = 90
-SCENE_CACHE_ENTRIES = 8
+SCENE_CACHE_BYTES = 128_000_000  # compiled scenes kept for reuse (a stock scene: 7 to 170 MB once rendered)
+MAX_RENDERS = 2  # frames rendered at once (each on every core); a render's buffers are the server's peak memory
+MAX_RENDER_QUEUE = 32  # requests waiting for a render slot before the next is told to come back later
 CULANE_CACHE_ENTRIES = 2048  # label texts are small (< 1 kB)
 DETECTION_CACHE_ENTRIES = 4096  # a frame's lanes: a few kB
 
@@ -76,12 +80,70 @@ class LRUCache(Generic[K, V]):
             while self._total > self.budget:
                 self._total -= self._items.popitem(last=False)[1][1]
 
+    def reweigh(self, key: K) -> None:
+        """Weigh ``key``'s value again (it grew since ``put``) and evict down to the budget."""
+        with self._lock:
+            item = self._items.get(key)
+            if item is None:
+                return
+            weight = self._weigh(item[0])
+            self._total += weight - item[1]
+            self._items[key] = (item[0], weight)
+            while self._total > self.budget and self._items:
+                self._total -= self._items.popitem(last=False)[1][1]
+
     def __len__(self) -> int:
         return len(self._items)
 
     @property
     def total(self) -> int:
         return self._total
+
+
+class RenderBusy(RuntimeError):
+    """Every render slot is taken and ``MAX_RENDER_QUEUE`` requests wait already: come back after ``retry_after_s``."""
+
+    def __init__(self, waiting: int, retry_after_s: int) -> None:
+        super().__init__(f"{waiting} frames are waiting to render: try again in {retry_after_s} s")
+        self.retry_after_s = retry_after_s
+
+
+class RenderSlots:
+    """At most ``slots`` renders at once; a thread already holding a slot re-enters freely (a frame's render may
+    compile its scene); more than ``max_waiting`` threads waiting -> ``RenderBusy``."""
+
+    def __init__(self, slots: int = MAX_RENDERS, max_waiting: int = MAX_RENDER_QUEUE) -> None:
+        self.slots = slots
+        self.max_waiting = max_waiting
+        self._semaphore = threading.BoundedSemaphore(slots)
+        self._lock = threading.Lock()
+        self._held = threading.local()
+        self.waiting = 0
+
+    @contextmanager
+    def hold(self) -> Iterator[None]:
+        if getattr(self._held, "depth", 0):
+            self._held.depth += 1
+            try:
+                yield
+            finally:
+                self._held.depth -= 1
+            return
+        with self._lock:
+            if self.waiting >= self.max_waiting:
+                raise RenderBusy(self.waiting, retry_after_s=max(1, self.waiting // self.slots))
+            self.waiting += 1
+        try:
+            self._semaphore.acquire()
+        finally:
+            with self._lock:
+                self.waiting -= 1
+        self._held.depth = 1
+        try:
+            yield
+        finally:
+            self._held.depth = 0
+            self._semaphore.release()
 
 
 def case_hash(case: Case) -> str:
@@ -154,10 +216,15 @@ class EncodedImage:
 class FrameService:
     """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
 
-    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0) -> None:
+    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0, meshes_dir: Path | None = None,
+                 scene_cache_bytes: int = SCENE_CACHE_BYTES, max_renders: int = MAX_RENDERS,
+                 max_render_queue: int = MAX_RENDER_QUEUE) -> None:
+        self.meshes_dir = meshes_dir  # where a vehicle's ``mesh_file`` is read from
         self.threads = threads or all_cores()  # one frame's row bands on every core (0): a request waits on one frame
-        self.scenes: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
-        self.roadsides: LRUCache[str, CompiledScene] = LRUCache(SCENE_CACHE_ENTRIES)
+        self.slots = RenderSlots(max_renders, max_render_queue)
+        # Scenes and the roadsides reused from them are bounded by their arrays' bytes.
+        self.scenes: LRUCache[str, CompiledScene] = LRUCache(scene_cache_bytes, CompiledScene.nbytes)
+        self.roadsides: LRUCache[str, CompiledScene] = LRUCache(scene_cache_bytes // 2, CompiledScene.nbytes)
         self.frames: LRUCache[str, RenderedFrame] = LRUCache(cache_bytes // 2, lambda item: item.rgb.nbytes)
         self.images: LRUCache[str, EncodedImage] = LRUCache(cache_bytes // 2, lambda item: len(item.data))
         self.culane: LRUCache[str, str] = LRUCache(CULANE_CACHE_ENTRIES)
@@ -185,13 +252,16 @@ class FrameService:
         if scene is None:
             side_key = roadside_key(case)
             reuse = self.roadsides.get(side_key)
-            scene = compile_scene(case, reuse=reuse)
+            with self.slots.hold():
+                scene = compile_scene(case, reuse=reuse, meshes_dir=self.meshes_dir)
             if reuse is None:
                 self.full_compiles += 1
             else:
                 self.partial_compiles += 1
             self.scenes.put(key, scene)
-            self.roadsides.put(side_key, scene)
+            # Without the renderer's cache (packed arrays, shadow cascades: tens of MB once frames are drawn), which
+            # a reuse never reads: what the roadside cache keeps is what it weighed.
+            self.roadsides.put(side_key, replace(scene, cache={}))
         return scene
 
     @staticmethod
@@ -243,7 +313,8 @@ class FrameService:
         with lock:
             cached = self.detections.get(key)
             if cached is None:
-                cached = detect_frame(detector, np.asarray(plain.rgb), plain.record)
+                with self.slots.hold():
+                    cached = detect_frame(detector, np.asarray(plain.rgb), plain.record)
                 self.detector_runs += 1
                 self.detections.put(key, cached)
         self._release(key)
@@ -259,10 +330,12 @@ class FrameService:
         if overlay:  # the overlay is drawn on the plain frame, which is then cached too
             plain = self.frame(case, index, size, overlay=False)
             return RenderedFrame(draw_lanes(plain.rgb, plain.record), plain.record, key)
-        scene = self.scene(case)
-        frame = render_frame(scene, index, size, threads=self.threads)
-        self.renders += 1
-        record = tusimple_record(scene, index, frame, raw_file=frame_file(index))
+        with self.slots.hold():
+            scene = self.scene(case)
+            frame = render_frame(scene, index, size, threads=self.threads)
+            self.renders += 1
+            record = tusimple_record(scene, index, frame, raw_file=frame_file(index))
+        self.scenes.reweigh(case_hash(case))  # the first render packed the scene's arrays into its cache
         rgb = np.ascontiguousarray(frame.rgb)
         rgb.setflags(write=False)
         return RenderedFrame(rgb, record, key)
@@ -286,8 +359,9 @@ class FrameService:
         key = f"{case_hash(case)}:{index}:culane"
         lines = self.culane.get(key)
         if lines is None:
-            scene = self.scene(case)
-            lines = culane_lines(scene, render_frame(scene, index, CULANE_SIZE, threads=self.threads))
-            self.renders += 1
+            with self.slots.hold():
+                scene = self.scene(case)
+                lines = culane_lines(scene, render_frame(scene, index, CULANE_SIZE, threads=self.threads))
+                self.renders += 1
             self.culane.put(key, lines)
         return lines

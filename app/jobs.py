@@ -247,17 +247,18 @@ def zip_folder(source: Path, target: Path, prefix: PurePosixPath) -> None:
 
 
 def export_zip(case: Case, folder: PurePosixPath, frames: Iterable[int], target: Path,
-               progress: Progress | None = None) -> Path:
+               progress: Progress | None = None, meshes_dir: Path | None = None) -> Path:
     """Render ``frames`` of ``case`` with TuSimple labels into a zip laid out as the benchmark
     (``folder/000000.png … labels.json case.json``, ``folder`` = ``Category/Type/case``)."""
     with tempfile.TemporaryDirectory(prefix=SCRATCH_PREFIX, dir=target.parent) as scratch:
-        export_case(case, scratch, frames=list(frames), formats={"tusimple"}, progress=progress)
+        export_case(case, scratch, frames=list(frames), formats={"tusimple"}, progress=progress,
+                    meshes_dir=meshes_dir)
         zip_folder(Path(scratch), target, folder)
     return target
 
 
 def drive_job(jobs: JobManager, case: Case, settings: DriveSettings, meta: dict[str, Any] | None = None,
-              key: str | None = None, client: str | None = None) -> Job:
+              key: str | None = None, client: str | None = None, meshes_dir: Path | None = None) -> Job:
     """Queue a closed-loop drive of ``case``; the job's result is its folder of files (``lanevil_core.drive``).
     ``key`` and ``client`` as in ``JobManager.submit`` (the same drive shared, a client's share bounded)."""
     from lanevil_core.drive.outputs import drive_to_folder
@@ -266,7 +267,7 @@ def drive_job(jobs: JobManager, case: Case, settings: DriveSettings, meta: dict[
 
     def work(job: Job, progress: Progress) -> Path:
         folder = jobs.drive_folder(job.id)
-        drive_to_folder(case, settings, folder, video=True, progress=progress)
+        drive_to_folder(case, settings, folder, video=True, progress=progress, meshes_dir=meshes_dir)
         return folder
 
     return jobs.submit("drive", steps, work, meta, key=key, client=client)

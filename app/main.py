@@ -8,8 +8,10 @@ from fastapi.responses import RedirectResponse
 from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
+from .api.allow import AllowMiddleware
 from .api.errors import error_response, handle_exception
 from .docs import mount_docs
+from .headers import SecurityHeadersMiddleware
 from .jobs import JobNotFound
 from .settings import Settings
 from .site import mount_static
@@ -27,8 +29,10 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
                   description="Editable 3D lane-detection robustness cases: store, render, export, study. Errors of "
                               "`/api` answer `{\"detail\": \"<field>: <message>\", \"field\": \"<field>\"}`.")
     app.state.lanevil = state
+    app.add_middleware(AllowMiddleware)
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes,
                        max_upload_bytes=settings.max_upload_bytes)
+    app.add_middleware(SecurityHeadersMiddleware)  # added last = outermost: 413s carry the headers too
     for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route
         app.add_exception_handler(error, handle_exception)
     app.include_router(api_router, prefix="/api")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import uvicorn
 
 from .main import create_app
+from .memory import limit_malloc_arenas
 from .settings import Settings
 from .state import AppState
 from .study.token import TOKEN_FILE, with_organiser_token
@@ -81,6 +82,7 @@ def _http_host(host: str) -> str:
 
 def serve(settings: Settings) -> int:
     """Run the backend (and the editor, unless ``settings.editor`` is off) until Ctrl+C / SIGTERM."""
+    limit_malloc_arenas(settings.malloc_arenas)  # before any thread starts (memory.py)
     sock = listen(settings.host, settings.port)  # first: a busy port fails at once, before the store is opened
     settings, new_token = with_organiser_token(settings)
     state = AppState.open(settings)
@@ -90,7 +92,7 @@ def serve(settings: Settings) -> int:
     if settings.editor:
         from .editor import launch_editor
 
-        editor = launch_editor(state, host=settings.host, port=settings.editor_port)
+        editor = launch_editor(state, host=settings.host, port=settings.editor_port, api_port=api_port)
         app.state.editor_port = editor.port
         app.state.open_in_editor = editor.open_case
     urls = Urls(api=f"http://{_http_host(settings.host)}:{api_port}/",

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Annotated
 
-from pydantic import Field
-from pydantic_settings import BaseSettings, SettingsConfigDict
+from pydantic import Field, field_validator
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 
 class Settings(BaseSettings):
@@ -27,5 +28,21 @@ class Settings(BaseSettings):
     max_jobs: int = Field(16, ge=1, description="export jobs queued or running before clients get 429")
     max_jobs_per_client: int = Field(4, ge=1, description="export jobs one client may have queued or running")
     frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
+    max_renders: int = Field(2, ge=1, description="frames rendered at once; more requests wait for a slot")
+    max_render_queue: int = Field(32, ge=0, description="requests waiting for a render slot before clients get 503")
+    scene_cache_bytes: int = Field(128_000_000, ge=0, description="memory budget of the compiled-scene cache")
+    malloc_arenas: int = Field(2, ge=0, description="glibc malloc arenas of the server process (0 = glibc's default); "
+                               "fewer arenas keep the resident memory of concurrent renders down")
     render_threads: int = Field(0, ge=0, description="threads per rendered frame (0 = every core this process may use)")
     editor: bool = Field(True, description="start the viser editor beside the API")
+    allowed_origins: Annotated[list[str], NoDecode] = Field(
+        default_factory=list, description="more origins whose pages may open the editor's websocket, comma-separated "
+        "(`http://studio.example:8080`; `*` = any); always allowed: the editor's and the API's ports on localhost, "
+        "127.0.0.1, [::1] and the bound host")
+
+    @field_validator("allowed_origins", mode="before")
+    @classmethod
+    def _comma_separated(cls, value: object) -> object:
+        if isinstance(value, str):
+            return [origin.strip() for origin in value.split(",") if origin.strip()]
+        return value

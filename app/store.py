@@ -26,6 +26,8 @@ from lanevil_core.files import remove_stale_temps
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.stock import CATEGORY_FOLDERS as STOCK_FOLDERS
 
+from .meshes import legacy_mesh_files
+
 ID_PATTERN = re.compile(r"^[a-z0-9][a-z0-9_-]{0,79}$")
 CASES_FOLDER = "cases"
 ChangeKind = Literal["created", "updated", "deleted"]
@@ -164,7 +166,7 @@ class CaseStore:
     def _read(self, path: Path) -> CaseRecord:
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
-            case = parse_case(data["case"], source=str(path.name))
+            case = parse_case(legacy_mesh_files(data["case"]), source=str(path.name))
             return CaseRecord(id=check_id(data["id"]), version=int(data["version"]), case=case,
                               created_at=float(data["created_at"]), updated_at=float(data["updated_at"]),
                               origin=data.get("origin"))

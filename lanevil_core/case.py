@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
 
 from .files import write_atomic
 from .illusions import IllusionSpec
@@ -38,9 +38,9 @@ class Marking(_Model):
     """The paint on one lane boundary."""
 
     type: LineType = "white_dashed"
-    width: float = Field(PAINT_WIDTH_M, gt=0.02, le=0.6, description="paint width of one line (m)")
-    dash: float = Field(DASH_M, gt=0.1, le=50, description="dash length (m)")
-    gap: float = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
+    width: StrictFloat = Field(PAINT_WIDTH_M, gt=0.02, le=0.6, description="paint width of one line (m)")
+    dash: StrictFloat = Field(DASH_M, gt=0.1, le=50, description="dash length (m)")
+    gap: StrictFloat = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
 
     @model_validator(mode="before")
     @classmethod
@@ -65,19 +65,19 @@ class Road(_Model):
     """
 
     type: RoadType = "straight"
-    length: float = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
-    lanes_per_direction: int = Field(2, ge=1, le=4)
-    lane_width: float = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
-    radius: float = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")
+    length: StrictFloat = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
+    lanes_per_direction: StrictInt = Field(2, ge=1, le=4)
+    lane_width: StrictFloat = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
+    radius: StrictFloat = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")
     turn: Turn = Field("left", description="direction of the (first) bend")
-    grade: float = Field(0.06, ge=0.0, le=0.15, description="slope of uphill/downhill roads (rise/run)")
-    junction_s: float = Field(70.0, ge=20.0, description="distance along the road of a junction's centre (m)")
+    grade: StrictFloat = Field(0.06, ge=0.0, le=0.15, description="slope of uphill/downhill roads (rise/run)")
+    junction_s: StrictFloat = Field(70.0, ge=20.0, description="distance along the road of a junction's centre (m)")
     markings: list[Marking] = Field(
         default_factory=list,
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults)",
     )
-    paint: bool = Field(
+    paint: StrictBool = Field(
         True,
         description="false removes every lane marking from the world (the paint-free control: the lane labels "
         "stay, so a detector that still finds the lanes reads the road's layout, not its paint)",
@@ -101,29 +101,29 @@ class Scene(_Model):
     """What stands beside the road."""
 
     kind: SceneKind = "suburban"
-    density: float = Field(1.0, ge=0.0, le=3.0, description="how many roadside props (1 = typical)")
+    density: StrictFloat = Field(1.0, ge=0.0, le=3.0, description="how many roadside props (1 = typical)")
 
 
 class Weather(_Model):
     """The numeric fields of CARLA's WeatherParameters (0-100 except distances)."""
 
-    cloudiness: float = Field(5.0, ge=0, le=100)
-    precipitation: float = Field(0.0, ge=0, le=100)
-    precipitation_deposits: float = Field(0.0, ge=0, le=100, description="puddles")
-    wetness: float = Field(0.0, ge=0, le=100)
-    fog_density: float = Field(2.0, ge=0, le=100)
-    fog_distance: float = Field(0.0, ge=0, le=1000, description="distance where fog starts (m)")
+    cloudiness: StrictFloat = Field(5.0, ge=0, le=100)
+    precipitation: StrictFloat = Field(0.0, ge=0, le=100)
+    precipitation_deposits: StrictFloat = Field(0.0, ge=0, le=100, description="puddles")
+    wetness: StrictFloat = Field(0.0, ge=0, le=100)
+    fog_density: StrictFloat = Field(2.0, ge=0, le=100)
+    fog_distance: StrictFloat = Field(0.0, ge=0, le=1000, description="distance where fog starts (m)")
 
 
 class Sun(_Model):
     """The sun: azimuth counter-clockwise from world +X (the road's start heading), altitude above the horizon."""
 
-    azimuth: float = Field(30.0, ge=-360, le=360, description="degrees, 0 = ahead at the start, 90 = left")
-    altitude: float = Field(45.0, ge=-90, le=90, description="degrees above the horizon")
-    intensity: float = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
+    azimuth: StrictFloat = Field(30.0, ge=-360, le=360, description="degrees, 0 = ahead at the start, 90 = left")
+    altitude: StrictFloat = Field(45.0, ge=-90, le=90, description="degrees above the horizon")
+    intensity: StrictFloat = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
 
 
-Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 
 
 def _take_preset(data: Any, lookup: Callable[[str], dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]] | None:
@@ -142,11 +142,11 @@ class Lens(_Model):
     """Brown-Conrady lens distortion (OpenCV's k1, k2, p1, p2, k3) on normalised image coordinates. All zero is a
     pinhole; k1 < 0 is the barrel distortion of a wide dash-cam lens. Labels go through the same model."""
 
-    k1: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^2 term")
-    k2: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^4 term")
-    k3: float = Field(0.0, ge=-1.0, le=1.0, description="radial, r^6 term")
-    p1: float = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
-    p2: float = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
+    k1: StrictFloat = Field(0.0, ge=-1.0, le=1.0, description="radial, r^2 term")
+    k2: StrictFloat = Field(0.0, ge=-1.0, le=1.0, description="radial, r^4 term")
+    k3: StrictFloat = Field(0.0, ge=-1.0, le=1.0, description="radial, r^6 term")
+    p1: StrictFloat = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
+    p2: StrictFloat = Field(0.0, ge=-0.05, le=0.05, description="tangential (decentring)")
 
     @property
     def coefficients(self) -> tuple[float, float, float, float, float]:
@@ -158,12 +158,12 @@ class Bonnet(_Model):
     """The ego's bonnet (hood) in view: a rounded front edge below and ahead of the camera. Lane labels stop
     where it hides the road."""
 
-    reach: float = Field(1.6, ge=0.3, le=4.0, description="distance ahead of the camera to the front edge (m)")
-    drop: float = Field(0.45, ge=0.05, le=2.0, description="how far below the camera the front edge is (m)")
-    width: float = Field(1.75, ge=0.8, le=3.0, description="width of the bonnet (m)")
-    crown: float = Field(0.08, ge=0.0, le=0.5, description="how much lower its corners are than its middle (m)")
+    reach: StrictFloat = Field(1.6, ge=0.3, le=4.0, description="distance ahead of the camera to the front edge (m)")
+    drop: StrictFloat = Field(0.45, ge=0.05, le=2.0, description="how far below the camera the front edge is (m)")
+    width: StrictFloat = Field(1.75, ge=0.8, le=3.0, description="width of the bonnet (m)")
+    crown: StrictFloat = Field(0.08, ge=0.0, le=0.5, description="how much lower its corners are than its middle (m)")
     color: tuple[Unit, Unit, Unit] = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
-    gloss: float = Field(0.35, ge=0.0, le=1.0, description="share of the sky mirrored in the paint")
+    gloss: StrictFloat = Field(0.35, ge=0.0, le=1.0, description="share of the sky mirrored in the paint")
 
 
 class Sensor(_Model):
@@ -172,20 +172,20 @@ class Sensor(_Model):
     the exposure time. Deterministic per case seed and frame."""
 
     exposure: Literal["auto", "fixed"] = Field("auto", description="auto meters every frame; fixed uses `gain`")
-    bias: float = Field(0.0, ge=-3.0, le=3.0, description="exposure compensation (EV)")
-    gain: float = Field(1.0, gt=0.0, le=64.0, description="exposure of the fixed mode (1 = scene-referred)")
-    min_gain: float = Field(0.05, gt=0.0, le=64.0, description="auto-exposure's lower limit")
-    max_gain: float = Field(16.0, gt=0.0, le=256.0, description="auto-exposure's upper limit (longest shutter, "
+    bias: StrictFloat = Field(0.0, ge=-3.0, le=3.0, description="exposure compensation (EV)")
+    gain: StrictFloat = Field(1.0, gt=0.0, le=64.0, description="exposure of the fixed mode (1 = scene-referred)")
+    min_gain: StrictFloat = Field(0.05, gt=0.0, le=64.0, description="auto-exposure's lower limit")
+    max_gain: StrictFloat = Field(16.0, gt=0.0, le=256.0, description="auto-exposure's upper limit (longest shutter, "
                             "highest ISO)")
-    white_balance: float = Field(5600.0, ge=2000.0, le=12000.0, description="colour temperature the camera "
+    white_balance: StrictFloat = Field(5600.0, ge=2000.0, le=12000.0, description="colour temperature the camera "
                                  "balances for (K); the scene's light is daylight (5600 K)")
-    saturation: float = Field(1.45, ge=0.0, le=3.0, description="colour matrix saturation (1 = none)")
-    contrast: float = Field(1.15, ge=0.5, le=2.0, description="slope of the filmic curve's toe and middle")
-    vignetting: float = Field(0.35, ge=0.0, le=1.0, description="light lost in the image corners (0-1)")
-    sharpen: float = Field(0.6, ge=0.0, le=3.0, description="ISP unsharp-mask amount")
-    noise: float = Field(1.0, ge=0.0, le=10.0, description="sensor noise scale (1 = a typical small sensor)")
-    shutter: float = Field(0.004, ge=0.0, le=0.1, description="exposure time for motion blur (s); 0 = none")
-    compression: int | None = Field(None, ge=10, le=100, description="JPEG quality of the recording (a dash "
+    saturation: StrictFloat = Field(1.45, ge=0.0, le=3.0, description="colour matrix saturation (1 = none)")
+    contrast: StrictFloat = Field(1.15, ge=0.5, le=2.0, description="slope of the filmic curve's toe and middle")
+    vignetting: StrictFloat = Field(0.35, ge=0.0, le=1.0, description="light lost in the image corners (0-1)")
+    sharpen: StrictFloat = Field(0.6, ge=0.0, le=3.0, description="ISP unsharp-mask amount")
+    noise: StrictFloat = Field(1.0, ge=0.0, le=10.0, description="sensor noise scale (1 = a typical small sensor)")
+    shutter: StrictFloat = Field(0.004, ge=0.0, le=0.1, description="exposure time for motion blur (s); 0 = none")
+    compression: StrictInt | None = Field(None, ge=10, le=100, description="JPEG quality of the recording (a dash "
                                     "cam's compressed video); empty = none")
 
 
@@ -196,18 +196,18 @@ class Camera(_Model):
     ``{"preset": "dashcam"}`` fills the numbers of a named camera (``presets.CAMERA_PRESETS``); fields given
     explicitly win. Without ``sensor`` the frame is the ideal tone-mapped render of the paper's CARLA captures."""
 
-    width: int = Field(1280, ge=64, le=4096)
-    height: int = Field(720, ge=64, le=4096)
-    fov: float = Field(90.0, gt=10, lt=170, description="horizontal field of view (degrees)")
-    focal: float | None = Field(None, gt=10, le=20000, description="focal length (px at `width`); wins over fov")
-    cx: float | None = Field(None, ge=0, le=4096, description="principal point column (px); empty = centre")
-    cy: float | None = Field(None, ge=0, le=4096, description="principal point row (px); empty = centre")
-    x: float = Field(1.0, ge=-5, le=5, description="mount position ahead of the vehicle origin (m)")
-    y: float = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
-    z: float = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
-    pitch: float = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
-    yaw: float = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
-    roll: float = Field(0.0, ge=-30, le=30, description="degrees about the optical axis, positive turns the "
+    width: StrictInt = Field(1280, ge=64, le=4096)
+    height: StrictInt = Field(720, ge=64, le=4096)
+    fov: StrictFloat = Field(90.0, gt=10, lt=170, description="horizontal field of view (degrees)")
+    focal: StrictFloat | None = Field(None, gt=10, le=20000, description="focal length (px at `width`); wins over fov")
+    cx: StrictFloat | None = Field(None, ge=0, le=4096, description="principal point column (px); empty = centre")
+    cy: StrictFloat | None = Field(None, ge=0, le=4096, description="principal point row (px); empty = centre")
+    x: StrictFloat = Field(1.0, ge=-5, le=5, description="mount position ahead of the vehicle origin (m)")
+    y: StrictFloat = Field(0.0, ge=-2, le=2, description="mount position to the left (m)")
+    z: StrictFloat = Field(3.0, gt=0.3, le=6, description="mount height above the road (m)")
+    pitch: StrictFloat = Field(0.0, ge=-45, le=45, description="degrees, positive looks down")
+    yaw: StrictFloat = Field(0.0, ge=-30, le=30, description="degrees, positive looks left of the vehicle's heading")
+    roll: StrictFloat = Field(0.0, ge=-30, le=30, description="degrees about the optical axis, positive turns the "
                         "image clockwise")
     lens: Lens = Field(default_factory=Lens)
     bonnet: Bonnet | None = Field(None, description="the ego's bonnet in view; empty = none")
@@ -251,11 +251,11 @@ class Camera(_Model):
 class Ego(_Model):
     """The ego vehicle drives its lane at constant speed."""
 
-    lane: int = Field(0, ge=0, description="lane of the ego's direction, 0 = next to the centre line")
-    start_s: float = Field(10.0, ge=0, description="start position along the road (m)")
-    speed: float = Field(10.0, ge=0, le=60, description="m/s")
-    fps: float = Field(10.0, gt=0, le=120)
-    frames: int = Field(100, ge=50, le=300)
+    lane: StrictInt = Field(0, ge=0, description="lane of the ego's direction, 0 = next to the centre line")
+    start_s: StrictFloat = Field(10.0, ge=0, description="start position along the road (m)")
+    speed: StrictFloat = Field(10.0, ge=0, le=60, description="m/s")
+    fps: StrictFloat = Field(10.0, gt=0, le=120)
+    frames: StrictInt = Field(100, ge=50, le=300)
 
 
 class Case(_Model):
@@ -271,7 +271,7 @@ class Case(_Model):
     camera: Camera = Field(default_factory=Camera)
     ego: Ego = Field(default_factory=Ego)
     illusions: list[IllusionSpec] = Field(default_factory=list)
-    seed: int = Field(0, ge=0, le=2**32 - 1)
+    seed: StrictInt = Field(0, ge=0, le=2**32 - 1)
 
     @model_validator(mode="before")
     @classmethod
@@ -317,6 +317,14 @@ class Case(_Model):
         values = preset_values(name)
         sun = {**values["sun"], "azimuth": self.sun.azimuth}
         return self.model_copy(update={"weather": Weather(**values["weather"]), "sun": Sun(**sun)})
+
+
+MESHES_FOLDER = "meshes"
+
+
+def case_meshes_dir(case_path: str | Path) -> Path:
+    """Where the library and the CLI read a case file's user meshes from: the ``meshes/`` folder beside it."""
+    return Path(case_path).parent / MESHES_FOLDER
 
 
 class CaseError(ValueError):

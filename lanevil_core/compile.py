@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import hashlib
 import json
+from pathlib import Path
 
 import numpy as np
 
 from .camera import ego_path
 from .case import Case
 from .environment import environment_for, is_night
-from .illusions import CompileContext
+from .illusions import CompileContext, MeshFileError
+from .illusions.traffic import mesh_path
 from .paint import road_paint
 from .road_layout import RoadNetwork, build_network
 from .scene import CompiledScene, Mesh
@@ -33,14 +35,34 @@ def _roadside(case: Case, reuse: CompiledScene | None) -> tuple[RoadNetwork, lis
     return network, roadside_meshes(case, network, np.random.default_rng([case.seed, 0]))
 
 
-def compile_scene(case: Case, reuse: CompiledScene | None = None) -> CompiledScene:
+def mesh_files(case: Case) -> list[tuple[str, str]]:
+    """(field path, file name) of every user mesh the case names (``illusions.N.vehicle.mesh_file``, the path
+    pydantic's errors give)."""
+    named = [(f"illusions.{index}.{illusion.type}.mesh_file", getattr(illusion, "mesh_file", None))
+             for index, illusion in enumerate(case.illusions)]
+    return [(field, name) for field, name in named if name]
+
+
+def check_mesh_files(case: Case, meshes_dir: Path | None) -> None:
+    """``MeshFileError`` naming the first ``mesh_file`` that is not a file in ``meshes_dir`` (without loading it)."""
+    for field, name in mesh_files(case):
+        try:
+            mesh_path(meshes_dir, name)
+        except ValueError as error:
+            raise MeshFileError(field, str(error)) from None
+
+
+def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir: Path | None = None) -> CompiledScene:
     """Build the network, the roadside props and every illusion's scene elements.
+
+    ``meshes_dir`` is the folder a vehicle's ``mesh_file`` is read from (``case_meshes_dir`` of a case file; the
+    server's uploads folder); a case naming a mesh file without one raises ``MeshFileError``.
 
     With ``reuse`` (an earlier scene whose ``roadside_key`` matches), its network and roadside meshes are taken
     as they are and only the environment and illusions are compiled anew; the result equals a full compile.
     """
     network, roadside = _roadside(case, reuse)
-    ctx = CompileContext(case=case, network=network, env=environment_for(case))
+    ctx = CompileContext(case=case, network=network, env=environment_for(case), meshes_dir=meshes_dir)
     ctx.meshes.extend(roadside)
     for index, illusion in enumerate(case.illusions):
         ctx.source = index

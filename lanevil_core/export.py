@@ -89,15 +89,16 @@ def export_case(
     formats: Collection[str] = frozenset({"tusimple", "culane"}),
     glb: bool = False,
     progress: Progress | None = None,
+    meshes_dir: Path | None = None,
 ) -> ExportResult:
     """Render ``frames`` (default: all) of ``case`` into ``out_dir`` with labels in ``formats``.
 
-    ``progress(done, total)`` is called after every frame.
+    ``progress(done, total)`` is called after every frame; a vehicle's ``mesh_file`` is read from ``meshes_dir``.
     """
     _check_formats(formats)
     chosen = _check_frames(case, range(case.ego.frames) if frames is None else frames)
     result = ExportResult(Path(out_dir))
-    scene = compile_scene(case)
+    scene = compile_scene(case, meshes_dir=meshes_dir)
     _write(result, "case.json", case_json(case).encode("utf-8"))
     records = []
     for done, frame_index in enumerate(chosen, start=1):

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from pydantic import BaseModel
 
 from .typed import Float32Array, FloatArray, IntArray
 
@@ -138,6 +139,30 @@ class Environment:
     detail: float = 0.0  # surface texture a photograph shows (0 = the ideal render's smooth surfaces)
 
 
+def array_bytes(root: Any) -> int:
+    """Summed ``nbytes`` of the distinct numpy arrays reachable from ``root`` through dataclass fields, object
+    attributes, lists, tuples and dicts (pydantic models, strings and numbers hold none worth counting)."""
+    seen: set[int] = set()
+    total, stack = 0, [root]
+    while stack:
+        item = stack.pop()
+        if id(item) in seen or item is None or isinstance(item, (str, bytes, int, float, bool, BaseModel)):
+            continue
+        seen.add(id(item))
+        if isinstance(item, np.ndarray):
+            total += item.nbytes if item.base is None else 0  # a view costs nothing beyond its base
+            if item.base is not None:
+                stack.append(item.base)
+        elif isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, (list, tuple, set, frozenset)):
+            stack.extend(item)
+        elif hasattr(item, "__dict__") or hasattr(item, "__slots__"):
+            stack.extend(getattr(item, "__dict__", {}).values())
+            stack.extend(getattr(item, name) for name in getattr(item, "__slots__", ()) if hasattr(item, name))
+    return total
+
+
 @dataclass
 class CompiledScene:
     """Everything the renderer, the label generator and the exporters need for any frame of a case; they read
@@ -152,6 +177,12 @@ class CompiledScene:
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)
     cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)  # renderer's packed arrays
+
+    def nbytes(self) -> int:
+        """Bytes of the numpy arrays the scene holds (meshes, layers, network, the renderer's packed cache): what
+        keeping it in memory costs, for caches bounded by bytes."""
+        return array_bytes([self.network, self.env, self.paint, self.ego, self.meshes, self.layers, self.lights,
+                            self.cache])
 
     def object_names(self) -> dict[int, str]:
         """Object id (as in the id buffer) -> mesh name."""

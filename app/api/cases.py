@@ -20,12 +20,14 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field, ValidationError
 
 from lanevil_core.case import Case
-from lanevil_core.illusions import CATEGORIES, REGISTRY
+from lanevil_core.compile import check_mesh_files
+from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
 
+from ..state import AppState
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id
 from .deps import CaseIdPath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
-from .params import etag_matches, parse_version
+from .params import VERSION_PATTERN, etag_matches, parse_version
 
 router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
@@ -76,7 +78,8 @@ def envelope_response(description: str) -> dict[str, Any]:
 
 CaseBody = Annotated[dict[str, Any], Body(description="a case document, or an envelope {id?, version?, case}",
                                           openapi_examples={"case": {"value": {"title": "my case"}}})]
-IfMatch = Annotated[str | None, Header(alias="If-Match", description='the version the change is based on: "3"')]
+IfMatch = Annotated[str | None, Header(alias="If-Match", description='the version the change is based on: "3"',
+                                       json_schema_extra={"pattern": VERSION_PATTERN})]
 
 
 def record_response(record: CaseRecord, status_code: int = 200, headers: dict[str, str] | None = None) -> JSONResponse:
@@ -106,13 +109,18 @@ def split_body(body: dict[str, Any], allow_version: bool) -> tuple[dict[str, Any
     return document, case_id, version
 
 
-def validate_case(document: dict[str, Any], prefix: str) -> Case:
-    """A ``Case`` from a JSON document; a 422 naming the first bad field (under ``prefix``) otherwise."""
+def validate_case(document: dict[str, Any], prefix: str, state: AppState) -> Case:
+    """A ``Case`` from a JSON document whose mesh files are uploaded; a 422 naming the first bad field (under
+    ``prefix``) otherwise."""
     try:
-        return Case.model_validate(document)
+        case = Case.model_validate(document)
+        check_mesh_files(case, state.meshes_dir)
     except ValidationError as error:
         field, message = first_error(error.errors(), prefix)
         raise ApiError(422, message, field) from None
+    except MeshFileError as error:
+        raise ApiError(422, error.message, f"{prefix}.{error.field}" if prefix else error.field) from None
+    return case
 
 
 def expected_version(if_match: str | None, body_version: int | None) -> int | None:
@@ -141,7 +149,9 @@ def list_cases(
     category: Annotated[str | None, Query(description=f"one of {', '.join(LISTING_CATEGORIES)}")] = None,
     type: Annotated[str | None, Query(description="an illusion type, e.g. fence_shadow")] = None,  # noqa: A002
 ) -> CaseList:
-    """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type."""
+    """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type (an empty
+    value is no filter)."""
+    category, type = category or None, type or None  # noqa: A001 - ``?category=`` as a form sends "no filter"
     if category is not None and category not in LISTING_CATEGORIES:
         raise ApiError(422, f"unknown category {category!r} (choose from {', '.join(LISTING_CATEGORIES)})",
                        "category")
@@ -156,7 +166,7 @@ def list_cases(
 def create_case(body: CaseBody, state: StateDep, request: Request) -> JSONResponse:
     """Store a new case at version 1; its id is the envelope's ``id`` or one derived from the title."""
     document, case_id, _ = split_body(body, allow_version=False)
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     if case_id is not None:
         try:
             check_id(case_id)
@@ -185,7 +195,7 @@ def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfM
         raise ApiError(422, f"{body_id!r} differs from the id in the URL ({case_id!r})", "id")
     version = expected_version(if_match, body_version)
     state.store.get(case_id)  # 404 before 422 for an unknown case
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     return record_response(state.store.update(case_id, case, expected_version=version))
 
 
@@ -203,7 +213,7 @@ def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: I
     if version is not None and version != current.version:
         raise VersionConflict(case_id, version, current.version)
     merged = merge_patch(current.case.model_dump(mode="json"), patch)
-    case = validate_case(merged, "case" if "case" in body else "")
+    case = validate_case(merged, "case" if "case" in body else "", state)
     # the patch applies to ``current``: only write if nobody changed the case since it was read
     return record_response(state.store.update(case_id, case, expected_version=current.version))
 

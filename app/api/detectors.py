@@ -20,7 +20,7 @@ from lanevil_core.detector_catalog import available_detector, detector_infos
 from lanevil_core.metrics.formats import LaneFileError
 
 from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiError, ApiRoute, ErrorBody
 from .params import ScrubQueryDep, check_frame, image_size
 
 router = APIRouter(tags=["detectors"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -90,7 +90,7 @@ def get_detectors() -> dict[str, Any]:
 
 @router.get("/cases/{case_id}/frames/{frame}/detections", summary="A detector's lanes on a frame, scored",
             response_model=FrameDetectionBody,
-            responses={404: {"model": ErrorBody, "description": "no such case or frame"}})
+            responses={404: {"model": ErrorBody, "description": "no such case or frame"}, **RENDER_BUSY})
 def get_detections(
     record: RecordDep,
     frame: int,

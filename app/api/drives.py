@@ -15,6 +15,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import FileResponse, JSONResponse
 from pydantic import BaseModel, Field
 
+from lanevil_core.compile import check_mesh_files
 from lanevil_core.drive.detectors import DRIVE_DETECTORS, GROUND_TRUTH
 from lanevil_core.drive.loop import DriveSettings
 from lanevil_core.drive.outputs import PATH_PLOT_FILE, SUMMARY_FILE, TRACE_FILE, TRACE_PLOT_FILE
@@ -93,13 +94,14 @@ def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONR
     if body.detector != GROUND_TRUTH:
         checked_detector(body.detector)
     size = image_size(body.width, body.height, record.case, state.settings)
+    check_mesh_files(record.case, state.meshes_dir)
     settings = DriveSettings(detector=body.detector, controller=body.controller, seconds=body.seconds, size=size)
     meta = {"case_id": record.id, "case_version": record.version, "detector": body.detector,
             "controller": body.controller}
     key = (f"drive:{case_hash(record.case)}:{body.detector}:{body.controller}:{body.seconds}:"
            f"{body.width}x{body.height}")
     client = request.client.host if request.client else "unknown"
-    job = drive_job(state.jobs, record.case, settings, meta, key=key, client=client)
+    job = drive_job(state.jobs, record.case, settings, meta, key=key, client=client, meshes_dir=state.meshes_dir)
     payload = drive_body(job, request)
     return JSONResponse(payload, status_code=202, headers={"Location": payload["links"]["self"]})
 

@@ -19,7 +19,9 @@ from fastapi.routing import APIRoute
 from pydantic import BaseModel, ValidationError
 
 from lanevil_core.case import CaseError
+from lanevil_core.illusions import MeshFileError
 
+from ..frames import RenderBusy
 from ..jobs import JobLimit, JobNotFound
 from ..store import CaseExists, CaseNotFound, InvalidId, StoreError, VersionConflict
 from .json_body import BodyError, check_json_type, parse_json
@@ -94,8 +96,12 @@ def exception_response(error: Exception) -> JSONResponse | None:
         return error_response(404, f"job_id: {error}", "job_id")
     if isinstance(error, JobLimit):
         return error_response(429, str(error), None, {"Retry-After": str(error.retry_after_s)})
+    if isinstance(error, RenderBusy):
+        return error_response(503, str(error), None, {"Retry-After": str(error.retry_after_s)})
     if isinstance(error, BodyError):
         return error_response(error.status, f"{error.field}: {error}", error.field)
+    if isinstance(error, MeshFileError):
+        return error_response(422, str(error), error.field)
     if isinstance(error, CaseError):
         return error_response(422, str(error), "case")
     return None
@@ -164,6 +170,11 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
 BODY_RESPONSES: dict[int | str, dict[str, Any]] = {
     413: {"model": ErrorBody, "description": "the body is over the server's limit (`field`: `body`)"},
     415: {"model": ErrorBody, "description": "the body is not sent as JSON (`field`: `Content-Type`)"},
+}
+# What every route that renders frames may answer when the render queue is full (``frames.RenderSlots``).
+RENDER_BUSY: dict[int | str, dict[str, Any]] = {
+    503: {"model": ErrorBody, "description": "too many frames waiting to render: try again after `Retry-After` seconds",
+          "headers": {"Retry-After": {"description": "seconds to wait", "schema": {"type": "integer"}}}},
 }
 TOO_MANY: dict[int | str, dict[str, Any]] = {
     429: {"model": ErrorBody, "description": "too many jobs queued: try again after `Retry-After` seconds",

@@ -20,6 +20,7 @@ from fastapi.responses import FileResponse, JSONResponse
 from pydantic import BaseModel, ConfigDict, Field
 
 from lanevil_core.benchmark_layout import case_folder
+from lanevil_core.compile import check_mesh_files
 
 from ..frames import case_hash
 from ..jobs import Job, JobStatus, export_zip
@@ -99,12 +100,13 @@ def job_body(job: Job, request: Request) -> dict[str, Any]:
 def submit_export(state: AppState, record: CaseRecord, frames: range, request: Request) -> JSONResponse:
     """Queue an export job of ``frames`` (or find the job of the same export); answer 202 with the job and its URL."""
     case, folder = record.case, export_folder(record)
+    check_mesh_files(case, state.meshes_dir)  # a stored case whose mesh is gone: 422 now, not a failed job
     meta = {"case_id": record.id, "case_version": record.version, "frames": f"{frames.start}:{frames.stop}",
             "folder": folder.as_posix()}
     key = f"export:{folder.as_posix()}:{case_hash(case)}:{frames.start}:{frames.stop}"
     client = request.client.host if request.client else "unknown"
     job = state.jobs.submit("export", len(frames), lambda job, progress: export_zip(
-        case, folder, frames, state.jobs.result_path(job.id), progress), meta, key=key, client=client)
+        case, folder, frames, state.jobs.result_path(job.id), progress, state.meshes_dir), meta, key=key, client=client)
     body = job_body(job, request)
     return JSONResponse(body, status_code=202, headers={"Location": body["links"]["self"]})
 
@@ -123,7 +125,7 @@ def export_case_zip(
         return submit_export(state, record, chosen, request)
     target = state.jobs.folder / f".direct-{uuid.uuid4().hex}.zip"
     try:
-        export_zip(record.case, export_folder(record), chosen, target)
+        export_zip(record.case, export_folder(record), chosen, target, meshes_dir=state.meshes_dir)
         data = target.read_bytes()
     finally:
         Path(target).unlink(missing_ok=True)

@@ -17,7 +17,7 @@ from ..state import AppState
 from .cases import split_body, validate_case
 from .deps import RecordDep, StateDep
 from .detectors import checked_detector, detector_errors
-from .errors import ERROR_RESPONSES, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
 from .params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
 
 router = APIRouter(tags=["frames"], route_class=ApiRoute, responses=ERROR_RESPONSES)
@@ -28,6 +28,7 @@ IMAGE_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"content": {"image/png": {}, "image/jpeg": {}}, "description": "the rendered frame"},
     304: {"description": "not modified (If-None-Match matched the ETag)"},
     404: {"model": ErrorBody, "description": "no such case or frame"},
+    **RENDER_BUSY,
 }
 IfNoneMatch = Annotated[str | None, Header(alias="If-None-Match")]
 
@@ -70,7 +71,7 @@ def render_case(
 ) -> Response:
     """Render an unsaved case (e.g. the editor's working copy); same query parameters as the frame route."""
     document, _, _ = split_body(body, allow_version=True)
-    case = validate_case(document, "case" if "case" in body else "")
+    case = validate_case(document, "case" if "case" in body else "", state)
     check_frame(case, frame)
     # the ETag is a content hash: an equal case renders the same bytes, so clients may cache by it
     return image_response(state, case, frame, query, fmt, if_none_match, "private, max-age=3600")

@@ -87,5 +87,7 @@ def parse_json(data: bytes | str, field: str = "body", max_depth: int = MAX_DEPT
         raise BodyError(422, field, f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}") from None
     except RecursionError:
         value = None  # _scan names the place
+    except ValueError as error:  # an integer over Python's digit limit (``sys.get_int_max_str_digits``)
+        raise BodyError(422, field, f"a number is too long: {str(error).split(';')[0]}") from None
     _scan(text, field, max_depth)
     return value

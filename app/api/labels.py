@@ -16,10 +16,10 @@ from fastapi import APIRouter, Query, Response
 from lanevil_core.labels import CULANE_SIZE, TUSIMPLE_SIZE
 
 from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, ApiRoute, ErrorBody
+from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
 from .params import frame_range
 
-router = APIRouter(tags=["labels"], route_class=ApiRoute, responses=ERROR_RESPONSES)
+router = APIRouter(tags=["labels"], route_class=ApiRoute, responses={**ERROR_RESPONSES, **RENDER_BUSY})
 
 MAX_LABEL_FRAMES = 50  # each frame is a 1280x720 (CULane: 1640x590) render: ~0.2-0.3 s
 JSON_LINES = "application/x-ndjson"

@@ -63,6 +63,11 @@ def check_frame(case: Case, frame: int, status_code: int = 422) -> int:
     return frame
 
 
+MAX_VERSION_DIGITS = 18  # a version fits an int64; longer digit strings are refused before int() reads them
+# What ``parse_version`` takes, for the OpenAPI description of ``If-Match``.
+VERSION_PATTERN = rf'^\s*(\*|(W/)?"?[0-9]{{1,{MAX_VERSION_DIGITS}}}"?)\s*$'
+
+
 def parse_version(text: str | None, field: str = "If-Match") -> int | None:
     """A version from ``If-Match`` (``"3"``, ``W/"3"``, ``3``; ``*`` = any version -> None)."""
     if text is None:
@@ -71,8 +76,10 @@ def parse_version(text: str | None, field: str = "If-Match") -> int | None:
     if value == "*":
         return None
     value = value.removeprefix("W/").strip('"')
-    if not value.isdigit():
-        raise ApiError(422, f"{text!r} is not a case version (send the ETag of the case, e.g. \"3\")", field)
+    if not (value.isascii() and value.isdigit()) or len(value) > MAX_VERSION_DIGITS:
+        shown = text if len(text) <= 40 else f"{text[:40]}..."
+        raise ApiError(422, f"{shown!r} is not a case version (send the ETag of the case, e.g. \"3\"; at most "
+                            f"{MAX_VERSION_DIGITS} digits)", field)
     return int(value)
 
 

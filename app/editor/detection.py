@@ -10,6 +10,8 @@ from __future__ import annotations
 from lanevil_core.detect.split import METHODS
 from lanevil_core.frame_detection import FrameDetection
 
+from .text import escape_markdown
+
 NO_DETECTOR = "none"
 DETECTOR_CHOICES: tuple[str, ...] = (NO_DETECTOR, *METHODS)
 
@@ -28,11 +30,11 @@ def detection_text(found: FrameDetection) -> str:
     """Markdown, two lines: the detector's verdict on the frame, then its score."""
     fooled = found.fp > 0 or found.fn > 0
     verdict = "✗ **fooled**" if fooled else "✓ not fooled"
-    return (f"**{found.detector}** (magenta): {verdict} · {len(found.lanes)} lanes found, "
+    return (f"**{escape_markdown(found.detector)}** (magenta): {verdict} · {len(found.lanes)} lanes found, "
             f"{len(found.gt_lanes)} labelled  \n"
             f"accuracy **{100 * found.accuracy:.1f}%** · FP {rate_text(found.fp)} · FN {rate_text(found.fn)}")
 
 
 def unavailable_text(detector: str, reason: str) -> str:
     """Markdown: why the chosen detector shows nothing."""
-    return f"⚠ **{detector}**: {reason.removeprefix('detector: ')}"
+    return f"⚠ **{escape_markdown(detector)}**: {escape_markdown(reason.removeprefix('detector: '))}"

@@ -25,6 +25,7 @@ from lanevil_core.drive.outputs import SUMMARY_FILE, TRACE_PLOT_FILE
 
 from ..jobs import Job, drive_job
 from ..state import AppState
+from .text import escape_markdown
 
 POLL_S = 0.5
 MAX_FRAMES = 600
@@ -60,7 +61,8 @@ def verdict_text(summary: dict) -> str:
     verdict = "**illusion succeeded**" if summary["success"] else "no success"
     return (f"{verdict} (|deviation| > 0.285 m within 2.5 s of coming into view) · > 0.285 m {exceed} · "
             f"max {summary['max_abs_deviation']:.3f} m · lane departure {'yes' if summary['lane_departure'] else 'no'}"
-            f" · off road {'yes' if summary['off_road'] else 'no'} · {summary['detector']} + {summary['controller']}")
+            f" · off road {'yes' if summary['off_road'] else 'no'} · {escape_markdown(summary['detector'])} + "
+            f"{escape_markdown(summary['controller'])}")
 
 
 class DrivePanel:
@@ -105,7 +107,7 @@ class DrivePanel:
         try:
             case_id, case = self.current()
         except Exception as error:  # noqa: BLE001 - no case open: say why in the folder
-            self.status.content = f"⚠ {error}"
+            self.status.content = f"⚠ {escape_markdown(error)}"
             return None
         controller = next(name for name in CONTROLLERS if name == self.controller.value)
         settings = DriveSettings(detector=self.detector(), controller=controller,
@@ -113,7 +115,7 @@ class DrivePanel:
         self.fps = case.ego.fps
         self.job = drive_job(self.state.jobs, case, settings,
                              {"case_id": case_id, "detector": settings.detector, "controller": settings.controller})
-        self.status.content = f"driving {case_id} with **{settings.detector}** …"
+        self.status.content = f"driving {escape_markdown(case_id)} with **{escape_markdown(settings.detector)}** …"
         threading.Thread(target=self._follow, args=(self.job,), name="lanevil-editor-drive", daemon=True).start()
         return self.job
 
@@ -121,11 +123,12 @@ class DrivePanel:
         while not job.finished.wait(POLL_S):
             if self._stopped.is_set():
                 return
-            self.status.content = f"driving with **{job.meta['detector']}**: step {job.done} of {job.total}"
+            detector = escape_markdown(job.meta["detector"])
+            self.status.content = f"driving with **{detector}**: step {job.done} of {job.total}"
         if self._stopped.is_set():
             return
         if job.status != "done" or job.result is None:
-            self.status.content = f"⚠ the drive {job.status}: {job.error or ''}"
+            self.status.content = f"⚠ the drive {job.status}: {escape_markdown(job.error or '')}"
             return
         summary = json.loads((job.result / SUMMARY_FILE).read_text(encoding="utf-8"))
         self.status.content = verdict_text(summary)

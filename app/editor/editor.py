@@ -20,23 +20,26 @@ import viser
 
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Bonnet, Case, CaseError, Sensor, parse_case
-from lanevil_core.compile import roadside_key
-from lanevil_core.illusions import REGISTRY, Illusion
+from lanevil_core.compile import check_mesh_files, roadside_key
+from lanevil_core.illusions import REGISTRY, Illusion, MeshFileError
 from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.presets import camera_preset_values, preset_values
 from lanevil_core.road_layout import RoadNetwork
 from lanevil_core.scene import CompiledScene
 
+from ..meshes import MeshUploadError, store_mesh
 from ..state import AppState
 from ..store import CaseRecord, ChangeKind, StoreError, VersionConflict
 from . import export
 from .detection import chosen_detector, detection_text, unavailable_text
 from .drive_panel import DrivePanel
+from .origins import OriginCheck, checking_origins
 from .panel import CUSTOM_CAMERA, CUSTOM_WEATHER, NO_SELECTION, PLACE_OFF, Panel, build_panel
 from .placement import anchor_road, field_bounds, placement_fields, ray_surface_hit, road_coordinates
 from .preview import PreviewRequest, PreviewResult, PreviewWorker
 from .scene_view import SceneView
 from .session import CaseSession, SessionRegistry
+from .text import escape_markdown
 
 SELECT_RADIUS_M = 8.0  # a click this close to an illusion's handle selects it
 SUN_FIELDS = ("azimuth", "altitude", "intensity")
@@ -151,6 +154,7 @@ class Editor:
                   "export_sequence": lambda e: self.export_sequence(e.client)}
         for name, action in clicks.items():
             getattr(p, name).on_click(self._guarded(action))
+        p.upload_mesh.on_upload(self._guarded(lambda e: self.upload_mesh(e.target.value.name, e.target.value.content)))
         self.server.gui.add_command("Undo", hotkey="Z", modifier="cmd/ctrl",
                                     description="undo the last change").on_trigger(self._guarded(lambda e: self.undo()))
         self.server.gui.add_command("Redo", hotkey="Z", modifier="cmd/ctrl+shift",
@@ -195,6 +199,7 @@ class Editor:
     def save(self) -> CaseRecord | None:
         """Write the edited case through the store's version check; a conflict is reported and the edits kept."""
         session = self._current()
+        self._check_meshes(session.case)
         try:
             record = session.save(self.state.store)
         except VersionConflict as error:
@@ -207,9 +212,17 @@ class Editor:
     def save_as_new(self) -> str:
         """Store the edited case under a fresh id and continue there."""
         case = self.case
+        self._check_meshes(case)
         record = self.state.store.create(case)
         self.open_case(record.id)
         return record.id
+
+    def _check_meshes(self, case: Case) -> None:
+        """What the REST API refuses is not stored from here either: a ``mesh_file`` that is not uploaded."""
+        try:
+            check_mesh_files(case, self.state.meshes_dir)
+        except MeshFileError as error:
+            raise EditError(f"Not saved: {error} (use Upload vehicle mesh)") from None
 
     def reload(self) -> None:
         session = self._current()
@@ -304,6 +317,19 @@ class Editor:
     def set_field(self, name: str, value: Any) -> None:
         illusion = self._illusion(self.selected)
         self._edit_illusion(self.selected, {name: value}, f"{illusion.type} {name}")
+
+    def upload_mesh(self, filename: str, data: bytes) -> str:
+        """Store a model in the server's uploads folder (as ``POST /api/meshes`` does) and make it the selected
+        vehicle's ``mesh_file``; returns the name it is stored under."""
+        illusion = self._illusion(self.selected)
+        if "mesh_file" not in type(illusion).model_fields:
+            raise EditError(f"a {illusion.type} takes no mesh: select a vehicle, then upload its model")
+        try:
+            name = store_mesh(self.state.meshes_dir, filename, data, self.state.settings.max_upload_bytes)
+        except MeshUploadError as error:
+            raise EditError(f"mesh not stored: {error}") from None
+        self.set_field("mesh_file", name)
+        return name
 
     def delete_selected(self) -> None:
         illusion = self._illusion(self.selected)
@@ -479,11 +505,11 @@ class Editor:
         session = self.session
         if session is None:
             return "No case open."
-        facts = [f"**{session.case_id}** · version {session.version}"]
+        facts = [f"**{escape_markdown(session.case_id)}** · version {session.version}"]
         facts.append("unsaved changes" if session.dirty else "saved")
         if session.remote_version is not None:
             facts.append(f"version {session.remote_version} in the store")
-        line = f"\n\n{'⚠ ' if error else ''}{self.message}" if self.message else ""
+        line = f"\n\n{'⚠ ' if error else ''}{escape_markdown(self.message)}" if self.message else ""
         return " · ".join(facts) + line
 
     def _report(self, message: str, error: bool = False) -> None:
@@ -634,7 +660,15 @@ class Editor:
         return job
 
 
-def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080) -> Editor:
-    """Start the viser editor on ``host:port`` (0 = any free port) over ``state``; ``editor.port`` is the real one."""
-    server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
+def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080, api_port: int | None = None) -> Editor:
+    """Start the viser editor on ``host:port`` (0 = any free port) over ``state``; ``editor.port`` is the real one.
+
+    Its websocket takes pages of its own and the API's port (``api_port``, default the settings') on loopback and
+    ``host``, and ``state.settings.allowed_origins`` (``origins.py``); other origins get a 403."""
+    bound: list[int] = []
+    ports = {state.settings.port if api_port is None else api_port}
+    check = OriginCheck(host, lambda: {*bound, *ports}, state.settings.allowed_origins)
+    with checking_origins(check):
+        server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
+    bound.append(server.get_port())
     return Editor(state, server)

@@ -19,6 +19,7 @@ from .detection import DETECTOR_CHOICES, NO_DETECTOR
 from .params import ParamInputs
 from .preview import PREVIEW_SIZE
 
+MESH_TYPES = ".glb,.gltf,.obj"  # what the upload dialog offers
 PLACE_OFF = "(pick a type, then click the road)"
 NO_SELECTION = "(none)"
 CUSTOM_WEATHER = "(as in the case)"
@@ -52,6 +53,7 @@ class Panel:
     selected: viser.GuiDropdownHandle
     severity: viser.GuiSliderHandle
     delete: viser.GuiButtonHandle
+    upload_mesh: viser.GuiUploadButtonHandle
     params: ParamInputs
     sun_azimuth: viser.GuiSliderHandle
     sun_altitude: viser.GuiSliderHandle
@@ -116,6 +118,9 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         severity = gui.add_slider("Severity", 1, 5, 1, 3, marks=((1, "subtle"), (3, "3"), (5, "strong")),
                                   hint="1 = subtle … 5 = most deceptive", disabled=True)
         delete = gui.add_button("Delete illusion", icon=viser.Icon.TRASH, color="red", disabled=True)
+        upload_mesh = gui.add_upload_button("Upload vehicle mesh", icon=viser.Icon.UPLOAD, mime_type=MESH_TYPES,
+                                            hint="a .glb, .gltf or .obj model (at most 60,000 triangles) for the "
+                                                 "selected vehicle's bodies; stored in the server's uploads folder")
         params_folder = gui.add_folder("Parameters", expand_by_default=False)
     with gui.add_folder("Sun & weather"):
         sun_azimuth = gui.add_slider("Sun azimuth", -180.0, 180.0, 1.0, 30.0,
@@ -146,7 +151,7 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
                                          hint="renders every frame with TuSimple labels in the background")
     return Panel(status=status, case_id=case_id, title=title, save=save, save_copy=save_copy, reload=reload,
                  undo=undo, redo=redo, template=template, scene_kind=scene_kind, create=create, place=place,
-                 selected=selected, severity=severity, delete=delete,
+                 selected=selected, severity=severity, delete=delete, upload_mesh=upload_mesh,
                  params=ParamInputs(gui, params_folder, lambda name, value: None),
                  sun_azimuth=sun_azimuth, sun_altitude=sun_altitude, sun_intensity=sun_intensity, weather=weather,
                  camera_preset=camera_preset, camera_fov=camera_fov, camera_height=camera_height,

@@ -11,7 +11,7 @@ import functools
 import json
 import types
 from collections.abc import Callable
-from typing import Any, Literal, Union, get_args, get_origin
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 import numpy as np
 import viser
@@ -26,12 +26,15 @@ FieldChange = Callable[[str, Any], None]
 
 
 def _unwrap_optional(annotation: Any) -> tuple[Any, bool]:
-    """(inner annotation, whether None is allowed)."""
+    """(inner annotation without ``Annotated`` metadata such as ``Strict``, whether None is allowed)."""
+    optional = False
     if get_origin(annotation) in (Union, types.UnionType):
         args = [arg for arg in get_args(annotation) if arg is not type(None)]
         if len(args) == 1 and len(args) != len(get_args(annotation)):
-            return args[0], True
-    return annotation, False
+            annotation, optional = args[0], True
+    if get_origin(annotation) is Annotated:
+        annotation = get_args(annotation)[0]
+    return annotation, optional
 
 
 def parse_text(raw: str, inner: Any) -> Any:

@@ -21,6 +21,7 @@ from pydantic import ValidationError
 from starlette.datastructures import UploadFile
 
 from ..api.errors import ApiError, ApiRoute, ErrorBody, first_error
+from ..api.forms import read_form
 from ..api.json_body import BodyError, check_json_type, is_json_type, parse_json
 from ..state import AppState, get_state
 from .auth import AdminDep
@@ -167,7 +168,7 @@ async def _read_create_request(request: Request, state: AppState) -> tuple[Study
             raise http_error(415, error.field, "send multipart/form-data (a 'spec' field and 'files') or "
                                                f"application/json (the spec alone), not {content_type or 'nothing'}"
                              ) from None
-    form = await request.form(max_files=MAX_UPLOAD_FILES)
+    form = await read_form(request, MAX_UPLOAD_FILES)
     part = form.get("spec")
     raw_spec: str | bytes | None
     if isinstance(part, UploadFile):  # a JSON part, as /docs and generated clients send it

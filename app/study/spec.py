@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, model_validator
 
 Role = Literal["test", "training", "gold", "trap"]
 Source = Literal["synthetic", "real"]
@@ -45,12 +45,14 @@ class ItemSpec(_Strict):
     """One stimulus: a generated frame or an uploaded image, with its role and quality-control answer."""
 
     case_id: str | None = Field(None, description="stored case to render (synthetic item)")
-    frame: int = Field(0, ge=0, description="frame index of the case")
+    frame: StrictInt = Field(0, ge=0, description="frame index of the case")
     upload: str | None = Field(None, description="file name of an uploaded real image (real item)")
     role: Role = "test"
-    expect: tuple[int, int] | None = Field(None, description="gold items: inclusive range of accepted ratings")
-    answer: int | None = Field(None, ge=1, le=5, description="trap items: the rating the banner asks for")
-    garble: bool = Field(False, description="scramble the image into an obviously broken one")
+    expect: tuple[StrictInt, StrictInt] | None = Field(
+        None, description="gold items: inclusive range of accepted ratings"
+    )
+    answer: StrictInt | None = Field(None, ge=1, le=5, description="trap items: the rating the banner asks for")
+    garble: StrictBool = Field(False, description="scramble the image into an obviously broken one")
 
     @model_validator(mode="after")
     def _consistent(self) -> ItemSpec:
@@ -77,7 +79,7 @@ class GeneratedSet(_Strict):
     """Shorthand for many scored synthetic items: every listed case at every listed frame."""
 
     cases: list[str] = Field(min_length=1)
-    frames: list[int] = Field([0], min_length=1)
+    frames: list[StrictInt] = Field([0], min_length=1)
 
     @model_validator(mode="after")
     def _frames_non_negative(self) -> GeneratedSet:
@@ -93,12 +95,12 @@ class StudySpec(_Strict):
     question: str = Field(DEFAULT_QUESTION, min_length=1, max_length=300)
     consent_text: str = Field(DEFAULT_CONSENT, min_length=1, max_length=10_000)
     instructions: str = Field(DEFAULT_INSTRUCTIONS, min_length=1, max_length=10_000)
-    viewing_seconds: float = Field(3.0, ge=0.1, le=30.0, description="how long each image is shown")
-    width: int = Field(1280, ge=16, description="render width of generated items")
-    height: int = Field(720, ge=16, description="render height of generated items")
+    viewing_seconds: StrictFloat = Field(3.0, ge=0.1, le=30.0, description="how long each image is shown")
+    width: StrictInt = Field(1280, ge=16, description="render width of generated items")
+    height: StrictInt = Field(720, ge=16, description="render height of generated items")
     items: list[ItemSpec] = Field(default_factory=list)
     generated: GeneratedSet | None = None
-    uploads_as_items: bool = Field(True, description="uploads no item names become scored real items")
+    uploads_as_items: StrictBool = Field(True, description="uploads no item names become scored real items")
 
     def all_items(self, upload_names: list[str]) -> list[ItemSpec]:
         """``items``, then the ``generated`` cross product, then (if asked) the uploads no item names."""
@@ -115,12 +117,12 @@ class StudySpec(_Strict):
 class ConsentIn(_Strict):
     """A participant's agreement; nothing is stored unless ``consent`` is true."""
 
-    consent: bool
+    consent: StrictBool
 
 
 class RatingIn(_Strict):
     """One ACR rating of one item."""
 
-    item_id: int = Field(ge=1)
-    rating: int = Field(ge=1, le=5, description="5 Excellent, 4 Good, 3 Fair, 2 Poor, 1 Bad")
-    response_ms: int | None = Field(None, ge=0, le=3_600_000, description="time from the scale appearing")
+    item_id: StrictInt = Field(ge=1)
+    rating: StrictInt = Field(ge=1, le=5, description="5 Excellent, 4 Good, 3 Fair, 2 Poor, 1 Bad")
+    response_ms: StrictInt | None = Field(None, ge=0, le=3_600_000, description="time from the scale appearing")

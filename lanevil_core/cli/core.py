@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..case import Case, load_case, write_atomic
+from ..case import Case, case_meshes_dir, load_case, write_atomic
 from .base import (
     CLEAN_DIR,
     SCENES_DIR,
@@ -36,14 +36,16 @@ def _render_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--labels", type=Path, default=None, help="also write the frame's TuSimple record (JSON)")
 
 
-def render_image(case: Case, frame_index: int, size: tuple[int, int] | None, overlay: bool) -> tuple[np.ndarray, dict]:
-    """Render one frame; return the (H, W, 3) uint8 image (lanes drawn when ``overlay``) and its TuSimple record."""
+def render_image(case: Case, frame_index: int, size: tuple[int, int] | None, overlay: bool,
+                 meshes_dir: Path | None = None) -> tuple[np.ndarray, dict]:
+    """Render one frame; return the (H, W, 3) uint8 image (lanes drawn when ``overlay``) and its TuSimple record.
+    A vehicle's ``mesh_file`` is read from ``meshes_dir``."""
     from ..compile import compile_scene
     from ..labels import tusimple_record
     from ..overlay import draw_lanes
     from ..render import render_frame
 
-    scene = compile_scene(case)
+    scene = compile_scene(case, meshes_dir=meshes_dir)
     frame = render_frame(scene, frame_index, size)
     record = tusimple_record(scene, frame_index, frame, raw_file=f"{frame_index:06d}.png")
     rgb = draw_lanes(frame.rgb, record) if overlay else frame.rgb
@@ -56,7 +58,7 @@ def _run_render(args: argparse.Namespace) -> int:
         output_file(args.labels, "--labels", "labels.json")
     case = load_case(args.case)
     check_frame(case, args.frame)
-    rgb, record = render_image(case, args.frame, args.size, args.overlay)
+    rgb, record = render_image(case, args.frame, args.size, args.overlay, case_meshes_dir(args.case))
     write_atomic(args.out, encode_image(rgb, args.out))
     if args.labels is not None:
         record["raw_file"] = args.out.name
@@ -103,7 +105,8 @@ def _run_export(args: argparse.Namespace) -> int:
     def progress(done: int, total: int) -> None:
         print(f"\rframe {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
-    result = export_case(case, args.out, frames=frames, formats=args.formats, glb=args.glb, progress=progress)
+    result = export_case(case, args.out, frames=frames, formats=args.formats, glb=args.glb, progress=progress,
+                         meshes_dir=case_meshes_dir(args.case))
     print(f"{len(result.files)} files in {result.out_dir}")
     return 0
 
@@ -136,7 +139,7 @@ def _run_preview(args: argparse.Namespace) -> int:
     cases = [(path, load_case(path)) for path in paths]  # validate every file before rendering any
     for path, case in cases:
         check_frame(case, args.frame)
-        rgb, record = render_image(case, args.frame, args.size, overlay=False)
+        rgb, record = render_image(case, args.frame, args.size, overlay=False, meshes_dir=case_meshes_dir(path))
         target = preview_path(path, args.out)
         write_atomic(target, png_bytes(rgb))
         write_atomic(target.with_suffix(".overlay.png"), png_bytes(draw_lanes(rgb, record)))

@@ -68,7 +68,7 @@ def _run_suite(args: argparse.Namespace) -> int:
 
 
 def _run_drive(args: argparse.Namespace) -> int:
-    from ..case import load_case
+    from ..case import case_meshes_dir, load_case
     from ..drive.outputs import drive_to_folder, summary_json
     from ..drive.plots import plots_available
 
@@ -82,7 +82,8 @@ def _run_drive(args: argparse.Namespace) -> int:
     def progress(done: int, total: int) -> None:
         print(f"\rstep {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
-    output = drive_to_folder(case, _settings(args), args.out, video=args.video is not False, progress=progress)
+    output = drive_to_folder(case, _settings(args), args.out, video=args.video is not False, progress=progress,
+                             meshes_dir=case_meshes_dir(args.case))
     if not plots_available():
         print("note: matplotlib is not installed (pip install 'lanevil[report]'): no plots written", file=sys.stderr)
     summary = output.summary

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..case import Case, write_atomic
+from ..compile import compile_scene
 from .loop import DriveSettings, DriveTrace, Progress, drive_case
 from .plots import path_plot, plots_available, trace_plot
 from .summary import DriveSummary, summarize
@@ -64,13 +65,16 @@ def write_drive(trace: DriveTrace, summary: DriveSummary, out_dir: Path, plots: 
 
 
 def drive_to_folder(case: Case, settings: DriveSettings, out_dir: str | Path, video: bool = True,
-                    plots: bool = True, progress: Progress | None = None) -> DriveOutput:
-    """Drive ``case`` and write every output into ``out_dir`` (created)."""
+                    plots: bool = True, progress: Progress | None = None,
+                    meshes_dir: Path | None = None) -> DriveOutput:
+    """Drive ``case`` and write every output into ``out_dir`` (created); ``mesh_file`` models come from
+    ``meshes_dir``."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     recorder = DriveVideo(out_dir / VIDEO_FILE, case.ego.fps) if video else None
     started = time.perf_counter()
-    trace = drive_case(case, settings, on_step=recorder, progress=progress)
+    scene = compile_scene(case, meshes_dir=meshes_dir)
+    trace = drive_case(case, settings, on_step=recorder, progress=progress, scene=scene)
     wall = time.perf_counter() - started
     summary = summarize(trace, wall)
     files = write_drive(trace, summary, out_dir, plots)

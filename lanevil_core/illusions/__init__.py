@@ -8,7 +8,7 @@ from pydantic import Field
 
 # Import order is registry order: the benchmark's category order.
 from . import road_damage, traffic, shadow, reflection  # noqa: F401  # isort: skip
-from .base import CATEGORIES, REGISTRY, Category, CompileContext, Illusion, register
+from .base import CATEGORIES, REGISTRY, Category, CompileContext, Illusion, MeshFileError, register
 
 ILLUSION_TYPES: tuple[str, ...] = tuple(REGISTRY)
 
@@ -29,6 +29,7 @@ __all__ = [
     "Category",
     "CompileContext",
     "Illusion",
+    "MeshFileError",
     "IllusionSpec",
     "register",
 ]

@@ -8,10 +8,11 @@ into real scene elements (meshes, road-surface layers, lights, sun and wetness c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -36,6 +37,7 @@ class CompileContext:
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)
     source: int = -1  # index of the illusion being compiled
+    meshes_dir: Path | None = None  # the folder user meshes (``vehicle.mesh_file``) come from; None = no meshes
 
     def rng(self, seed: int) -> np.random.Generator:
         """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""
@@ -54,6 +56,15 @@ class CompileContext:
         self.lights.append(light)
 
 
+class MeshFileError(ValueError):
+    """A ``mesh_file`` that names no readable model in the meshes folder; ``field`` is its path in the case."""
+
+    def __init__(self, field: str, message: str) -> None:
+        super().__init__(f"{field}: {message}")
+        self.field = field
+        self.message = message
+
+
 @dataclass(frozen=True)
 class Level:
     """Base of the severity rows: each illusion type's row is a frozen dataclass of what one level sets."""
@@ -69,9 +80,9 @@ class Illusion(BaseModel):
     SEVERITY: ClassVar[tuple[Level, ...]]
 
     type: str
-    severity: int = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
-    seed: int = Field(0, ge=0, le=2**32 - 1)
-    s: float | None = Field(
+    severity: StrictInt = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
+    seed: StrictInt = Field(0, ge=0, le=2**32 - 1)
+    s: StrictFloat | None = Field(
         None, ge=0, description="distance along the road where it starts (m); empty = just ahead of the ego start"
     )
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
 from ..environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, sun_direction
 from ..primitives import pose_on_road, transformed
@@ -101,9 +101,11 @@ class SunlightReflection(Illusion):
     )
 
     type: Literal["sunlight_reflection"] = "sunlight_reflection"
-    sun_offset: float = Field(0.0, ge=-45, le=45, description="sun azimuth relative to the road heading (degrees)")
-    length: float = Field(150.0, gt=5, le=1000, description="extent of the puddled stretch (m)")
-    puddle_size: float = Field(1.6, gt=0.2, le=10, description="typical puddle size (m)")
+    sun_offset: StrictFloat = Field(
+        0.0, ge=-45, le=45, description="sun azimuth relative to the road heading (degrees)"
+    )
+    length: StrictFloat = Field(150.0, gt=5, le=1000, description="extent of the puddled stretch (m)")
+    puddle_size: StrictFloat = Field(1.6, gt=0.2, le=10, description="typical puddle size (m)")
 
     def level(self) -> SunlightReflectionLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -150,10 +152,10 @@ class StreetlightReflection(Illusion):
     type: Literal["streetlight_reflection"] = "streetlight_reflection"
     lamp_color: Literal["white", "yellow"] = "yellow"
     sides: Literal["left", "right", "both"] = "both"
-    spacing: float | None = Field(None, gt=5, le=100, description="lamp spacing (m); empty = from the severity")
-    height: float = Field(8.0, ge=4, le=14, description="lamp height (m)")
-    length: float | None = Field(None, gt=10, le=2000, description="extent (m); empty = to the end of the drive")
-    headlights: bool = Field(True, description="the ego's own headlights light the road ahead")
+    spacing: StrictFloat | None = Field(None, gt=5, le=100, description="lamp spacing (m); empty = from the severity")
+    height: StrictFloat = Field(8.0, ge=4, le=14, description="lamp height (m)")
+    length: StrictFloat | None = Field(None, gt=10, le=2000, description="extent (m); empty = to the end of the drive")
+    headlights: StrictBool = Field(True, description="the ego's own headlights light the road ahead")
 
     def level(self) -> StreetlightReflectionLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -214,10 +216,12 @@ class VehicleReflection(Illusion):
     )
 
     type: Literal["vehicle_reflection"] = "vehicle_reflection"
-    count: int | None = Field(None, ge=1, le=20, description="vehicles ahead; empty = from the severity")
-    gap: float = Field(14.0, ge=6, le=60, description="distance between vehicles along the road (m)")
-    color: tuple[float, float, float] | None = Field(None, description="linear RGB paint; empty = varied")
-    length: float = Field(150.0, gt=5, le=1000, description="extent of the wet stretch (m)")
+    count: StrictInt | None = Field(None, ge=1, le=20, description="vehicles ahead; empty = from the severity")
+    gap: StrictFloat = Field(14.0, ge=6, le=60, description="distance between vehicles along the road (m)")
+    color: tuple[StrictFloat, StrictFloat, StrictFloat] | None = Field(
+        None, description="linear RGB paint; empty = varied"
+    )
+    length: StrictFloat = Field(150.0, gt=5, le=1000, description="extent of the wet stretch (m)")
 
     def level(self) -> VehicleReflectionLevel:
         """This illusion's row of ``SEVERITY``."""

@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
 from .. import surface_textures as tex
 from ..environment import sun_direction
@@ -49,8 +49,8 @@ class _SurfaceDamage(Illusion):
     CATEGORY: ClassVar[Category] = "road_damage"
     TEXEL: ClassVar[float] = 0.03
 
-    extent: float = Field(80.0, gt=0, le=400, description="length along the road (m)")
-    margin: float = Field(0.5, ge=0, le=5, description="reach beyond each carriageway edge (m)")
+    extent: StrictFloat = Field(80.0, gt=0, le=400, description="length along the road (m)")
+    margin: StrictFloat = Field(0.5, ge=0, le=5, description="reach beyond each carriageway edge (m)")
 
     def start_s(self, case: Case) -> float:
         """Where along the road the damage starts: by default where the ego camera's view of the road begins."""
@@ -154,12 +154,12 @@ class RoadCrack(_SurfaceDamage):
     type: Literal["road_crack"] = "road_crack"
     kind: Literal["mixed", "transverse", "longitudinal", "alligator"] = Field(
         "mixed", description="crack pattern (mixed = mostly transverse, some longitudinal and alligator)")
-    density: float | None = Field(None, ge=0, le=20, description="cracks per 100 m^2; empty = from severity")
-    width: float | None = Field(None, ge=0.003, le=0.1, description="core width of a main crack (m)")
-    darkness: float | None = Field(None, ge=0, le=1, description="opacity of the crack core")
-    along_lines: int | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
-    joints: int | None = Field(None, ge=0, le=12, description="lane lines with failed joints cracked along them")
-    paint_wear: float | None = Field(None, ge=0, le=1, description="mean share of the lines' paint flaked off")
+    density: StrictFloat | None = Field(None, ge=0, le=20, description="cracks per 100 m^2; empty = from severity")
+    width: StrictFloat | None = Field(None, ge=0.003, le=0.1, description="core width of a main crack (m)")
+    darkness: StrictFloat | None = Field(None, ge=0, le=1, description="opacity of the crack core")
+    along_lines: StrictInt | None = Field(None, ge=0, le=12, description="long cracks right beside lane lines")
+    joints: StrictInt | None = Field(None, ge=0, le=12, description="lane lines with failed joints cracked along them")
+    paint_wear: StrictFloat | None = Field(None, ge=0, le=1, description="mean share of the lines' paint flaked off")
 
     def level(self) -> RoadCrackLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -243,17 +243,19 @@ class RoadRepair(_SurfaceDamage):
     GHOST_SHIFT_LANES: ClassVar[float] = 0.4  # the old lanes lay this share of a lane width to the right
 
     type: Literal["road_repair"] = "road_repair"
-    patches: int | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
-    strips: int | None = Field(None, ge=0, le=200, description="free-running sealant strips")
-    parallel: int | None = Field(None, ge=0, le=12, description="sealant strips right beside lane lines")
-    trenches: int | None = Field(None, ge=0, le=8, description="long narrow trench patches along lane lines")
-    unpainted: int | None = Field(None, ge=0, le=12, description="patches across lane lines, paint not restored")
-    size: float | None = Field(None, gt=0, le=4, description="patch size scale (1 = 0.8-4.4 m long)")
-    contrast: float | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
-    strip_width: float | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
-    bright_share: float | None = Field(None, ge=0, le=1, description="share of strips in bright weathered filler")
-    ghosts: int | None = Field(None, ge=0, le=12, description="old lane lines ground off beside today's lines")
-    ghost_opacity: float | None = Field(None, ge=0, le=1, description="how much of a ghost line's paler stone shows")
+    patches: StrictInt | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
+    strips: StrictInt | None = Field(None, ge=0, le=200, description="free-running sealant strips")
+    parallel: StrictInt | None = Field(None, ge=0, le=12, description="sealant strips right beside lane lines")
+    trenches: StrictInt | None = Field(None, ge=0, le=8, description="long narrow trench patches along lane lines")
+    unpainted: StrictInt | None = Field(None, ge=0, le=12, description="patches across lane lines, paint not restored")
+    size: StrictFloat | None = Field(None, gt=0, le=4, description="patch size scale (1 = 0.8-4.4 m long)")
+    contrast: StrictFloat | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
+    strip_width: StrictFloat | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
+    bright_share: StrictFloat | None = Field(None, ge=0, le=1, description="share of strips in bright weathered filler")
+    ghosts: StrictInt | None = Field(None, ge=0, le=12, description="old lane lines ground off beside today's lines")
+    ghost_opacity: StrictFloat | None = Field(
+        None, ge=0, le=1, description="how much of a ghost line's paler stone shows"
+    )
 
     def level(self) -> RoadRepairLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -329,13 +331,13 @@ class TireMarks(_SurfaceDamage):
     HALF_GAUGE_M: ClassVar[float] = 0.82  # a car's track centre to its wheel tracks
 
     type: Literal["tire_marks"] = "tire_marks"
-    straight: int | None = Field(None, ge=0, le=40, description="straight braking marks")
-    swerve: int | None = Field(None, ge=0, le=40, description="swerving marks that cross a lane line")
-    yaw: int | None = Field(None, ge=0, le=40, description="curved sideways-sliding marks")
-    darkness: float | None = Field(None, ge=0, le=1, description="peak opacity of the rubber")
-    track_width: float | None = Field(None, ge=0.1, le=0.4, description="width of one tyre track (m)")
-    length_min: float = Field(20.0, gt=1, le=200, description="shortest mark (m)")
-    length_max: float = Field(45.0, gt=1, le=200, description="longest mark (m)")
+    straight: StrictInt | None = Field(None, ge=0, le=40, description="straight braking marks")
+    swerve: StrictInt | None = Field(None, ge=0, le=40, description="swerving marks that cross a lane line")
+    yaw: StrictInt | None = Field(None, ge=0, le=40, description="curved sideways-sliding marks")
+    darkness: StrictFloat | None = Field(None, ge=0, le=1, description="peak opacity of the rubber")
+    track_width: StrictFloat | None = Field(None, ge=0.1, le=0.4, description="width of one tyre track (m)")
+    length_min: StrictFloat = Field(20.0, gt=1, le=200, description="shortest mark (m)")
+    length_max: StrictFloat = Field(45.0, gt=1, le=200, description="longest mark (m)")
 
     def level(self) -> TireMarksLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -406,13 +408,17 @@ class GuardRail(Illusion):
 
     type: Literal["guard_rail"] = "guard_rail"
     side: Literal["right", "left"] = Field("right", description="road edge of the main rail")
-    offset: float | None = Field(None, ge=0, le=30, description="gap between the carriageway edge and the rail (m)")
-    extent: float = Field(130.0, gt=1, le=1000, description="length along the road (m)")
-    far_side: bool | None = Field(None, description="also a rail along the other edge")
-    median: bool | None = Field(None, description="also a rail just left of the centre line")
+    offset: StrictFloat | None = Field(
+        None, ge=0, le=30, description="gap between the carriageway edge and the rail (m)"
+    )
+    extent: StrictFloat = Field(130.0, gt=1, le=1000, description="length along the road (m)")
+    far_side: StrictBool | None = Field(None, description="also a rail along the other edge")
+    median: StrictBool | None = Field(None, description="also a rail just left of the centre line")
     color: tuple[_Unit, _Unit, _Unit] | None = Field(None, description="linear albedo of the steel; empty = grey")
-    shadow_m: float | None = Field(None, ge=0, le=20, description="shadow reach across the road (m); 0 = keep sun")
-    post_spacing: float = Field(2.0, ge=0.5, le=10, description="distance between posts (m)")
+    shadow_m: StrictFloat | None = Field(
+        None, ge=0, le=20, description="shadow reach across the road (m); 0 = keep sun"
+    )
+    post_spacing: StrictFloat = Field(2.0, ge=0.5, le=10, description="distance between posts (m)")
 
     def level(self) -> GuardRailLevel:
         """This illusion's row of ``SEVERITY``."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, StrictFloat
 
 from ..environment import sun_direction
 from ..primitives import pose_on_road, transformed
@@ -67,15 +67,15 @@ class SunShadowIllusion(Illusion):
 
     CATEGORY: ClassVar[Category] = "shadow"
 
-    sun_altitude: float | None = Field(
+    sun_altitude: StrictFloat | None = Field(
         None, ge=2, le=89, description="sun altitude (degrees); empty = from the severity table"
     )
-    sun_azimuth: float | None = Field(
+    sun_azimuth: StrictFloat | None = Field(
         None, ge=-360, le=360,
         description="sun azimuth (degrees, CCW from world +X); empty = chosen from the road heading so shadows "
         "fall across the lanes",
     )
-    sun_intensity: float | None = Field(
+    sun_intensity: StrictFloat | None = Field(
         None, ge=0, le=3, description="direct sun luminance (1 = clear noon); empty = from the severity table"
     )
 
@@ -187,11 +187,13 @@ class StreetlightShadow(SunShadowIllusion):
 
     type: Literal["streetlight_shadow"] = "streetlight_shadow"
     side: Literal["left", "right", "both"] = Field("right", description="which roadside the lamps stand on")
-    length: float | None = Field(
+    length: StrictFloat | None = Field(
         None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
     )
-    offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
-    spacing: float | None = Field(None, ge=10, le=100, description="distance between lamps (m); empty = from the table")
+    offset: StrictFloat = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
+    spacing: StrictFloat | None = Field(
+        None, ge=10, le=100, description="distance between lamps (m); empty = from the table"
+    )
 
     def level(self) -> StreetlightShadowLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -247,10 +249,10 @@ class FenceShadow(SunShadowIllusion):
 
     type: Literal["fence_shadow"] = "fence_shadow"
     side: Side = Field("right", description="which roadside the fence stands on")
-    length: float | None = Field(
+    length: StrictFloat | None = Field(
         None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
     )
-    offset: float = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
+    offset: StrictFloat = Field(0.8, ge=0.3, le=20, description="lateral distance beyond the paved edge (m)")
     color: tuple[Albedo, Albedo, Albedo] = Field((0.13, 0.085, 0.05), description="linear albedo of the slats")
 
     def level(self) -> FenceShadowLevel:
@@ -301,11 +303,11 @@ class RailShadow(SunShadowIllusion):
 
     type: Literal["rail_shadow"] = "rail_shadow"
     side: Side = Field("right", description="side the sun leans towards (the shadow shifts the other way)")
-    deck_length: float | None = Field(
+    deck_length: StrictFloat | None = Field(
         None, ge=3, le=80, description="length of the deck along the road (m); empty = from the table"
     )
-    clearance: float = Field(5.5, ge=4.5, le=15, description="height of the deck's underside above the road (m)")
-    margin: float = Field(3.0, ge=0.5, le=15, description="how far the deck reaches beyond each paved edge (m)")
+    clearance: StrictFloat = Field(5.5, ge=4.5, le=15, description="height of the deck's underside above the road (m)")
+    margin: StrictFloat = Field(3.0, ge=0.5, le=15, description="how far the deck reaches beyond each paved edge (m)")
 
     def level(self) -> RailShadowLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -358,14 +360,16 @@ class WireShadow(SunShadowIllusion):
 
     type: Literal["wire_shadow"] = "wire_shadow"
     side: Side = Field("right", description="which roadside the main pole row stands on")
-    length: float | None = Field(
+    length: StrictFloat | None = Field(
         None, gt=0, le=2000, description="extent along the road (m); empty = to 40 m past the end of the drive"
     )
-    offset: float = Field(1.0, ge=0.3, le=30, description="lateral distance of the poles beyond the paved edge (m)")
-    wire_radius: float | None = Field(
+    offset: StrictFloat = Field(
+        1.0, ge=0.3, le=30, description="lateral distance of the poles beyond the paved edge (m)"
+    )
+    wire_radius: StrictFloat | None = Field(
         None, ge=0.02, le=0.2, description="half the wire thickness (m); empty = from the table"
     )
-    pole_spacing: float = Field(35.0, ge=15, le=80, description="distance between poles (m)")
+    pole_spacing: StrictFloat = Field(35.0, ge=15, le=80, description="distance between poles (m)")
 
     def level(self) -> WireShadowLevel:
         """This illusion's row of ``SEVERITY``."""

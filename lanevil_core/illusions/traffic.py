@@ -7,12 +7,15 @@ participants crowd the lines beside it and the lanes next to it instead. Severit
 participants, brings the first one closer and puts more of them on the lane lines.
 
 ``load_obstacle`` reads a user's glTF/GLB/OBJ model; the ``vehicle`` type's ``mesh_file`` uses it in place of
-the procedural bodies.
+the procedural bodies. ``mesh_file`` is a file NAME, never a path: it is looked up in the meshes folder the compile
+is given (``CompileContext.meshes_dir``: a case file's ``meshes/`` folder for the library and CLI, the server's
+``<data dir>/uploads/``), and a name that resolves outside that folder or to no file is refused.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,12 +23,12 @@ from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, cast
 
 import numpy as np
 import trimesh
-from pydantic import Field
+from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 
 from .. import props
 from ..primitives import pose_on_road, rotation_z, to_mesh, transformed
 from ..scene import Mesh
-from .base import Category, CompileContext, Illusion, Level, register
+from .base import Category, CompileContext, Illusion, Level, MeshFileError, register
 
 if TYPE_CHECKING:
     from ..case import Case
@@ -40,7 +43,14 @@ NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, 
 GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
 GREY = (0.3, 0.3, 0.3)
 
-Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+# What a ``mesh_file`` may be: a plain file name of a model format ``load_obstacle`` reads (no folder, no "..").
+MESH_SUFFIXES = ("glb", "gltf", "obj")
+MESH_NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9._-]{{0,99}}\.({'|'.join(MESH_SUFFIXES)})$")
+MESH_NAME_RULE = (f"must be a file name in the uploads folder (letters, digits, '.', '_', '-'; ending "
+                  f"{', '.join('.' + suffix for suffix in MESH_SUFFIXES)}), not a path")
+MAX_OBSTACLE_FACES = 60_000
+
+Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 RGB = tuple[Unit, Unit, Unit]
 # Footprint and height (length, width, height) of each procedural vehicle (m).
 VEHICLE_SIZE: dict[str, tuple[float, float, float]] = {"car": (4.5, 1.8, 1.45), "van": (5.2, 2.0, 2.3),
@@ -120,11 +130,11 @@ class TrafficIllusion(Illusion):
 
     CATEGORY: ClassVar[Category] = "traffic"
 
-    count: int | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
-    distance: float | None = Field(
+    count: StrictInt | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
+    distance: StrictFloat | None = Field(
         None, ge=3, le=300, description="distance of the first one ahead of the ego start (m); empty = severity table"
     )
-    spacing: float | None = Field(
+    spacing: StrictFloat | None = Field(
         None, gt=0, le=200,
         description="distance between successive groups along the road (m); empty = spread over the drive",
     )
@@ -280,12 +290,12 @@ class Pedestrian(TrafficIllusion):
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
-    group: int | None = Field(None, ge=1, le=12, description="people per group; empty = the level-5 crowd's")
-    on_lines: float | None = Field(
+    group: StrictInt | None = Field(None, ge=1, le=12, description="people per group; empty = the level-5 crowd's")
+    on_lines: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of people standing on a lane line; empty = severity table"
     )
     shirt_colors: list[RGB] | None = Field(None, description="shirt colours (linear RGB), cycled; empty = random")
-    height: float = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
+    height: StrictFloat = Field(1.75, ge=1.0, le=2.1, description="body height (m), varied by +-6 %")
 
     def level(self) -> CrowdLevel:
         """This illusion's row of ``SEVERITY``."""
@@ -325,8 +335,8 @@ class Bicycle(TrafficIllusion):
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
-    group: int | None = Field(None, ge=1, le=12, description="cyclists per group; empty = the level-5 crowd's")
-    on_lines: float | None = Field(
+    group: StrictInt | None = Field(None, ge=1, le=12, description="cyclists per group; empty = the level-5 crowd's")
+    on_lines: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of cyclists on a lane line; empty = severity table"
     )
     frame_colors: list[RGB] | None = Field(None, description="bicycle frame colours (linear RGB), cycled")
@@ -381,19 +391,35 @@ class Vehicle(TrafficIllusion):
 
     type: Literal["vehicle"] = "vehicle"
     kind: Literal["mixed", "car", "van", "truck"] = Field("mixed", description="vehicle type; mixed = by severity")
-    per_row: int | None = Field(None, ge=1, le=8, description="vehicles side by side; empty = severity table")
-    lane_change: float | None = Field(
+    per_row: StrictInt | None = Field(None, ge=1, le=8, description="vehicles side by side; empty = severity table")
+    lane_change: StrictFloat | None = Field(
         None, ge=0, le=1, description="share of vehicles straddling a lane line; empty = severity table"
     )
     colors: list[RGB] | None = Field(None, description="body colours (linear RGB), cycled; empty = random")
-    lights_on: bool = Field(False, description="headlights and tail lights glow")
+    lights_on: StrictBool = Field(False, description="headlights and tail lights glow")
     mesh_file: str | None = Field(
-        None, description="glTF/GLB/OBJ model used instead of the procedural bodies, scaled to the vehicle size"
+        None, description="glTF/GLB/OBJ model used instead of the procedural bodies, scaled to the vehicle size: "
+        "a file name in the uploads folder (`POST /api/meshes`; a case file's `meshes/` folder on the command line)",
+        json_schema_extra={"pattern": MESH_NAME.pattern},
     )
+
+    @field_validator("mesh_file")
+    @classmethod
+    def _mesh_file_is_a_name(cls, value: str | None) -> str | None:
+        if value is not None and not is_mesh_name(value):
+            raise ValueError(MESH_NAME_RULE)
+        return value
 
     def level(self) -> VehicleLevel:
         """This illusion's row of ``SEVERITY``."""
         return self.SEVERITY[self.severity - 1]
+
+    def load_mesh(self, ctx: CompileContext) -> Mesh:
+        """The ``mesh_file`` model from ``ctx.meshes_dir``; ``MeshFileError`` naming the field otherwise."""
+        try:
+            return load_obstacle(mesh_path(ctx.meshes_dir, self.mesh_file or ""))
+        except (OSError, ValueError) as error:
+            raise MeshFileError(f"illusions.{ctx.source}.{self.type}.mesh_file", str(error)) from None
 
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
@@ -403,7 +429,7 @@ class Vehicle(TrafficIllusion):
         total = self.participants()
         stations = self.group_stations(ctx, math.ceil(total / per_row))
         free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
-        loaded = load_obstacle(self.mesh_file) if self.mesh_file else None
+        loaded = self.load_mesh(ctx) if self.mesh_file else None
         index = 0
         for row, s in enumerate(stations):
             for lane_t in self._row_lanes(ctx, s, per_row, row):
@@ -498,7 +524,28 @@ def _face_colors(geometry: trimesh.Trimesh) -> FloatArray:
     return np.broadcast_to(np.asarray(GREY, np.float64), (len(faces), 3))
 
 
-def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: int = 60_000,
+def is_mesh_name(name: str) -> bool:
+    """Whether ``name`` is an acceptable ``mesh_file``: a plain model file name (``MESH_NAME``, no "..")."""
+    return bool(MESH_NAME.match(name)) and ".." not in name
+
+
+def mesh_path(meshes_dir: Path | None, name: str) -> Path:
+    """The file ``name`` in ``meshes_dir``; ``ValueError`` for a name that is no plain model name, no folder, a
+    path resolving outside the folder (a link pointing away) or a missing file."""
+    if not is_mesh_name(name):
+        raise ValueError(f"{name!r} {MESH_NAME_RULE}")
+    if meshes_dir is None:
+        raise ValueError(f"{name!r}: no meshes folder to read it from")
+    folder = Path(meshes_dir).resolve()
+    path = (folder / name).resolve()
+    if not path.is_relative_to(folder):
+        raise ValueError(f"{name!r} resolves outside the meshes folder")
+    if not path.is_file():
+        raise ValueError(f"{name!r} is not in the meshes folder (upload it first)")
+    return path
+
+
+def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: int = MAX_OBSTACLE_FACES,
                   name: str | None = None) -> Mesh:
     """A user's glTF/GLB/OBJ model as a local-frame ``Mesh``: footprint centred on the origin, resting on z = 0,
     +X forward.

@@ -12,9 +12,9 @@ import trimesh
 from pydantic import ValidationError
 
 from lanevil_core.camera import ego_camera
-from lanevil_core.case import Case, parse_case
+from lanevil_core.case import Case, case_meshes_dir, parse_case
 from lanevil_core.environment import environment_for
-from lanevil_core.illusions import REGISTRY, CompileContext
+from lanevil_core.illusions import REGISTRY, CompileContext, MeshFileError
 from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
 from lanevil_core.road_layout import build_network
 from lanevil_core.scene import Mesh
@@ -22,11 +22,11 @@ from lanevil_core.scene import Mesh
 TRAFFIC = ("pedestrian", "vehicle", "bicycle")
 
 
-def compiled(spec: dict, **case: object) -> tuple[Case, CompileContext]:
+def compiled(spec: dict, meshes_dir: Path | None = None, **case: object) -> tuple[Case, CompileContext]:
     """Compile one illusion on its own (no roadside) into a fresh context."""
     model = Case.model_validate({"illusions": [spec], **case})
     network = build_network(model.road, model.scene.kind)
-    ctx = CompileContext(case=model, network=network, env=environment_for(model), source=0)
+    ctx = CompileContext(case=model, network=network, env=environment_for(model), source=0, meshes_dir=meshes_dir)
     model.illusions[0].compile(ctx)
     return model, ctx
 
@@ -226,13 +226,38 @@ def test_load_obstacle_obj_and_errors(tmp_path: Path) -> None:
 
 
 def test_vehicle_mesh_file_replaces_the_bodies(tmp_path: Path) -> None:
-    path = tmp_path / "thing.glb"
-    _two_part_glb(path)
-    _, ctx = compiled({"type": "vehicle", "severity": 2, "kind": "van", "mesh_file": str(path)})
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    _two_part_glb(meshes / "thing.glb")
+    _, ctx = compiled({"type": "vehicle", "severity": 2, "kind": "van", "mesh_file": "thing.glb"}, meshes)
     for mesh in ctx.meshes:
         assert len(mesh.faces) == 12 + 32  # the loaded model, not the procedural van
         size = np.sort(mesh.vertices.max(0) - mesh.vertices.min(0))
         assert size.max() <= 5.2 + 1e-6 and size.max() > 2.5
+
+
+@pytest.mark.parametrize("name", ["/etc/passwd", "/proc/self/environ", "../../etc/hostname", "a/b.glb", "x.txt",
+                                  ".hidden.glb", "a..glb", "C:\\x.glb"])
+def test_mesh_file_is_a_plain_model_name(name: str) -> None:
+    with pytest.raises(ValidationError, match="must be a file name in the uploads folder"):
+        Case.model_validate({"illusions": [{"type": "vehicle", "mesh_file": name}]})
+
+
+def test_a_mesh_file_outside_or_missing_from_the_folder_is_refused(tmp_path: Path) -> None:
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    _two_part_glb(tmp_path / "elsewhere.glb")
+    (meshes / "link.glb").symlink_to(tmp_path / "elsewhere.glb")
+    for name, says in (("link.glb", "outside"), ("missing.glb", "not in the meshes folder")):
+        with pytest.raises(MeshFileError, match=says) as error:
+            compiled({"type": "vehicle", "mesh_file": name}, meshes)
+        assert error.value.field == "illusions.0.vehicle.mesh_file"
+    with pytest.raises(MeshFileError, match="no meshes folder"):
+        compiled({"type": "vehicle", "mesh_file": "elsewhere.glb"})
+
+
+def test_the_cli_reads_meshes_beside_the_case_file(tmp_path: Path) -> None:
+    assert case_meshes_dir(tmp_path / "cases" / "a.json") == tmp_path / "cases" / "meshes"
 
 
 def test_someone_on_an_edge_line_stands_just_inside_the_paved_edge() -> None:

@@ -310,3 +310,18 @@ def test_multipart_uploads_have_their_own_limit(settings, state) -> None:
         assert response.status_code == 413 and response.json()["field"] == "body"
         assert client.post("/api/cases", content=b" " * 1025,
                            headers={"content-type": "application/json"}).status_code == 413
+
+
+@pytest.mark.parametrize(("document", "field"), [
+    ({"illusions": [{"type": "fence_shadow", "severity": "3"}]}, "illusions.0.fence_shadow.severity"),
+    ({"illusions": [{"type": "fence_shadow", "severity": True}]}, "illusions.0.fence_shadow.severity"),
+    ({"seed": "3"}, "seed"),
+    ({"seed": 3.0}, "seed"),
+    ({"ego": {"frames": True}}, "ego.frames"),
+    ({"sun": {"azimuth": "120"}}, "sun.azimuth"),
+    ({"sun": {"azimuth": False}}, "sun.azimuth"),
+])
+def test_numbers_are_strict(client, document: dict, field: str) -> None:
+    response = client.post("/api/cases", json={"title": "strict", **document})
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == field

@@ -186,3 +186,48 @@ def test_openapi_describes_study_creation(client) -> None:
     assert {"StudySpec", "ItemSpec", "GeneratedSet"} <= set(schema["components"]["schemas"])
     assert {"201", "202", "401", "403", "413", "415", "422"} <= set(create["responses"])
     assert create["security"] == [{"OrganiserToken": []}]
+
+
+@pytest.mark.parametrize("method", ["PUT", "PATCH", "DELETE"])
+@pytest.mark.parametrize("if_match", ["9" * 4400, '"' + "1" * 19 + '"', "null", "W/\"x\""])
+def test_if_match_that_is_no_version_names_if_match(client, method: str, if_match: str) -> None:
+    body = {} if method == "DELETE" else {"json": {"title": "x"}}
+    response = client.request(method, f"/api/cases/{SHADOW_ID}", headers={"If-Match": if_match}, **body)
+    assert response.status_code == 422
+    assert response.json()["field"] == "If-Match"
+    assert len(response.json()["detail"]) < 200
+
+
+def test_if_match_pattern_is_documented(client) -> None:
+    put = client.get("/openapi.json").json()["paths"]["/api/cases/{case_id}"]["put"]
+    header = next(p for p in put["parameters"] if p["name"] == "If-Match")
+    assert "pattern" in header["schema"]
+
+
+def test_an_integer_over_the_digit_limit_names_body(client) -> None:
+    response = post_case(client, b'{"title": "x", "seed": ' + b"9" * 4400 + b"}")
+    assert response.status_code == 422
+    assert response.json()["field"] == "body"
+    assert "too long" in response.json()["detail"]
+
+
+def test_an_empty_category_is_no_filter(client) -> None:
+    assert client.get("/api/cases?category=&type=").json() == client.get("/api/cases").json()
+
+
+@pytest.mark.parametrize(("path", "methods"), [
+    ("/api/cases", "GET, OPTIONS, POST"),
+    (f"/api/cases/{SHADOW_ID}", "DELETE, GET, OPTIONS, PATCH, PUT"),
+])
+def test_options_and_405_list_every_method_of_the_path(client, path: str, methods: str) -> None:
+    response = client.options(path)
+    assert response.status_code == 204
+    assert response.headers["allow"] == methods
+    assert client.request("TRACE", path).headers["allow"] == methods
+
+
+def test_multipart_without_boundary_names_content_type(client) -> None:
+    response = client.post("/api/study/studies", content=b"x",
+                           headers={**ADMIN, "content-type": "multipart/form-data"})
+    assert response.status_code == 422
+    assert response.json()["field"] == "Content-Type"

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import trimesh
 
 from app.editor import EditError, Editor
 from app.editor.detection import rate_text
@@ -339,3 +340,68 @@ def test_camera_controls_change_the_case_camera_and_the_preview(editor: Editor) 
     settle(editor)
     assert editor.case.camera.bonnet is None and editor.case.camera.sensor is None
     assert editor.panel.camera_exposure.disabled
+
+
+INJECTION = '<iframe srcdoc="<script>alert(1)</script>"> <script>alert(2)</script> [x](javascript:alert(3))'
+
+
+def markdown_texts(editor: Editor) -> list[str]:
+    return [editor.panel.status.content, editor.panel.preview_info.content, editor.panel.detection.content,
+            editor.drive.status.content]
+
+
+def test_case_text_and_errors_are_escaped_in_the_markdown(editor: Editor, state: AppState, monkeypatch) -> None:
+    case = parse_case({"title": INJECTION, "description": INJECTION})
+    record = state.store.create(case, case_id="injected")
+    editor.panel.case_id.value = record.id
+    settle(editor)
+    assert editor.panel.title.value == INJECTION  # a text input shows the title as typed
+
+    def fail(*args, **kwargs):
+        raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
+
+    monkeypatch.setattr(state.frames, "frame", fail)
+    editor.panel.frame.value = 3
+    assert editor.preview.wait_idle(WAIT_S)
+    status = editor.panel.status.content
+    assert "Preview failed" in status and "obstacle model not found" in status
+    assert "&lt;iframe srcdoc\\=&quot;&lt;script&gt;" in status
+    editor.drive.status.content = ""
+    monkeypatch.setattr(editor.drive, "current", fail)
+    editor.drive.start()
+    for text in markdown_texts(editor):
+        assert "<" not in text and "](" not in text and '"' not in text, text
+
+
+def test_upload_mesh_stores_the_model_and_sets_the_vehicles_mesh_file(editor: Editor, state: AppState) -> None:
+
+
+    case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1, "kind": "van"}]})
+    editor.panel.case_id.value = state.store.create(case, case_id="vans").id
+    settle(editor)
+    editor.panel.selected.value = editor.panel.selected.options[1]
+    glb = trimesh.Scene(trimesh.creation.box((4.0, 2.0, 1.5))).export(file_type="glb")
+    assert editor.upload_mesh("../My Van.glb", glb) == "My_Van.glb"
+    settle(editor)
+    assert editor.case.illusions[0].mesh_file == "My_Van.glb"
+    assert (state.meshes_dir / "My_Van.glb").read_bytes() == glb
+    assert "⚠" not in editor.panel.status.content
+    with pytest.raises(EditError, match="mesh not stored"):
+        editor.upload_mesh("notes.txt", b"hello")
+    open_shadow(editor)
+    with pytest.raises(EditError, match="takes no mesh"):
+        editor.upload_mesh("van.glb", glb)
+
+
+def test_a_mesh_file_that_is_not_uploaded_is_not_saved(editor: Editor, state: AppState) -> None:
+    case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1}]})
+    editor.panel.case_id.value = state.store.create(case, case_id="vans").id
+    settle(editor)
+    editor.panel.selected.value = editor.panel.selected.options[1]
+    editor.set_field("mesh_file", "nowhere.glb")
+    assert editor.preview.wait_idle(WAIT_S)
+    with pytest.raises(EditError, match="nowhere.glb"):
+        editor.save()
+    with pytest.raises(EditError, match="Not saved"):
+        editor.save_as_new()
+    assert state.store.get("vans").version == 1

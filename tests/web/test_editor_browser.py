@@ -143,3 +143,35 @@ def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, scree
     time.sleep(1)
     page.screenshot(path=str(screenshot_dir / "editor_5_camera.png"), timeout=SHOT_MS)
     page.close()
+
+
+INJECTION = '<iframe srcdoc="<script>alert(1)</script>"></iframe><img src=x onerror=alert(2)> [x](javascript:alert(3))'
+
+
+def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, state: AppState, monkeypatch) -> None:
+    record = state.store.create(state.store.get(editor.session.case_id).case.model_copy(
+        update={"title": INJECTION, "description": INJECTION}), case_id="injected")
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    dialogs: list[str] = []
+    page.on("dialog", lambda dialog: (dialogs.append(dialog.message), dialog.dismiss()))
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
+    wait_for(lambda: bool(editor.server.get_clients()), "the browser to connect")
+    scripts_before = page.locator("script").count()
+    editor.panel.case_id.value = record.id
+    assert editor.preview.wait_idle(WAIT_S)
+
+    def fail(*args: object, **kwargs: object) -> None:
+        raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
+
+    monkeypatch.setattr(state.frames, "frame", fail)
+    editor.panel.frame.value = 2
+    assert editor.preview.wait_idle(WAIT_S)
+    page.get_by_text("obstacle model not found", exact=False).first.wait_for(timeout=WAIT_S * 1000)
+    time.sleep(2)
+    assert dialogs == []
+    assert page.locator("iframe").count() == 0
+    assert page.locator("img[src='x']").count() == 0
+    assert page.locator("a[href^='javascript']").count() == 0
+    assert page.locator("script").count() == scripts_before
+    assert "<iframe srcdoc=" in page.get_by_text("obstacle model not found", exact=False).first.inner_text()

@@ -150,6 +150,10 @@ def test_admin_routes_need_the_token(client, state) -> None:
     ({"title": "x"}, {"notes.png": b"this is not an image"}, 422, "files.0"),
     ({"title": "x"}, {"a.gif": b"GIF89a\x01\x00\x01\x00\x00\x00\x00;"}, 422, "files.0"),
     ({"title": "x", "viewing_seconds": 0}, {}, 422, "spec.viewing_seconds"),
+    ({"title": "x", "generated": {"cases": ["clean-00_straight_urban"], "frames": [False]}}, {}, 422,
+     "spec.generated.frames.0"),
+    ({"title": "x", "items": [{"case_id": "clean-00_straight_urban", "frame": "3"}]}, {}, 422, "spec.items.0.frame"),
+    ({"title": "x", "width": True}, {}, 422, "spec.width"),
 ])
 def test_bad_specs_name_the_field(client, spec, files, status, field) -> None:
     response = create(client, spec, files)

@@ -1,0 +1,47 @@
+"""``/api/meshes``: upload a glTF/GLB/OBJ model for a vehicle's ``mesh_file`` and list the uploaded ones."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fastapi import APIRouter, Request
+from fastapi.concurrency import run_in_threadpool
+from starlette.datastructures import UploadFile
+
+from ..meshes import MeshUploadError, list_meshes, store_mesh
+from .deps import StateDep
+from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from .forms import read_form
+
+router = APIRouter(prefix="/meshes", tags=["meshes"], route_class=ApiRoute, responses=ERROR_RESPONSES)
+
+UPLOAD_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {"multipart/form-data": {"schema": {
+    "type": "object", "required": ["file"],
+    "properties": {"file": {"type": "string", "format": "binary", "description": ".glb, .gltf or .obj model"}}}}}}}
+
+
+@router.get("", summary="List uploaded meshes")
+def get_meshes(state: StateDep) -> dict[str, Any]:
+    """Names of the uploaded meshes: what a vehicle's ``mesh_file`` may name."""
+    names = list_meshes(state.meshes_dir)
+    return {"data": names, "count": len(names)}
+
+
+@router.post("", status_code=201, summary="Upload a mesh", openapi_extra=UPLOAD_BODY,
+             responses={status: {"model": ErrorBody, "description": description} for status, description in (
+                 (409, "another mesh is stored under that name"), (413, "the file is over the upload limit"),
+                 (415, "not a .glb, .gltf or .obj file"))})
+async def upload_mesh(request: Request, state: StateDep) -> dict[str, Any]:
+    """Store a model (multipart field ``file``) in the uploads folder under a checked name; a vehicle's
+    ``mesh_file`` may then name it. The model must load and have at most 60,000 triangles."""
+    form = await read_form(request, max_files=1)
+    upload = form.get("file")
+    if not isinstance(upload, UploadFile):
+        raise ApiError(422, "send the model as the multipart file field 'file'", "file")
+    limit = state.settings.max_upload_bytes
+    data = await upload.read(limit + 1)
+    try:
+        name = await run_in_threadpool(store_mesh, state.meshes_dir, upload.filename or "", data, limit)
+    except MeshUploadError as error:
+        raise ApiError(error.status, str(error), "file") from None
+    return {"name": name, "meshes": list_meshes(state.meshes_dir)}
