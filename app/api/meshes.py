@@ -6,12 +6,28 @@ from typing import Any
 
 from fastapi import APIRouter, Request
 from fastapi.concurrency import run_in_threadpool
+from pydantic import BaseModel
 from starlette.datastructures import UploadFile
 
 from ..meshes import MeshUploadError, list_meshes, store_mesh
 from .deps import StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
 from .forms import read_form
+
+
+class MeshList(BaseModel):
+    """The uploaded models' names."""
+
+    data: list[str]
+    count: int
+
+
+class MeshStored(BaseModel):
+    """The name a model was stored under, and every uploaded name."""
+
+    name: str
+    meshes: list[str]
+
 
 router = APIRouter(prefix="/meshes", tags=["meshes"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
@@ -21,17 +37,17 @@ UPLOAD_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {"mu
 
 
 @router.get("", summary="List uploaded meshes")
-def get_meshes(state: StateDep) -> dict[str, Any]:
+def get_meshes(state: StateDep) -> MeshList:
     """Names of the uploaded meshes: what a vehicle's ``mesh_file`` may name."""
     names = list_meshes(state.meshes_dir)
-    return {"data": names, "count": len(names)}
+    return MeshList(data=names, count=len(names))
 
 
 @router.post("", status_code=201, summary="Upload a mesh", openapi_extra=UPLOAD_BODY,
              responses={status: {"model": ErrorBody, "description": description} for status, description in (
                  (409, "another mesh is stored under that name"), (413, "the file is over the upload limit"),
                  (415, "not a .glb, .gltf or .obj file"))})
-async def upload_mesh(request: Request, state: StateDep) -> dict[str, Any]:
+async def upload_mesh(request: Request, state: StateDep) -> MeshStored:
     """Store a model (multipart field ``file``) in the uploads folder under a checked name; a vehicle's
     ``mesh_file`` may then name it. The model must load and have at most 60,000 triangles."""
     form = await read_form(request, max_files=1)
@@ -44,4 +60,4 @@ async def upload_mesh(request: Request, state: StateDep) -> dict[str, Any]:
         name = await run_in_threadpool(store_mesh, state.meshes_dir, upload.filename or "", data, limit)
     except MeshUploadError as error:
         raise ApiError(error.status, str(error), "file") from None
-    return {"name": name, "meshes": list_meshes(state.meshes_dir)}
+    return MeshStored(name=name, meshes=list_meshes(state.meshes_dir))
