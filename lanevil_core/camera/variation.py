@@ -42,10 +42,12 @@ def _pick(u: float, lo_hi: tuple[float, float], digits: int = 3) -> float:
     return round(lo + (hi - lo) * u, digits)
 
 
-def random_camera(rng: np.random.Generator) -> dict[str, Any]:
-    """Camera fields (a dict for ``Case.camera``) drawn from the ranges above, always ``DRAWS`` uniform draws."""
+def random_camera(rng: np.random.Generator, size: tuple[int, int] = (1280, 720)) -> dict[str, Any]:
+    """Camera fields (a dict for ``Case.camera``) of an image of ``size`` drawn from the ranges above, always
+    ``DRAWS`` uniform draws."""
     u = rng.uniform(0.0, 1.0, DRAWS)
     camera = camera_preset_values(CAMERA_PRESET_NAMES[int(u[0] * len(CAMERA_PRESET_NAMES))])
+    camera.update(width=size[0], height=size[1])
     camera.update(fov=_pick(u[1], HFOV_DEG, 1), z=_pick(u[2], HEIGHT_M, 2), x=_pick(u[3], AHEAD_M, 2),
                   pitch=_pick(u[4], PITCH_DEG, 2), roll=_pick(u[5], ROLL_DEG, 2), yaw=_pick(u[6], YAW_DEG, 2),
                   lens={"k1": _pick(u[7], K1, 4), "k2": _pick(u[8], K2, 4)})

@@ -333,7 +333,7 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     case_seed = int(rng.integers(0, 2**32))
     camera = _camera_mount(base, rng)
     markings = _markings(lanes_per_direction, rng)
-    drawn = {**random_camera(rng), "width": base.camera.width, "height": base.camera.height} if vary_camera else None
+    drawn = random_camera(rng, (base.camera.width, base.camera.height)) if vary_camera else None
     if drawn is not None and rng.uniform() < VARIED_CAMERA_SHARE:
         camera = drawn
     data = base.model_dump()
