@@ -182,7 +182,7 @@ def test_summary_applies_the_paper_criterion(make_case):
 def test_illusion_span_covers_the_illusion():
     from lanevil_core.drive.illusion_view import illusion_span
 
-    case = load_case(SCENES / "10_road_damage" / "tire_marks" / "03_level3.json")
+    case = load_case(SCENES / "10_road_damage" / "tire_marks" / "00_straight_highway_noon" / "03_level3.json")
     s0, s1 = illusion_span(compile_scene(case))
     start = case.illusions[0].start_s(case)
     assert s0 == pytest.approx(start, abs=2.0) and s1 > s0 + 10
