@@ -164,11 +164,11 @@ ORIGINALS: dict[str, tuple[Original, ...]] = {
     ),
     "guard_rail": (
         _o("bend", "highway", "ClearNoon", 200.0, turn="left", radius=200.0),
-        _o("straight", "highway", "CloudyNoon", 110.0, _WD_WD2, camera="tusimple", lanes_per_direction=3,
+        _o("straight", "highway", "CloudyNoon", 110.0, _WD_WD2, camera="carla", lanes_per_direction=3,
            lane_width=3.6, lane=1),
         _o("s_curve", "rural", "ClearSunset", 230.0, _ONE_YD, radius=160.0, lanes_per_direction=1, lane_width=3.3),
         _o("uphill", "highway", "ClearNoon", 70.0, _BD_YD2, grade=0.04, lanes_per_direction=3, lane_width=3.6),
-        _o("downhill", "rural", "WetNoon", 300.0, _ONE_YSD, grade=0.07, lanes_per_direction=1),
+        _o("downhill", "rural", "ClearNoon", 300.0, _ONE_YSD, grade=0.07, lanes_per_direction=1),
         _o("t_junction", "rural", "ClearNoon", 160.0, _WD_YS, junction_s=90.0),
         _o("straight", "tunnel_approach", "CloudySunset", 250.0, _WD_WSD),
     ),
