@@ -232,7 +232,7 @@ def _in_view(job: tuple[Case, int]) -> tuple[int, ...]:
 
 def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None,
                       mapper: Mapper = threads_map) -> dict[str, tuple[int, ...]]:
-    """Test frames per case folder (a type's original and levels) where that folder's most severe case shows
+    """Test frames per case folder (an original and its levels) where that folder's most severe case shows
     its illusion near the lanes, so Original and every level are scored on the same views. Folders are planned
     with ``mapper`` (a dataset run passes its local workers' when it has them)."""
     if frames_per_case is None:

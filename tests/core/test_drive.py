@@ -189,6 +189,17 @@ def test_illusion_span_covers_the_illusion():
     assert illusion_span(compile_scene(load_case(SCENES / "00_clean" / "00_straight_urban.json"))) is None
 
 
+
+def test_suite_files_an_original_under_the_type_its_folders_name():
+    from lanevil_core.drive.suite import case_group
+
+    folder = SCENES / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
+    assert case_group(load_case(folder / "00_original.json"), folder / "00_original.json") == (
+        "shadow", "fence_shadow", 0)
+    assert case_group(load_case(folder / "03_level3.json"), folder / "03_level3.json")[2] == 3
+    clean = SCENES / "00_clean" / "00_straight_urban.json"
+    assert case_group(load_case(clean), clean)[1] == "straight"
+
 # ---------------------------------------------------------------------------------------------- command
 
 def test_drive_command_writes_trace_summary_plots_and_video(tmp_path, make_case, capsys):

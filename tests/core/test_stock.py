@@ -64,3 +64,16 @@ def test_a_perturbed_case_differs_from_its_original_only_in_its_illusion() -> No
         assert not original.illusions and [(i.type, i.severity) for i in perturbed.illusions] == [(name, 4)]
         strip = {"title", "description", "illusions"}
         assert original.model_dump(exclude=strip) == perturbed.model_dump(exclude=strip), (name, index)
+
+
+def test_layout_names_the_type_and_case_of_either_layout() -> None:
+    from pathlib import PurePosixPath
+
+    from lanevil_core.benchmark_layout import case_name, folder_type
+
+    per_original = PurePosixPath("30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
+    per_type = PurePosixPath("30_shadow/fence_shadow/03_level3.json")
+    clean = PurePosixPath("00_clean/00_straight_urban.json")
+    assert [folder_type(p) for p in (per_original, per_type, clean)] == ["fence_shadow", "fence_shadow", None]
+    assert [str(case_name(p)) for p in (per_original, per_type, clean)] == [
+        "00_uphill_rural_noon/03_level3", "03_level3", "00_straight_urban"]
