@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any, Literal
 
-from lanevil_core.benchmark_layout import case_illusion_type
+from lanevil_core.benchmark_layout import case_illusion_type, case_name, folder_type
 from lanevil_core.case import Case, CaseError, case_json, load_case, parse_case, write_atomic
 from lanevil_core.files import remove_stale_temps
 from lanevil_core.illusions import REGISTRY
@@ -73,7 +73,7 @@ class CaseRecord:
     case: Case
     created_at: float
     updated_at: float
-    origin: str | None = None  # e.g. "30_shadow/streetlight_shadow/00_original.json" for seeded stock cases
+    origin: str | None = None  # e.g. "30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json" (stock cases)
 
     @property
     def illusion_type(self) -> str | None:
@@ -116,10 +116,8 @@ def _origin_type(origin: str | None) -> str | None:
     """The illusion type a stock path files a case under (``30_shadow/fence_shadow/…`` -> ``fence_shadow``)."""
     if not origin:
         return None
-    parts = PurePosixPath(origin).parts
-    if len(parts) >= 3 and parts[0] in STOCK_FOLDERS.values() and parts[1] in REGISTRY:
-        return parts[1]
-    return None
+    path = PurePosixPath(origin)
+    return folder_type(path) if path.parts[0] in STOCK_FOLDERS.values() else None
 
 
 def check_id(case_id: str) -> str:
@@ -137,10 +135,12 @@ def slugify(text: str) -> str:
 
 def stock_id(relative: PurePosixPath) -> str:
     """Id of a stock case: ``00_clean/00_straight_urban.json`` -> ``clean-00_straight_urban``,
-    ``30_shadow/fence_shadow/03_level3.json`` -> ``fence_shadow-03_level3``."""
-    folder = relative.parent.name
-    prefix = "clean" if folder == "00_clean" else folder
-    return check_id(slugify(f"{prefix}-{relative.stem}"))
+    ``30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json`` -> ``fence_shadow-00_uphill_rural_noon-03_level3``
+    (and ``30_shadow/fence_shadow/03_level3.json`` of a folder per type -> ``fence_shadow-03_level3``)."""
+    illusion_type = folder_type(relative)
+    prefix = illusion_type or ("clean" if relative.parent.name == "00_clean" else relative.parent.name)
+    name = case_name(relative).as_posix().replace("/", "-") if illusion_type else relative.stem
+    return check_id(slugify(f"{prefix}-{name}"))
 
 
 class CaseStore:

@@ -51,7 +51,8 @@ from lanevil_core.scene import ID_SKY, CompiledScene
 from lanevil_core.typed import Float32Array, FloatArray, UInt8Array
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_CASE = ROOT / "scenes" / "30_shadow" / "fence_shadow" / "03_level3.json"  # low sun, long fence shadows
+# a low sun, long fence shadows
+DEFAULT_CASE = ROOT / "scenes" / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon" / "03_level3.json"
 SHADOW_MAP_SIZE = 2048
 SHADOW_FAR_M = CASCADE_FAR_M[-1]  # the ground our renderer's farthest cascade covers
 SHADOW_BIAS_M = 0.05  # depth bias against self-shadowing, in metres along the light

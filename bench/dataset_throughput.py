@@ -38,12 +38,18 @@ SIZE = (1280, 720)
 TARGET_FPS = 33.0  # the goal on two cores
 # One original and one perturbed case per category (plus more in this order when --cases asks for them).
 CASES = (
-    "10_road_damage/road_crack/00_original.json", "10_road_damage/road_crack/03_level3.json",
-    "20_traffic/vehicle/00_original.json", "20_traffic/vehicle/03_level3.json",
-    "30_shadow/fence_shadow/00_original.json", "30_shadow/fence_shadow/03_level3.json",
-    "40_reflection/sunlight_reflection/00_original.json", "40_reflection/sunlight_reflection/03_level3.json",
-    "10_road_damage/road_repair/05_level5.json", "20_traffic/pedestrian/05_level5.json",
-    "30_shadow/rail_shadow/05_level5.json", "40_reflection/streetlight_reflection/05_level5.json",
+    "10_road_damage/road_crack/00_straight_suburban_cloudy/00_original.json",
+    "10_road_damage/road_crack/00_straight_suburban_cloudy/03_level3.json",
+    "20_traffic/vehicle/00_straight_highway_noon/00_original.json",
+    "20_traffic/vehicle/00_straight_highway_noon/03_level3.json",
+    "30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json",
+    "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json",
+    "40_reflection/sunlight_reflection/00_straight_suburban_noon/00_original.json",
+    "40_reflection/sunlight_reflection/00_straight_suburban_noon/03_level3.json",
+    "10_road_damage/road_repair/00_bend_urban_noon/05_level5.json",
+    "20_traffic/pedestrian/00_crossroad_urban_noon/05_level5.json",
+    "30_shadow/rail_shadow/00_straight_urban_noon/05_level5.json",
+    "40_reflection/streetlight_reflection/00_t_junction_suburban_night/05_level5.json",
 )
 
 

@@ -32,7 +32,7 @@ from app.main import create_app  # noqa: E402
 from app.settings import Settings  # noqa: E402
 from app.state import AppState  # noqa: E402
 
-CASE = "30_shadow/fence_shadow/03_level3.json"
+CASE = "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json"
 CASE_ID = "fence_shadow-03_level3"
 SIZES = [(640, 360), (1280, 720)]
 

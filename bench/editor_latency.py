@@ -27,8 +27,8 @@ from app.editor import Editor, launch_editor  # noqa: E402
 from app.settings import Settings  # noqa: E402
 from app.state import AppState  # noqa: E402
 
-CASES = ["00_clean/00_straight_urban.json", "30_shadow/fence_shadow/03_level3.json",
-         "20_traffic/vehicle/03_level3.json"]
+CASES = ["00_clean/00_straight_urban.json", "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json",
+         "20_traffic/vehicle/00_straight_highway_noon/03_level3.json"]
 CASE_ID = "fence_shadow-03_level3"
 BURST_GAP_S = 0.02  # a slider dragged at 50 updates per second
 

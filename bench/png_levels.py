@@ -37,9 +37,12 @@ from lanevil_core.typed import UInt8Array
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 SIZE = (1280, 720)
 FRAMES: tuple[tuple[str, int], ...] = (
-    ("00_clean/00_straight_urban.json", 0), ("00_clean/02_s_curve_rural.json", 40),
-    ("20_traffic/vehicle/03_level3.json", 20), ("30_shadow/fence_shadow/03_level3.json", 0),
-    ("40_reflection/streetlight_reflection/03_level3.json", 10), ("10_road_damage/road_crack/05_level5.json", 60),
+    ("00_clean/00_straight_urban.json", 0),
+    ("00_clean/02_s_curve_rural.json", 40),
+    ("20_traffic/vehicle/00_straight_highway_noon/03_level3.json", 20),
+    ("30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json", 0),
+    ("40_reflection/streetlight_reflection/00_t_junction_suburban_night/03_level3.json", 10),
+    ("10_road_damage/road_crack/00_straight_suburban_cloudy/05_level5.json", 60),
 )
 Encoder = Callable[[UInt8Array], bytes]
 PROJECT = "project"

@@ -5,6 +5,10 @@ marks the clean original cases, 1-5 the perturbed ones. Every figure of a group 
 over its images (F1 from the group's mean FP and FN), so a category pools the images of its types. Gap =
 Perturbed - Original (negative = the detector lost accuracy under the illusion).
 
+Every Gap carries a 95 % interval from a bootstrap over basic cases (``report_interval``: frames within a case
+are not independent, so whole cases are resampled), printed ``-7.40 [-9.10, -5.80]`` and written as ``_lo`` /
+``_hi`` columns.
+
 Records with ``"paint": false`` (``lanevil dataset --no-paint``) are the originals rendered with their lane paint
 removed: they form the *paint-free control*, reported beside the originals and never mixed into them. A detector
 that reads the paint scores low there; one that scores high places lanes from the road's layout.
@@ -16,17 +20,20 @@ import csv
 import io
 from collections.abc import Iterable
 from dataclasses import dataclass
+from dataclasses import field as default_field
 from pathlib import Path
 
 from .case import write_atomic
 from .encode import figure_png
 from .metrics.evaluate import ScoredImage
 from .metrics.tusimple import summarize
+from .report_interval import CaseSums, Interval, gap_interval
 
 LEVELS = (1, 2, 3, 4, 5)
 ALL = "All"
 CATEGORY_ORDER = ("RoadDamage", "TrafficObstruction", "Shadow", "Reflection")
 REPORT_MD, REPORT_CSV, SEVERITY_CSV, REPORT_PNG = "report.md", "report.csv", "report_severity.csv", "report.png"
+FIELDS = ("accuracy", "f1")
 
 
 @dataclass(frozen=True)
@@ -42,7 +49,10 @@ class Stats:
 
 @dataclass(frozen=True)
 class Row:
-    """One table row: a category (type ``All``), a type, or everything (category and type ``All``)."""
+    """One table row: a category (type ``All``), a type, or everything (category and type ``All``).
+
+    ``cases`` holds the per-case totals the intervals are resampled from: key 0 the originals, 1-5 each level,
+    None every perturbed image; ``intervals`` the 95 % interval of each gap by (field, level or None)."""
 
     category: str
     type: str
@@ -50,6 +60,8 @@ class Row:
     perturbed: Stats | None
     levels: dict[int, Stats | None]
     no_paint: Stats | None = None
+    cases: dict[int | None, CaseSums] = default_field(default_factory=dict)
+    intervals: dict[tuple[str, int | None], Interval | None] = default_field(default_factory=dict)
 
     def gap(self, field: str, level: int | None = None) -> float | None:
         """Perturbed (or one level) minus Original of ``field`` ('accuracy' or 'f1'); None if either is missing."""
@@ -57,6 +69,10 @@ class Row:
         if self.original is None or other is None:
             return None
         return getattr(other, field) - getattr(self.original, field)
+
+    def gap_interval(self, field: str, level: int | None = None) -> Interval | None:
+        """The 95 % interval of ``gap(field, level)`` (None where the gap is missing)."""
+        return self.intervals.get((field, level))
 
 
 @dataclass(frozen=True)
@@ -90,10 +106,14 @@ def _row(category: str, type_name: str, images: list[ScoredImage], f1_variant: s
     images = [image for image in images if not paint_free(image)]
     originals = [image for image in images if _severity(image) == 0]
     perturbed = [image for image in images if _severity(image) > 0]
-    levels = {level: _stats([image for image in images if _severity(image) == level], f1_variant)
-              for level in LEVELS}
+    by_level = {level: [image for image in images if _severity(image) == level] for level in LEVELS}
+    levels = {level: _stats(chosen, f1_variant) for level, chosen in by_level.items()}
+    cases: dict[int | None, CaseSums] = {0: CaseSums.of(originals), None: CaseSums.of(perturbed),
+                                         **{level: CaseSums.of(chosen) for level, chosen in by_level.items()}}
+    intervals = {(name, level): gap_interval(cases[0], cases[level], name, f1_variant)
+                 for name in FIELDS for level in (None, *LEVELS) if originals and cases[level].keys}
     return Row(category, type_name, _stats(originals, f1_variant), _stats(perturbed, f1_variant), levels,
-               _stats(control, f1_variant))
+               _stats(control, f1_variant), cases, intervals)
 
 
 def _labelled(image: ScoredImage) -> bool:
@@ -129,6 +149,19 @@ def _pct(value: float | None, signed: bool = False) -> str:
     return f"{percent:+.2f}" if signed else f"{percent:.2f}"
 
 
+def with_interval(value: float | None, interval: Interval | None) -> str:
+    """``-7.40 [-9.10, -5.80]``: a signed percentage and its interval (just the value where there is none)."""
+    text = _pct(value, signed=True)
+    if value is None or interval is None:
+        return text
+    return f"{text} [{_pct(interval.lo, signed=True)}, {_pct(interval.hi, signed=True)}]"
+
+
+def gap_cell(row: Row, field: str, level: int | None = None) -> str:
+    """A gap of a row with its 95 % interval."""
+    return with_interval(row.gap(field, level), row.gap_interval(field, level))
+
+
 def _label(row: Row) -> tuple[str, str]:
     if row.category == ALL:
         return "**All**", ""
@@ -145,7 +178,7 @@ def markdown(report: Report) -> str:
     """report.md: the main Original/Perturbed/Gap table and per-severity tables (values in %)."""
     lines = [f"# {report.title or 'Robustness report'}", "",
              f"TuSimple metric; F1 variant `{report.f1_variant}`. Values in %. Gap = Perturbed - Original "
-             "(negative = drop). Original = the clean `00_original` cases of each type.", ""]
+             "(negative = drop). Original = the clean `00_original` cases of each type. " + INTERVAL_NOTE, ""]
     if report.unlabelled:
         lines += [f"{report.unlabelled} image(s) without category/type/severity are not in the tables.", ""]
     lines += ["| Category | Type | Images orig/pert | Acc Original | Acc Perturbed | Acc Gap | F1 Original "
@@ -155,7 +188,7 @@ def markdown(report: Report) -> str:
         cells = [category, type_name, f"{_images(row.original)}/{_images(row.perturbed)}"]
         for field in ("accuracy", "f1"):
             cells += [_pct(getattr(row.original, field, None)), _pct(getattr(row.perturbed, field, None)),
-                      _pct(row.gap(field), signed=True)]
+                      gap_cell(row, field)]
         lines.append("| " + " | ".join(cells) + " |")
     total = report.rows[-1] if report.rows else None
     if total is not None and total.no_paint is not None:
@@ -170,8 +203,9 @@ def markdown(report: Report) -> str:
             lines.append(f"| {category} | {type_name} | {row.no_paint.images} | "
                          f"{_pct(getattr(row.original, 'accuracy', None))} | {_pct(row.no_paint.accuracy)} |")
     for field, name in (("accuracy", "Accuracy"), ("f1", "F1")):
-        lines += ["", f"## {name} by severity", "",
-                  f"{name} of the originals (level 0) and of each level; in brackets the gap to the originals.", "",
+        lines += ["", f"## {name} by type and severity", "",
+                  f"{name} of the originals (level 0) and of each level, per type (the supplementary breakdown); in "
+                  "parentheses the gap to the originals with its 95 % interval.", "",
                   "| Category | Type | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
                   "|---|---|" + "---:|" * (len(LEVELS) + 1)]
         for row in report.rows:
@@ -181,13 +215,22 @@ def markdown(report: Report) -> str:
                 stats = row.levels[level]
                 value = _pct(getattr(stats, field, None))
                 gap = row.gap(field, level)
-                cells.append(value if gap is None else f"{value} ({_pct(gap, signed=True)})")
+                cells.append(value if gap is None else f"{value} ({gap_cell(row, field, level)})")
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
 def _number(value: float | None) -> str:
     return "" if value is None else f"{value:.6f}"
+
+
+def interval_numbers(interval: Interval | None) -> list[str | int]:
+    """The ``_lo`` and ``_hi`` CSV cells of an interval (empty where there is none)."""
+    return ["", ""] if interval is None else [_number(interval.lo), _number(interval.hi)]
+
+
+INTERVAL_NOTE = ("Intervals in brackets: 95 % bootstrap over basic cases (an original with its levels; "
+                 "2,000 resamples, seed 0).")
 
 
 def _csv(rows: list[list[str | int]]) -> str:
@@ -198,32 +241,38 @@ def _csv(rows: list[list[str | int]]) -> str:
 
 def report_csv(report: Report) -> str:
     """report.csv: one line per row with original/perturbed/gap accuracy and F1 (fractions)."""
-    header = ["category", "type", "images_original", "images_perturbed", "accuracy_original",
-              "accuracy_perturbed", "accuracy_gap", "f1_original", "f1_perturbed", "f1_gap", "f1_variant"]
-    rows: list[list[str | int]] = [list(header)]
+    header = ["category", "type", "images_original", "images_perturbed", "cases"]
+    for name in FIELDS:
+        header += [f"{name}_original", f"{name}_perturbed", f"{name}_gap", f"{name}_gap_lo", f"{name}_gap_hi"]
+    rows: list[list[str | int]] = [[*header, "f1_variant"]]
     for row in report.rows:
-        rows.append([row.category, row.type, _images(row.original), _images(row.perturbed),
-                     _number(getattr(row.original, "accuracy", None)),
-                     _number(getattr(row.perturbed, "accuracy", None)), _number(row.gap("accuracy")),
-                     _number(getattr(row.original, "f1", None)), _number(getattr(row.perturbed, "f1", None)),
-                     _number(row.gap("f1")), report.f1_variant])
+        cells: list[str | int] = [row.category, row.type, _images(row.original), _images(row.perturbed),
+                                  len(row.cases[0].keys) if row.cases else 0]
+        for name in FIELDS:
+            cells += [_number(getattr(row.original, name, None)), _number(getattr(row.perturbed, name, None)),
+                      _number(row.gap(name)), *interval_numbers(row.gap_interval(name))]
+        rows.append([*cells, report.f1_variant])
     return _csv(rows)
 
 
 def severity_csv(report: Report) -> str:
     """report_severity.csv: one line per row and level 0-5 (0 = originals) with accuracy, FP, FN, F1, gaps."""
-    header = ["category", "type", "severity", "images", "accuracy", "fp", "fn", "f1", "accuracy_gap", "f1_gap",
-              "f1_variant"]
+    header = ["category", "type", "severity", "images", "accuracy", "fp", "fn", "f1", "accuracy_gap",
+              "accuracy_gap_lo", "accuracy_gap_hi", "f1_gap", "f1_gap_lo", "f1_gap_hi", "f1_variant"]
     rows: list[list[str | int]] = [list(header)]
     for row in report.rows:
         for level in (0, *LEVELS):
             stats = row.original if level == 0 else row.levels[level]
             if stats is None:
                 continue
-            gaps = (0.0, 0.0) if level == 0 else (row.gap("accuracy", level), row.gap("f1", level))
+            gaps: list[str | int] = []
+            for name in FIELDS:
+                if level == 0:
+                    gaps += [_number(0.0), "", ""]
+                else:
+                    gaps += [_number(row.gap(name, level)), *interval_numbers(row.gap_interval(name, level))]
             rows.append([row.category, row.type, level, stats.images, _number(stats.accuracy), _number(stats.fp),
-                         _number(stats.fn), _number(stats.f1), _number(gaps[0]), _number(gaps[1]),
-                         report.f1_variant])
+                         _number(stats.fn), _number(stats.f1), *gaps, report.f1_variant])
     return _csv(rows)
 
 

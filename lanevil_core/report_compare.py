@@ -1,20 +1,45 @@
 """Several detectors side by side, in the paper's table layout.
 
 For each detector: Perturbed / Original / Gap of TuSimple Accuracy and F1 for each category and their average;
-a per-severity table (accuracy drop against the originals at each level) and a plot of the drop against severity,
-one line per detector. Each detector's own full report (``report.md`` ...) goes into a sub-folder.
+a per-severity table (accuracy drop against the originals at each level), the per-type x per-level breakdown of
+the paper's supplementary material, and a plot of the drop against severity, one line per detector. Each detector's
+own full report (``report.md`` ...) goes into a sub-folder.
+
+Every gap, drop and gain carries its 95 % bootstrap interval over basic cases (``report_interval``); differences
+between two detectors or defences are resampled paired over the cases, and where that interval includes 0 the
+two are reported as *not separable*.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from itertools import combinations
 from pathlib import Path
 
 from .case import write_atomic
 from .encode import figure_png
-from .report import ALL, CATEGORY_ORDER, LEVELS, Report, Row, _csv, _number, _pct, write_report
+from .report import (
+    ALL,
+    CATEGORY_ORDER,
+    FIELDS,
+    INTERVAL_NOTE,
+    LEVELS,
+    Report,
+    Row,
+    _csv,
+    _number,
+    _pct,
+    gap_cell,
+    interval_numbers,
+    with_interval,
+    write_report,
+)
+from .report_interval import Interval, Term, combination_interval
 
 COMPARE_MD, COMPARE_CSV, COMPARE_PNG = "compare.md", "compare.csv", "compare.png"
+BREAKDOWN_CSV = "compare_breakdown.csv"
+NOT_SEPARABLE = "not separable"
 
 
 @dataclass(frozen=True)
@@ -37,12 +62,33 @@ def _heading(row: Row) -> str:
     return "Average" if row.category == ALL else row.category
 
 
+def paired_interval(terms: Sequence[tuple[float, Row, int | None]], field: str, f1_variant: str) -> Interval | None:
+    """Interval of a combination of rows' figures (coefficient, row, severity key of ``Row.cases``: 0 originals,
+    None all perturbed, 1-5 a level), the cases of all the rows resampled paired."""
+    chosen: list[Term] = [(coefficient, row.cases[key]) for coefficient, row, key in terms if key in row.cases]
+    return combination_interval(chosen, field, f1_variant) if len(chosen) == len(terms) else None
+
+
+def gap_difference(a: Row, b: Row, field: str, f1_variant: str) -> tuple[float | None, Interval | None]:
+    """Gap of ``a`` minus gap of ``b`` and its paired interval."""
+    gap_a, gap_b = a.gap(field), b.gap(field)
+    if gap_a is None or gap_b is None:
+        return None, None
+    terms = [(1.0, a, None), (-1.0, a, 0), (-1.0, b, None), (1.0, b, 0)]
+    return gap_a - gap_b, paired_interval(terms, field, f1_variant)
+
+
+def separable_mark(interval: Interval | None) -> str:
+    """`` (not separable)`` where a difference's interval includes 0."""
+    return f" ({NOT_SEPARABLE})" if interval is not None and not interval.excludes_zero else ""
+
+
 def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = None) -> str:
     first = category_rows(detectors[0].report)
     heads = [_heading(row) for row in first]
     lines = ["# Robustness of several detectors", "",
              f"TuSimple metric, F1 variant `{f1_variant}`, values in %. P = Perturbed, O = Original (the clean "
-             "`00_original` cases), G = Gap = P - O.", ""]
+             "`00_original` cases), G = Gap = P - O. " + INTERVAL_NOTE, ""]
     for field, name in (("accuracy", "Accuracy"), ("f1", "F1")):
         lines += [f"## {name}", "", "| Detector | | " + " | ".join(heads) + " |",
                   "|---|---|" + "---:|" * len(heads)]
@@ -55,7 +101,7 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
                     if row is None:
                         cells.append("-")
                     elif pick is None:
-                        cells.append(_pct(row.gap(field), signed=True))
+                        cells.append(gap_cell(row, field))
                     else:
                         cells.append(_pct(getattr(getattr(row, pick), field, None)))
                 name_cell = detector.name if label == "P" else ""
@@ -71,6 +117,7 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
             lines.append(f"| {detector.name} | {_pct(getattr(row.original, 'accuracy', None))} | "
                          f"{_pct(getattr(row.no_paint, 'accuracy', None))} |")
         lines.append("")
+    lines += separability(detectors, f1_variant)
     if baseline is not None:
         lines += defences(detectors, baseline)
     lines += type_table(detectors)
@@ -80,9 +127,56 @@ def markdown(detectors: list[Detector], f1_variant: str, baseline: str | None = 
     for detector in detectors:
         row = category_rows(detector.report)[-1]
         cells = [_pct(getattr(row.original, "accuracy", None))]
-        cells += [_pct(row.gap("accuracy", level), signed=True) for level in LEVELS]
+        cells += [gap_cell(row, "accuracy", level) for level in LEVELS]
         lines.append(f"| {detector.name} | " + " | ".join(cells) + " |")
+    lines += ["", *breakdown(detectors)]
     return "\n".join(lines) + "\n"
+
+
+def separability(detectors: list[Detector], f1_variant: str) -> list[str]:
+    """Markdown lines: for every pair of detectors, the difference of their accuracy gaps per category and on
+    average with its paired interval, marked where the two are not separable (the interval includes 0)."""
+    if len(detectors) < 2:
+        return []
+    heads = [_heading(row) for row in category_rows(detectors[0].report)]
+    lines = ["## Separability", "",
+             "Accuracy Gap of the first detector minus the second's (points), cases resampled paired; "
+             f"`{NOT_SEPARABLE}` where the interval includes 0.", "",
+             "| Detectors | " + " | ".join(heads) + " |", "|---|" + "---:|" * len(heads)]
+    inseparable = []
+    for first, second in combinations(detectors, 2):
+        a_rows = {_heading(row): row for row in category_rows(first.report)}
+        b_rows = {_heading(row): row for row in category_rows(second.report)}
+        cells = []
+        for head in heads:
+            if head not in a_rows or head not in b_rows:
+                cells.append("-")
+                continue
+            value, interval = gap_difference(a_rows[head], b_rows[head], "accuracy", f1_variant)
+            cells.append(with_interval(value, interval) + separable_mark(interval))
+            if head == "Average" and separable_mark(interval):
+                inseparable.append(f"{first.name} and {second.name}")
+        lines.append(f"| {first.name} - {second.name} | " + " | ".join(cells) + " |")
+    if inseparable:
+        lines += ["", "Not separable on average (accuracy gap): " + "; ".join(inseparable) + "."]
+    return lines + [""]
+
+
+def breakdown(detectors: list[Detector]) -> list[str]:
+    """Markdown lines: the supplementary per-type x per-level table, each detector's accuracy of the originals
+    and its gap at every level with the interval."""
+    lines = ["## Accuracy by type and level", "",
+             "Per type: accuracy of the originals and the gap (points) at each level with its 95 % interval.", "",
+             "| Detector | Category | Type | Original | " + " | ".join(f"Level {level}" for level in LEVELS) + " |",
+             "|---|---|---|---:|" + "---:|" * len(LEVELS)]
+    for detector in detectors:
+        for row in detector.report.rows:
+            if ALL in (row.category, row.type):
+                continue
+            cells = [_pct(getattr(row.original, "accuracy", None))]
+            cells += [gap_cell(row, "accuracy", level) for level in LEVELS]
+            lines.append(f"| {detector.name} | {row.category} | {row.type} | " + " | ".join(cells) + " |")
+    return lines + [""]
 
 
 def grows_with_level(row: Row) -> bool:
@@ -103,16 +197,16 @@ def type_table(detectors: list[Detector]) -> list[str]:
     if not types:
         return []
     lines = ["## Level-5 drop by type", "",
-             "Accuracy at level 5 minus the originals', per type; `↑` = the drop grows with the level (levels 1-5). "
-             "The last row averages the types (each type counts once).", "",
+             "Accuracy at level 5 minus the originals', per type, with its 95 % interval; `↑` = the drop grows with "
+             "the level (levels 1-5). The last row averages the types (each type counts once).", "",
              "| Category | Type | " + " | ".join(d.name for d in detectors) + " |",
              "|---|---|" + "---:|" * len(detectors)]
     for category, type_name in types:
         cells = []
         for rows in keyed:
             row = rows.get((category, type_name))
-            gap = None if row is None else row.gap("accuracy", LEVELS[-1])
-            cells.append(_pct(gap, signed=True) + (" ↑" if row is not None and grows_with_level(row) else ""))
+            cell = "-" if row is None else gap_cell(row, "accuracy", LEVELS[-1])
+            cells.append(cell + (" ↑" if row is not None and grows_with_level(row) else ""))
         lines.append(f"| {category} | {type_name} | " + " | ".join(cells) + " |")
     means = []
     for rows in keyed:
@@ -154,18 +248,21 @@ def _average(report: Report, field: str) -> float | None:
 
 def seed_mean_table(detectors: list[Detector], baseline: str, seeds: list[str]) -> list[str]:
     """Markdown lines: per defence, its average perturbed gain over the baseline run of the same seed, each seed's
-    and their mean (ranked by the mean), and the mean change of clean accuracy."""
+    and their mean with its interval (cases resampled paired across all runs; ranked by the mean), and the mean
+    change of clean accuracy."""
     by_name = {d.name: d for d in detectors}
     rows: list[tuple[float, str]] = []
     for defence in dict.fromkeys(defence_and_seed(d.name)[0] for d in detectors):
         if defence == baseline:
             continue
-        gains, clean = [], []
+        gains, clean, pairs = [], [], []
         for seed in seeds:
             run, base = by_name.get(f"{defence}{SEED_MARK}{seed}"), by_name[f"{baseline}{SEED_MARK}{seed}"]
             mine, theirs = (None, None) if run is None else (_average(run.report, "perturbed"),
                                                               _average(base.report, "perturbed"))
             gains.append(None if mine is None or theirs is None else mine - theirs)
+            if gains[-1] is not None and run is not None:
+                pairs.append((category_rows(run.report)[-1], category_rows(base.report)[-1]))
             o_mine, o_theirs = (None, None) if run is None else (_average(run.report, "original"),
                                                                   _average(base.report, "original"))
             clean.append(None if o_mine is None or o_theirs is None else o_mine - o_theirs)
@@ -173,16 +270,20 @@ def seed_mean_table(detectors: list[Detector], baseline: str, seeds: list[str]) 
         if not found:
             continue
         mean = sum(found) / len(found)
+        terms = [term for mine_row, base_row in pairs
+                 for term in ((1.0 / len(pairs), mine_row, None), (-1.0 / len(pairs), base_row, None))]
+        interval = paired_interval(terms, "accuracy", detectors[0].report.f1_variant)
         found_clean = [c for c in clean if c is not None]
         mean_clean = sum(found_clean) / len(found_clean) if found_clean else None
         cells = [_pct(g, signed=True) for g in gains]
-        rows.append((mean, f"| {defence} | " + " | ".join(cells) + f" | **{_pct(mean, signed=True)}** | "
-                           f"{_pct(mean_clean, signed=True)} | {len(found)} |"))
+        rows.append((mean, f"| {defence} | " + " | ".join(cells) + f" | **{with_interval(mean, interval)}**"
+                           f"{separable_mark(interval)} | {_pct(mean_clean, signed=True)} | {len(found)} |"))
     if not rows:
         return []
     lines = ["## Defences, mean over seeds", "",
              f"Average perturbed accuracy gain (points) over `{baseline}` trained with the same seed, per seed and "
-             "their mean (best first), and the mean change of clean accuracy.", "",
+             "their mean with its 95 % interval (best first; `not separable` where it includes 0), and the mean "
+             "change of clean accuracy.", "",
              "| Defence | " + " | ".join(f"seed {seed}" for seed in seeds) + " | Mean gain | Clean change | Seeds |",
              "|---|" + "---:|" * (len(seeds) + 3)]
     lines += [line for _, line in sorted(rows, key=lambda r: -r[0])]
@@ -191,15 +292,17 @@ def seed_mean_table(detectors: list[Detector], baseline: str, seeds: list[str]) 
 
 def defence_table(detectors: list[Detector], title: str = "Defences") -> list[str]:
     """Markdown lines: each detector's Perturbed accuracy per category and average, its gain over the first
-    detector (the baseline: the vanilla model when comparing training defences), and its clean (Original)
-    accuracy and change."""
+    detector (the baseline: the vanilla model when comparing training defences) with the paired interval, and its
+    clean (Original) accuracy and change."""
     if len(detectors) < 2:
         return []
     base = {_heading(row): row for row in category_rows(detectors[0].report)}
     heads = list(base)
+    f1_variant = detectors[0].report.f1_variant
     lines = [f"## {title}", "",
-             f"Perturbed accuracy (%) per category and its gain over `{detectors[0].name}` in brackets; Clean = "
-             "accuracy on the originals (a defence should not cost more than 1 point there).", "",
+             f"Perturbed accuracy (%) per category and its gain over `{detectors[0].name}` in parentheses with its "
+             f"95 % interval, cases resampled paired (`{NOT_SEPARABLE}` where it includes 0); Clean = accuracy on "
+             "the originals (a defence should not cost more than 1 point there).", "",
              "| Detector | " + " | ".join(heads) + " | Clean |", "|---|" + "---:|" * (len(heads) + 1)]
     for detector in detectors:
         rows = {_heading(row): row for row in category_rows(detector.report)}
@@ -208,8 +311,11 @@ def defence_table(detectors: list[Detector], title: str = "Defences") -> list[st
             mine = getattr(rows[head].perturbed, "accuracy", None) if head in rows else None
             theirs = getattr(base[head].perturbed, "accuracy", None)
             gain = None if mine is None or theirs is None else mine - theirs
-            cells.append(_pct(mine) if detector is detectors[0] or gain is None
-                         else f"{_pct(mine)} ({_pct(gain, signed=True)})")
+            if detector is detectors[0] or gain is None:
+                cells.append(_pct(mine))
+                continue
+            interval = paired_interval([(1.0, rows[head], None), (-1.0, base[head], None)], "accuracy", f1_variant)
+            cells.append(f"{_pct(mine)} ({with_interval(gain, interval)}){separable_mark(interval)}")
         clean = getattr(rows.get("Average") and rows["Average"].original, "accuracy", None)
         base_clean = getattr(base["Average"].original, "accuracy", None) if "Average" in base else None
         clean_cell = _pct(clean)
@@ -219,19 +325,35 @@ def defence_table(detectors: list[Detector], title: str = "Defences") -> list[st
     return lines + [""]
 
 
-def comparison_csv(detectors: list[Detector]) -> str:
-    rows: list[list[str | int]] = [["detector", "category", "severity", "images", "accuracy", "f1",
-                                    "accuracy_gap", "f1_gap"]]
+def _level_rows(detectors: list[Detector], rows_of: Callable[[Report], list[Row]]) -> list[list[str | int]]:
+    header: list[str | int] = ["detector", "category", "type", "severity", "images", "accuracy", "f1"]
+    for name in FIELDS:
+        header += [f"{name}_gap", f"{name}_gap_lo", f"{name}_gap_hi"]
+    rows: list[list[str | int]] = [header]
     for detector in detectors:
-        for row in category_rows(detector.report):
+        for row in rows_of(detector.report):
             for level in (0, *LEVELS):
                 stats = row.original if level == 0 else row.levels[level]
                 if stats is None:
                     continue
-                gaps = (0.0, 0.0) if level == 0 else (row.gap("accuracy", level), row.gap("f1", level))
-                rows.append([detector.name, row.category, level, stats.images, _number(stats.accuracy),
-                             _number(stats.f1), _number(gaps[0]), _number(gaps[1])])
-    return _csv(rows)
+                cells: list[str | int] = [detector.name, row.category, row.type, level, stats.images,
+                                          _number(stats.accuracy), _number(stats.f1)]
+                for name in FIELDS:
+                    cells += ([_number(0.0), "", ""] if level == 0 else
+                              [_number(row.gap(name, level)), *interval_numbers(row.gap_interval(name, level))])
+                rows.append(cells)
+    return rows
+
+
+def comparison_csv(detectors: list[Detector]) -> str:
+    """compare.csv: per detector, category (and all) and level 0-5: images, accuracy, F1, gaps and intervals."""
+    return _csv(_level_rows(detectors, category_rows))
+
+
+def breakdown_csv(detectors: list[Detector]) -> str:
+    """compare_breakdown.csv: the same per detector, illusion type and level (the supplementary breakdown)."""
+    return _csv(_level_rows(detectors, lambda report: [row for row in report.rows
+                                                          if ALL not in (row.category, row.type)]))
 
 
 def comparison_plot(detectors: list[Detector]) -> bytes:
@@ -260,13 +382,15 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
 
 def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str,
                      baseline: str | None = None) -> list[Path]:
-    """compare.md, compare.csv and compare.png in ``out_dir`` and each detector's report in ``out_dir/<name>/``."""
+    """compare.md, compare.csv, compare_breakdown.csv and compare.png in ``out_dir`` and each detector's report in
+    ``out_dir/<name>/``."""
     out_dir = Path(out_dir)
     written = []
     for detector in detectors:
         written += write_report(detector.report, out_dir / detector.name)
     files = {COMPARE_MD: markdown(detectors, f1_variant, baseline).encode("utf-8"),
-             COMPARE_CSV: comparison_csv(detectors).encode("utf-8"), COMPARE_PNG: comparison_plot(detectors)}
+             COMPARE_CSV: comparison_csv(detectors).encode("utf-8"),
+             BREAKDOWN_CSV: breakdown_csv(detectors).encode("utf-8"), COMPARE_PNG: comparison_plot(detectors)}
     for name, data in files.items():
         write_atomic(out_dir / name, data)
     return [out_dir / name for name in files] + written

@@ -4,7 +4,8 @@
 Not run in CI: it needs a running CARLA server (0.9.14 or later) and its ``carla`` Python package; for the
 scenario, also a checkout of CARLA's scenario_runner.
 
-    lanevil export scenes/10_road_damage/tire_marks/05_level5.json --out out/tire_marks --openscenario
+    lanevil export scenes/10_road_damage/tire_marks/00_straight_highway_noon/05_level5.json --out out/tire_marks \
+        --openscenario
     python scripts/carla_run.py out/tire_marks                      # the road as a CARLA world, weather, ego
     python scripts/carla_run.py out/tire_marks --scenario-runner ~/scenario_runner   # the .xosc, via scenario_runner
 

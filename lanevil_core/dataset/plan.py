@@ -5,8 +5,9 @@ process or a Dask worker) receives its share as ``RenderTask`` values, so the sa
 whatever runs it.
 
 - Test split: every case with an illusion type (its own first illusion's, or for an original with no illusion
-  the type named by its folder, ``.../fence_shadow/00_original.json``) lands in
-  ``test/<Category>/<Type>/<case file stem>/``.
+  the type named by its folders, ``.../fence_shadow/00_uphill_rural_noon/00_original.json``) lands in
+  ``test/<Category>/<Type>/<original>/<case file stem>/`` (``test/<Category>/<Type>/<case file stem>/`` for a
+  folder holding one type's cases directly).
 - Train split: the clean cases (no illusion, no type folder) are the bases of deterministic variations (weather
   preset, sun angles, seed, ego lane and start, line types), ``TRAIN_FRAMES_PER_VARIANT`` frames each, in
   ``train/<nnnnn>_<base>_<preset>/``.
@@ -25,7 +26,15 @@ from typing import Any
 
 import numpy as np
 
-from ..benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, case_folder, case_illusion_type, frame_file
+from ..benchmark_layout import (
+    CATEGORY_FOLDERS,
+    TYPE_FOLDERS,
+    case_folder,
+    case_illusion_type,
+    case_name,
+    folder_type,
+    frame_file,
+)
 from ..camera.variation import random_camera
 from ..case import Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
@@ -94,9 +103,9 @@ class SourceCase:
 
     @property
     def folder_type(self) -> str | None:
-        """The illusion type named by the file's folder (``fence_shadow/00_original.json``), if any."""
-        parent = self.relative.parent.name
-        return parent if parent in REGISTRY else None
+        """The illusion type named by the file's folders (``fence_shadow/00_uphill_rural_noon/00_original.json``),
+        if any."""
+        return folder_type(self.relative)
 
 
 @dataclass(frozen=True)
@@ -201,9 +210,9 @@ def evenly_spaced(total: int, count: int | None) -> tuple[int, ...]:
 def discover_cases(root: Path) -> list[SourceCase]:
     """Every ``**/*.json`` case under ``root``, sorted by relative path (a bad file raises ``CaseError``)."""
     paths = sorted(root.glob("**/*.json"))
-    # A single type's folder (``--cases scenes/30_shadow/fence_shadow``) keeps its name in the relative paths, so
-    # its original is still known as that type's.
-    base = root.parent if root.name in REGISTRY else root
+    # A single type's folder (``--cases scenes/30_shadow/fence_shadow``) or one original's folder keeps the type's
+    # name in the relative paths, so its original is still known as that type's.
+    base = root.parent if root.name in REGISTRY else root.parent.parent if root.parent.name in REGISTRY else root
     return [SourceCase(PurePosixPath(path.relative_to(base).as_posix()), load_case(path)) for path in paths]
 
 
@@ -227,7 +236,7 @@ def _in_view(job: tuple[Case, int]) -> tuple[int, ...]:
 
 def in_view_by_folder(typed: list[SourceCase], frames_per_case: int | None,
                       mapper: Mapper = threads_map) -> dict[str, tuple[int, ...]]:
-    """Test frames per case folder (a type's original and levels) where that folder's most severe case shows
+    """Test frames per case folder (an original and its levels) where that folder's most severe case shows
     its illusion near the lanes, so Original and every level are scored on the same views. Folders are planned
     with ``mapper`` (a dataset run passes its local workers' when it has them)."""
     if frames_per_case is None:
@@ -250,7 +259,7 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
     illusion_type = case_illusion_type(case, source.folder_type)
     if illusion_type is None:
         raise PlanError(f"{source.relative}: a clean case has no test folder")
-    folder = case_folder(case, source.relative.stem, source.folder_type)
+    folder = case_folder(case, case_name(source.relative), source.folder_type)
     severity = case.illusions[0].severity if case.illusions else 0
     return PlannedCase(
         split=TEST_SPLIT, folder=folder, case_text=case_json(case),

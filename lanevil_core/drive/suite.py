@@ -13,9 +13,9 @@ import io
 import json
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
-from ..benchmark_layout import case_illusion_type
+from ..benchmark_layout import case_illusion_type, folder_type
 from ..case import Case, load_case, write_atomic
 from ..illusions import CATEGORIES, REGISTRY
 from .loop import DriveSettings
@@ -42,8 +42,8 @@ class SuiteEntry:
 
 
 def case_group(case: Case, path: Path) -> tuple[str, str, int]:
-    """(category, type, level) of a case: its illusion type (or its folder's, for an original)."""
-    illusion_type = case_illusion_type(case, path.parent.name if path.parent.name in REGISTRY else None)
+    """(category, type, level) of a case: its illusion type (or its folders', for an original)."""
+    illusion_type = case_illusion_type(case, folder_type(PurePosixPath(path.as_posix())))
     if illusion_type is None:
         return CLEAN, case.road.type, 0
     level = max((illusion.severity for illusion in case.illusions), default=0)

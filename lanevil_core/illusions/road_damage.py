@@ -395,15 +395,17 @@ class GuardRail(Illusion):
     CATEGORY: ClassVar[Category] = "road_damage"
     # offset: gap between the carriageway edge and the rail (m); far_side: a second rail along the other edge;
     # median: a rail just left of the centre line; shadow_m: how far across the road (from the rail nearest
-    # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept). The sun is the same at
-    # every level; the rails come closer to the lanes, brighter, and more of them, so their edges and shadows
-    # run ever nearer the lane lines.
+    # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept). Level 1 keeps the case's
+    # light (one rail set back: barely a mark on the lanes); from level 2 one sun on the main rail's side throws its
+    # shadow over the lane beside it, the same sun at every level, so what rises is the rails: closer to the lanes,
+    # brighter (new galvanised steel), and more of them, their edges and shadows ever nearer the lane lines. (A sun
+    # sinking with the level would shade a street canyon's whole road and lower the change there.)
     SEVERITY: ClassVar[tuple[GuardRailLevel, ...]] = (
-        GuardRailLevel(offset=2.4, far_side=False, median=False, albedo=0.30, shadow_m=2.5),  # one rail, set back
-        GuardRailLevel(offset=1.6, far_side=False, median=False, albedo=0.40, shadow_m=2.5),
-        GuardRailLevel(offset=1.0, far_side=True, median=False, albedo=0.50, shadow_m=2.5),  # both edges
-        GuardRailLevel(offset=0.5, far_side=True, median=False, albedo=0.60, shadow_m=2.5),
-        GuardRailLevel(offset=0.1, far_side=True, median=True, albedo=0.70, shadow_m=2.5),  # and the median
+        GuardRailLevel(offset=2.4, far_side=False, median=False, albedo=0.30, shadow_m=0.0),  # one rail, set back
+        GuardRailLevel(offset=1.6, far_side=False, median=False, albedo=0.44, shadow_m=2.5),
+        GuardRailLevel(offset=1.0, far_side=True, median=False, albedo=0.58, shadow_m=2.5),  # both edges
+        GuardRailLevel(offset=0.5, far_side=True, median=False, albedo=0.72, shadow_m=2.5),
+        GuardRailLevel(offset=0.1, far_side=True, median=True, albedo=0.85, shadow_m=2.5),  # and the median
     )
 
     type: Literal["guard_rail"] = "guard_rail"

@@ -167,22 +167,24 @@ class StreetlightShadowLevel(SunAheadLevel):
 class StreetlightShadow(SunShadowIllusion):
     """Rows of street lamps whose shadows, poles and arms, stripe the lanes."""
 
-    # One high, hard sun from the lamps' side, nearly square-on, at every level (the scene's light does not change
-    # between levels): high enough that the buildings of a street canyon leave the carriageway lit, so the lamps'
-    # shadows, not the buildings', fall on the lanes. The level makes the lamps taller, thicker, with longer arms
-    # and closer together, so their shadows reach further across the lanes and stripe more of them.
+    # A low sun from the lamps' side and ahead (``sun_ahead`` from square-on), so each pole throws a long shadow
+    # back along the road at a shallow angle to the lanes: neighbouring poles' shadows run parallel, about a lane
+    # width apart across the road (spacing * tan(90 - sun_ahead)), dark lines that look like lane lines. The sun
+    # sinks only a little between levels (an original with a low sun of its own changes about as much at every
+    # level); the level hardens it and makes the lamps taller and closer, so the shadows grow longer (pole height
+    # / tan(altitude): 16 m to 30 m), reach over more lanes and stripe more of the road.
     SEVERITY: ClassVar[tuple[StreetlightShadowLevel, ...]] = (
-        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=50.0,
-                               pole_height=6.0, pole_radius=0.08, arm=0.6),  # a few thin lamps, short shadows
-        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=38.0,
-                               pole_height=7.5, pole_radius=0.11, arm=1.0),
-        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=29.0,
-                               pole_height=9.0, pole_radius=0.14, arm=1.4),
-        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=22.0,
-                               pole_height=10.5, pole_radius=0.17, arm=1.8),
-        StreetlightShadowLevel(sun_altitude=62.0, sun_ahead=10.0, sun_intensity=1.2, penumbra=0.008, spacing=17.0,
-                               pole_height=12.0, pole_radius=0.20,
-                               arm=2.2),  # tall, thick, dense: shadows over every lane
+        StreetlightShadowLevel(sun_altitude=24.0, sun_ahead=68.0, sun_intensity=1.1, penumbra=0.010, spacing=30.0,
+                               pole_height=7.0, pole_radius=0.12, arm=1.2),  # sparse lamps, shadows into one lane
+        StreetlightShadowLevel(sun_altitude=23.0, sun_ahead=68.0, sun_intensity=1.2, penumbra=0.008, spacing=24.0,
+                               pole_height=8.0, pole_radius=0.14, arm=1.5),
+        StreetlightShadowLevel(sun_altitude=22.0, sun_ahead=68.0, sun_intensity=1.3, penumbra=0.007, spacing=19.0,
+                               pole_height=9.0, pole_radius=0.16, arm=1.8),
+        StreetlightShadowLevel(sun_altitude=21.0, sun_ahead=68.0, sun_intensity=1.4, penumbra=0.006, spacing=15.0,
+                               pole_height=10.0, pole_radius=0.18, arm=2.0),
+        StreetlightShadowLevel(sun_altitude=20.0, sun_ahead=68.0, sun_intensity=1.5, penumbra=0.005, spacing=12.0,
+                               pole_height=11.0, pole_radius=0.20,
+                               arm=2.2),  # tall dense lamps: lane-like stripes over every lane
     )
 
     type: Literal["streetlight_shadow"] = "streetlight_shadow"
@@ -286,18 +288,19 @@ class RailShadowLevel(SunAheadLevel):
 class RailShadow(SunShadowIllusion):
     """An elevated slotted rail deck over the road: a shaded road with bright lines where light comes through."""
 
-    # One high sun and one slot pattern (slots along the road: bright lines parallel to the lanes) at every level;
-    # the deck, starting at the same place, grows longer, so each level's striped shade holds the one before.
+    # One sun bearing and altitude and one slot pattern (slots along the road: bright lines parallel to the
+    # lanes) at every level; the deck, starting at the same place, grows longer while the sun hardens (brighter,
+    # crisper edges), so each level's striped shade holds the one before with starker slots.
     SEVERITY: ClassVar[tuple[RailShadowLevel, ...]] = (
-        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=4.0,
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=0.9, penumbra=0.010, deck_length=5.0,
                         slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),  # a narrow footbridge
-        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=8.0,
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.1, penumbra=0.008, deck_length=10.0,
                         slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
-        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=13.0,
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.3, penumbra=0.006, deck_length=16.0,
                         slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
-        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=19.0,
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.5, penumbra=0.005, deck_length=23.0,
                         slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),
-        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.2, penumbra=0.006, deck_length=26.0,
+        RailShadowLevel(sun_altitude=50.0, sun_ahead=72.0, sun_intensity=1.7, penumbra=0.004, deck_length=30.0,
                         slots_along="s", slot_width=0.24, slot_pitch=1.4, deck_depth=0.35),  # a slotted viaduct
     )
 

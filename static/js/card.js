@@ -2,8 +2,9 @@
  * One illusion card: the stock original next to a perturbed frame, with severity and sun sliders.
  *
  * A card does nothing until `activate()` (called when it scrolls near the viewport). It then looks up the type's
- * cases in the store: `<type>-00_original` for the left frame and a level case (`<type>-03_level3` preferred)
- * re-rendered at the slider's severity for the right one. Types the store lacks get a "not in this library" card.
+ * cases in the store: the type's representative stock original (`<type>-00_<original>-00_original`, the first of
+ * its originals) for the left frame and a level case of the same original (`…-03_level3` preferred) re-rendered
+ * at the slider's severity for the right one. Types the store lacks get a "not in this library" card.
  * With a detector chosen (page toolbar), both frames show its lanes in magenta and their captions its TuSimple
  * accuracy on that frame; "Open the editor" opens the card's perturbed case (else its original) in the editor.
  */
@@ -21,16 +22,26 @@ export function typeTitle(type) {
   return words.charAt(0).toUpperCase() + words.slice(1);
 }
 
-/** The stock id of `type`'s original, or of its `level` case. */
-export function stockId(type, level = 0) {
-  return level === 0 ? `${type}-00_original` : `${type}-0${level}_level${level}`;
+const ORIGINAL_STEM = "00_original";
+
+/** The stock id of the case at `level` (0 = the original) in the folder whose original has id `originalId`. */
+export function stockId(originalId, level = 0) {
+  const folder = originalId.slice(0, -ORIGINAL_STEM.length);
+  return level === 0 ? originalId : `${folder}0${level}_level${level}`;
+}
+
+/** The id of `type`'s representative original among `ids`: its first stock original
+ * (`<type>-00_<original>-00_original`, or `<type>-00_original` of a library with one original per type). */
+export function representativeId(type, ids) {
+  return [...ids].sort().find((id) => id.startsWith(`${type}-00_`) && id.endsWith(`-${ORIGINAL_STEM}`)) ?? null;
 }
 
 /** Ids of the original (or null) and of the case to re-render at any severity (or null) among `rows`. */
 export function pickCases(type, rows) {
   const ids = new Set(rows.map((row) => row.id));
-  const original = ids.has(stockId(type)) ? stockId(type) : null;
-  const levels = [PREFERRED_LEVEL, 1, 2, 4, 5].map((level) => stockId(type, level)).filter((id) => ids.has(id));
+  const original = representativeId(type, ids);
+  const levels = original === null ? []
+    : [PREFERRED_LEVEL, 1, 2, 4, 5].map((level) => stockId(original, level)).filter((id) => ids.has(id));
   const anyPerturbed = rows.find((row) => row.id !== original && row.type === type && row.illusions > 0);
   return { original, perturbed: levels[0] ?? anyPerturbed?.id ?? null };
 }

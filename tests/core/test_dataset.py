@@ -25,15 +25,15 @@ from lanevil_core.labels import h_samples_for
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 SIZE = "160x90"
 CASE_FILES = (
-    "30_shadow/fence_shadow/00_original.json",
-    "30_shadow/fence_shadow/01_level1.json",
-    "10_road_damage/road_crack/03_level3.json",
+    "30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json",
+    "30_shadow/fence_shadow/00_uphill_rural_noon/01_level1.json",
+    "10_road_damage/road_crack/00_straight_suburban_cloudy/03_level3.json",
     "00_clean/00_straight_urban.json",
 )
 EXPECTED_TEST = {  # case folder -> (category, type, severity, source file)
-    "Shadow/Fence/00_original": ("Shadow", "Fence", 0, CASE_FILES[0]),
-    "Shadow/Fence/01_level1": ("Shadow", "Fence", 1, CASE_FILES[1]),
-    "RoadDamage/RoadCrack/03_level3": ("RoadDamage", "RoadCrack", 3, CASE_FILES[2]),
+    "Shadow/Fence/00_uphill_rural_noon/00_original": ("Shadow", "Fence", 0, CASE_FILES[0]),
+    "Shadow/Fence/00_uphill_rural_noon/01_level1": ("Shadow", "Fence", 1, CASE_FILES[1]),
+    "RoadDamage/RoadCrack/00_straight_suburban_cloudy/03_level3": ("RoadDamage", "RoadCrack", 3, CASE_FILES[2]),
 }
 ARGS = ["--size", SIZE, "--frames-per-case", "2", "--sampling", "even", "--train-frames", "3", "--quiet"]
 
@@ -101,7 +101,7 @@ def test_test_split_layout_and_labels(dataset: Path) -> None:
     # The split file holds the same lines as the case files (case folders sorted by source path).
     split_records = read_lines(split / "test_label.json")
     assert sorted(map(json.dumps, split_records)) == sorted(map(json.dumps, all_records))
-    assert (split / "Shadow/Fence/01_level1/case.json").is_file()
+    assert (split / "Shadow/Fence/00_uphill_rural_noon/01_level1/case.json").is_file()
 
 
 def test_train_split_from_clean_variations(dataset: Path) -> None:
@@ -165,9 +165,9 @@ def test_resume_repairs_exactly_the_damaged_frames(
     out = tmp_path / "damaged"
     shutil.copytree(dataset, out)
     expected = tree(dataset)
-    case_dir = out / "test/Shadow/Fence/01_level1"
+    case_dir = out / "test/Shadow/Fence/00_uphill_rural_noon/01_level1"
     missing, truncated = case_dir / "000000.png", case_dir / "000099.png"
-    flipped = out / "test/RoadDamage/RoadCrack/03_level3/000000.png"
+    flipped = out / "test/RoadDamage/RoadCrack/00_straight_suburban_cloudy/03_level3/000000.png"
     missing.unlink()
     truncated.write_bytes(truncated.read_bytes()[:100])
     data = bytearray(flipped.read_bytes())
@@ -219,7 +219,7 @@ def test_frames_from_other_settings_are_not_reused(dataset: Path, cases_dir: Pat
                    "--frames-per-case", "1", "--quiet") == 0
     line = capsys.readouterr().out
     assert "(3 rendered, 0 kept); rendering " in line and " frames/s; total wall time " in line
-    with Image.open(out / "test/Shadow/Fence/00_original/000000.png") as image:
+    with Image.open(out / "test/Shadow/Fence/00_uphill_rural_noon/00_original/000000.png") as image:
         assert image.size == (128, 72)
     manifest = json.loads((out / "manifest.json").read_text())
     assert [entry["split"] for entry in manifest["cases"]] == ["test"] * 3
@@ -231,7 +231,7 @@ def test_jpg_format(cases_dir: Path, tmp_path: Path) -> None:
     assert run_cli("--cases", str(cases), "--out", str(out), "--size", SIZE, "--frames-per-case", "1",
                    "--format", "jpg", "--workers", "1", "--quiet") == 0
     record = read_lines(out / "test" / "test_label.json")[0]
-    assert record["raw_file"] == "Shadow/Fence/00_original/000000.jpg"
+    assert record["raw_file"] == "Shadow/Fence/00_uphill_rural_noon/00_original/000000.jpg"
     assert (out / "test" / record["raw_file"]).read_bytes()[:3] == b"\xff\xd8\xff"
 
 
@@ -270,7 +270,7 @@ def test_levels_of_a_folder_share_the_worker_s_original_renders() -> None:
     from lanevil_core.dataset import worker
     from lanevil_core.illusion_effect import SHARE_SIZE, clean_of, scene_changes
 
-    folder = SCENES / "30_shadow" / "fence_shadow"
+    folder = SCENES / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
     frames = (0, 30)
     worker._CLEAN_VIEWS.clear()
     for level in (2, 4):

@@ -11,8 +11,8 @@ from lanevil_core.case import Case
 from lanevil_core.dataset import PlanError, Settings, build_plan, discover_cases, evenly_spaced
 from lanevil_core.dataset.manifest import _PACKAGE, source_files
 from lanevil_core.dataset.plan import SourceCase, render_tasks, train_variation
-from lanevil_core.illusions import REGISTRY
 from lanevil_core.presets import PRESET_NAMES
+from lanevil_core.stock import ORIGINALS, original_folder
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
@@ -36,16 +36,34 @@ def stock() -> list[SourceCase]:
 def test_stock_library_plan(stock: list[SourceCase]) -> None:
     plan = build_plan(stock, Settings(frames_per_case=10, train_frames=160, sampling="even"))
     test = plan.split_cases("test")
-    assert len(test) == 6 * len(REGISTRY)  # an original and five levels per illusion type
+    originals = sum(len(originals) for originals in ORIGINALS.values())
+    assert len(test) == 6 * originals  # every original and its five levels
     assert len({case.folder for case in test}) == len(test)
     for case in test:
-        category, type_folder, name = case.folder.parts
+        category, type_folder, original, name = case.folder.parts
         assert category in CATEGORY_FOLDERS.values() and type_folder in TYPE_FOLDERS.values()
         assert case.severity == (0 if name == "00_original" else int(name[-1]))
         assert len(case.frames) == 10
-    assert str(test[0].folder) == "RoadDamage/GuardRail/00_original"  # sorted by source path
+    assert str(test[0].folder) == "RoadDamage/GuardRail/00_bend_highway_noon/00_original"  # sorted by source path
     assert sum(len(case.frames) for case in plan.split_cases("train")) == 160
-    assert plan.total_frames == 1000
+    assert plan.total_frames == 10 * len(test) + 160
+
+
+def test_full_test_split_reaches_the_paper_s_scale(stock: list[SourceCase]) -> None:
+    """All frames of every case (the default): at least 94 originals, 560 cases and 50,000 test frames."""
+    plan = build_plan(stock, Settings())
+    test = plan.split_cases("test")
+    assert len([case for case in test if case.severity == 0]) >= 94 and len(test) >= 560
+    assert sum(len(case.frames) for case in test) >= 50_000
+    assert all(case.frames == tuple(range(100)) for case in test)
+
+
+def test_one_original_s_folder_keeps_its_type() -> None:
+    sources = discover_cases(SCENES / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon")
+    assert {s.folder_type for s in sources} == {"fence_shadow"} and len(sources) == 6
+    plan = build_plan(sources, Settings(frames_per_case=1, sampling="even"))
+    assert [str(c.folder) for c in plan.split_cases("test")][:2] == ["Shadow/Fence/00_uphill_rural_noon/00_original",
+                                                                      "Shadow/Fence/00_uphill_rural_noon/01_level1"]
 
 
 def test_train_variations_are_seeded_valid_and_varied(stock: list[SourceCase]) -> None:
@@ -89,7 +107,7 @@ def test_renderer_sources_reach_the_render_path_only() -> None:
 def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[SourceCase]) -> None:
     from lanevil_core.illusion_effect import IN_VIEW_SHARE, SHARE_SIZE, clean_of, frame_changes
 
-    fence = [source for source in stock if source.relative.parent.name == "fence_shadow"]
+    fence = [source for source in stock if str(source.relative.parent) == original_folder("fence_shadow")]
     plan = build_plan(fence, Settings(frames_per_case=4))
     frames = {case.frames for case in plan.split_cases("test")}
     assert len(frames) == 1  # the original and every level share the views
@@ -101,7 +119,8 @@ def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[Source
 def test_in_view_planning_on_worker_processes_picks_the_same_frames(stock: list[SourceCase]) -> None:
     from lanevil_core.dataset.local import LocalPool
 
-    sources = [source for source in stock if source.relative.parent.name in ("fence_shadow", "vehicle")]
+    folders = (original_folder("fence_shadow"), original_folder("vehicle"))
+    sources = [source for source in stock if str(source.relative.parent) in folders]
     on_threads = build_plan(sources, Settings(frames_per_case=3))
     pool = LocalPool(2)
     pool.start()
@@ -114,7 +133,9 @@ def test_in_view_planning_on_worker_processes_picks_the_same_frames(stock: list[
 
 def test_a_single_type_folder_keeps_its_original_as_that_type() -> None:
     sources = discover_cases(SCENES / "30_shadow" / "fence_shadow")
-    assert [str(s.relative) for s in sources][:2] == ["fence_shadow/00_original.json", "fence_shadow/01_level1.json"]
+    assert [str(s.relative) for s in sources][:2] == ["fence_shadow/00_uphill_rural_noon/00_original.json",
+                                                      "fence_shadow/00_uphill_rural_noon/01_level1.json"]
     assert {s.folder_type for s in sources} == {"fence_shadow"}
     plan = build_plan(sources, Settings(frames_per_case=2, sampling="even"))
-    assert sorted(c.severity for c in plan.split_cases("test")) == [0, 1, 2, 3, 4, 5]
+    levels = sorted(c.severity for c in plan.split_cases("test"))
+    assert levels == sorted([0, 1, 2, 3, 4, 5] * len(ORIGINALS["fence_shadow"]))

@@ -182,12 +182,23 @@ def test_summary_applies_the_paper_criterion(make_case):
 def test_illusion_span_covers_the_illusion():
     from lanevil_core.drive.illusion_view import illusion_span
 
-    case = load_case(SCENES / "10_road_damage" / "tire_marks" / "03_level3.json")
+    case = load_case(SCENES / "10_road_damage" / "tire_marks" / "00_straight_highway_noon" / "03_level3.json")
     s0, s1 = illusion_span(compile_scene(case))
     start = case.illusions[0].start_s(case)
     assert s0 == pytest.approx(start, abs=2.0) and s1 > s0 + 10
     assert illusion_span(compile_scene(load_case(SCENES / "00_clean" / "00_straight_urban.json"))) is None
 
+
+
+def test_suite_files_an_original_under_the_type_its_folders_name():
+    from lanevil_core.drive.suite import case_group
+
+    folder = SCENES / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
+    assert case_group(load_case(folder / "00_original.json"), folder / "00_original.json") == (
+        "shadow", "fence_shadow", 0)
+    assert case_group(load_case(folder / "03_level3.json"), folder / "03_level3.json")[2] == 3
+    clean = SCENES / "00_clean" / "00_straight_urban.json"
+    assert case_group(load_case(clean), clean)[1] == "straight"
 
 # ---------------------------------------------------------------------------------------------- command
 

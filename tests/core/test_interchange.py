@@ -114,7 +114,7 @@ def test_junction_cases_have_arms_and_a_junction(exported):
 
 
 def test_roadside_objects_are_written(tmp_path):
-    case = load_case(SCENES / "10_road_damage" / "guard_rail" / "05_level5.json")
+    case = load_case(SCENES / "10_road_damage" / "guard_rail" / "00_bend_highway_noon" / "05_level5.json")
     xodr, = write_interchange(case, tmp_path)
     objects = ET.parse(xodr).getroot().findall("road/objects/object")
     types = {obj.get("type") for obj in objects}
@@ -126,7 +126,7 @@ def test_roadside_objects_are_written(tmp_path):
 def test_openscenario_names_every_entity(tmp_path):
     from scenariogeneration import xosc
 
-    case = load_case(SCENES / "20_traffic" / "pedestrian" / "03_level3.json")
+    case = load_case(SCENES / "20_traffic" / "pedestrian" / "00_crossroad_urban_noon" / "03_level3.json")
     _, path = write_interchange(case, tmp_path, openscenario=True)
     expected = {EGO_NAME} | {p.name for p in participants(compile_scene(case))}
     assert len(expected) > 3

@@ -157,7 +157,8 @@ def test_shipped_model_detects_the_lanes_of_clean_renders(tmp_path, family):
         pytest.skip(f"no shipped {family} model")
     cases = tmp_path / "cases" / "fence_shadow"
     cases.mkdir(parents=True)
-    (cases / "00_original.json").write_text((SCENES / "30_shadow" / "fence_shadow" / "00_original.json").read_text())
+    original = SCENES / "30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json"
+    (cases / "00_original.json").write_text(original.read_text())
     out = tmp_path / "data"
     assert main(["dataset", "--cases", str(tmp_path / "cases"), "--out", str(out), "--frames-per-case", "2",
                  "--workers", "1", "--quiet"]) == 0

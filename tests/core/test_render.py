@@ -23,7 +23,8 @@ GOLDEN = Path(__file__).parent / "golden"
 GOLDEN_TOLERANCE = 2.0
 UPDATE = os.environ.get("LANEVIL_UPDATE_GOLDEN") == "1"  # set to write the actual images as the new goldens
 GOLDEN_CASES = ["00_clean/00_straight_urban.json", "00_clean/01_bend_suburban.json",
-                "30_shadow/rail_shadow/05_level5.json", "40_reflection/streetlight_reflection/05_level5.json"]
+                "30_shadow/rail_shadow/00_straight_urban_noon/05_level5.json",
+                "40_reflection/streetlight_reflection/00_t_junction_suburban_night/05_level5.json"]
 
 
 def _small(case: Case, size: tuple[int, int] = (320, 180)) -> Case:
@@ -132,7 +133,8 @@ def test_every_stock_case_renders(path: Path) -> None:
     assert frame.rgb.std() > 5.0  # not a blank image
 
 
-THREADED_CASE = "40_reflection/vehicle_reflection/05_level5.json"  # vehicles, sun shadows, a wet road and a puddle
+# vehicles, sun shadows, a wet road and a puddle
+THREADED_CASE = "40_reflection/vehicle_reflection/00_downhill_suburban_noon/05_level5.json"
 
 
 def _buffers_equal(a: Frame, b: Frame) -> bool:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -47,8 +48,8 @@ def test_groups_original_perturbed_and_gap():
     assert shadow.original.accuracy == pytest.approx(0.95) and shadow.perturbed.images == 3
     assert rows[(ALL, ALL)].original.images == 3 and report.unlabelled == 1
     text = markdown(report)
-    assert "| Shadow | Fence | 1/2 | 100.00 | 60.00 | -40.00 |" in text
-    assert "40.00 (-60.00)" in text and "1 image(s) without category" in text
+    assert "| Shadow | Fence | 1/2 | 100.00 | 60.00 | -40.00 [-40.00, -40.00] |" in text  # one case: no spread
+    assert "40.00 (-60.00 [-60.00, -60.00])" in text and "1 image(s) without category" in text
     levels = list(csv.DictReader(severity_csv(report).splitlines()))
     assert [r["severity"] for r in levels if r["type"] == "Fence"] == ["0", "1", "5"]
 
@@ -58,7 +59,7 @@ CASES = [("fence_shadow", "00_original", 0), ("fence_shadow", "05_level5", 5), (
 
 
 def _stock_path(illusion_type: str, name: str) -> Path:
-    return next(SCENES.glob(f"*/{illusion_type}/{name}.json"))
+    return min(SCENES.glob(f"*/{illusion_type}/*/{name}.json"))  # on the type's representative original
 
 
 @pytest.fixture(scope="module")
@@ -161,11 +162,12 @@ def test_paint_free_control_and_several_detectors(tmp_path):
     detectors = [Detector("vanilla", vanilla), Detector("aam", build_report(images(0.94, 0.80, 0.01), "ganet"))]
     assert "## Defences" not in compare_markdown(detectors, "ganet")
     text = compare_markdown(detectors, "ganet", baseline="vanilla")
-    assert "| aam | 80.00 (+10.00) | 80.00 (+10.00) | 94.00 (-1.00) |" in text
+    gain = "80.00 (+10.00 [+10.00, +10.00])"  # one case: the interval has no width
+    assert f"| aam | {gain} | {gain} | 94.00 (-1.00) |" in text
     assert "| vanilla | 95.00 | 2.00 |" in text and "| aam | 94.00 | 1.00 |" in text
     paths = write_comparison(detectors, tmp_path, "ganet", "vanilla")
     assert (tmp_path / "compare.png").read_bytes()[:4] == b"\x89PNG" and (tmp_path / "aam" / "report.md").is_file()
-    assert len(paths) == 3 + 2 * 4
+    assert len(paths) == 4 + 2 * 4 and (tmp_path / "compare_breakdown.csv").is_file()
 
 
 def test_defences_over_seeds_compare_each_run_with_its_own_seed_s_baseline():
@@ -180,11 +182,12 @@ def test_defences_over_seeds_compare_each_run_with_its_own_seed_s_baseline():
     detectors = [Detector(name, report(*scores)) for name, scores in runs.items()]
     text = compare_markdown(detectors, "ganet", baseline="none")
     assert "## Defences, seed 0" in text and "## Defences, seed 1" in text
-    assert "| aam@1 | 86.00 (+6.00) | 86.00 (+6.00) | 89.00 (-1.00) |" in text  # against none@1, not none@0
+    gain = "86.00 (+6.00 [+6.00, +6.00])"
+    assert f"| aam@1 | {gain} | {gain} | 89.00 (-1.00) |" in text  # against none@1, not none@0
     mean = text.split("## Defences, mean over seeds")[1]
     # aam: +10 and +6 -> +8; cutout: +15 and -1 -> +7; best first
-    assert mean.index("| aam | +10.00 | +6.00 | **+8.00** | -0.50 | 2 |") < mean.index(
-        "| cutout | +15.00 | -1.00 | **+7.00** | -1.00 | 2 |")
+    assert mean.index("| aam | +10.00 | +6.00 | **+8.00 [+8.00, +8.00]** | -0.50 | 2 |") < mean.index(
+        "| cutout | +15.00 | -1.00 | **+7.00 [+7.00, +7.00]** | -1.00 | 2 |")
     assert defence_and_seed("aam@1") == ("aam", "1") and defence_and_seed("aam") == ("aam", None)
     assert defence_and_seed("@1") == ("@1", None)
 
@@ -202,5 +205,86 @@ def test_level5_drop_by_type_marks_drops_that_grow_with_the_level():
     assert grows_with_level(rows["Fence"]) and not grows_with_level(rows["Wire"])
     assert not grows_with_level(rows["Rail"])  # the same drop at every level: flat, not growing
     lines = type_table([Detector("a", report)])
-    assert "| Shadow | Fence | -40.00 ↑ |" in lines and "| Shadow | Wire | -10.00 |" in lines
+    assert "| Shadow | Fence | -40.00 [-40.00, -40.00] ↑ |" in lines
+    assert "| Shadow | Wire | -10.00 [-10.00, -10.00] |" in lines
     assert "| **Mean over types** | | -18.33 (1/3 ↑) |" in lines
+
+
+# ------------------------------------------------------------------------------------ intervals (bootstrap over cases)
+
+def _cases(count: int, original: float, perturbed: float, spread: float, seed: int = 0,
+           type_name: str = "Fence") -> list[ScoredImage]:
+    """``count`` basic cases of three frames per level: accuracies around ``original`` / ``perturbed`` with a
+    per-case offset of up to ``spread`` (frames of one case alike, as in a drive)."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    images = []
+    for index in range(count):
+        offset = float(rng.uniform(-spread, spread))
+        for level in range(6):
+            accuracy = min(max((original if level == 0 else perturbed) + offset, 0.0), 1.0)
+            for frame in range(3):
+                extra = {"category": "Shadow", "type": type_name, "severity": level,
+                         "case": f"Shadow/{type_name}/{index:02d}_case/{level:02d}"}
+                images.append(ScoredImage(f"{index}/{level}/{frame}.png", ImageScore(accuracy, 0.0, 0.0), extra))
+    return images
+
+
+def test_gap_interval_contains_the_gap_and_narrows_with_more_cases():
+    widths = []
+    for count in (8, 64):
+        row = build_report(_cases(count, 0.9, 0.8, 0.15), "ganet").rows[0]
+        for level in (None, 5):
+            interval = row.gap_interval("accuracy", level)
+            assert interval is not None and interval.contains(row.gap("accuracy", level))
+            assert interval.excludes_zero  # a 10-point drop on every case
+        f1 = row.gap_interval("f1")
+        assert f1 is not None and f1.contains(row.gap("f1"))
+        interval = row.gap_interval("accuracy")
+        widths.append(interval.hi - interval.lo)
+    assert widths[1] < 0.6 * widths[0]
+
+
+def test_cases_not_frames_are_resampled():
+    from lanevil_core.report_interval import CaseSums, case_unit
+
+    images = _cases(4, 0.9, 0.8, 0.1)
+    assert case_unit(images[0]) == "Shadow/Fence/00_case"
+    sums = CaseSums.of(images)
+    assert len(sums.keys) == 4 and sums.n.tolist() == [18.0] * 4
+
+
+def test_report_prints_and_writes_intervals(tmp_path):
+    from lanevil_core.report import report_csv, write_report
+
+    report = build_report(_cases(12, 0.9, 0.8, 0.1), "ganet")
+    assert re.search(r"\| Shadow \| Fence \| 36/180 \| [\d.]+ \| [\d.]+ \| -10\.00 \[-\d+\.\d\d, -\d+\.\d\d\] \|",
+                     markdown(report))
+    row = next(csv.DictReader(report_csv(report).splitlines()))
+    assert float(row["accuracy_gap_lo"]) <= float(row["accuracy_gap"]) <= float(row["accuracy_gap_hi"])
+    assert row["cases"] == "12" and "f1_gap_lo" in row and "f1_gap_hi" in row
+    levels = [r for r in csv.DictReader(severity_csv(report).splitlines()) if r["type"] == "Fence"]
+    assert [r["accuracy_gap_lo"] != "" for r in levels] == [False, True, True, True, True, True]
+    write_report(report, tmp_path)
+
+
+def test_compare_says_which_detectors_are_separable():
+    from lanevil_core.report_compare import NOT_SEPARABLE, Detector, gap_difference
+    from lanevil_core.report_compare import markdown as compare_markdown
+
+    strong = build_report(_cases(30, 0.9, 0.88, 0.1, seed=1), "ganet")  # drops 2 points
+    weak = build_report(_cases(30, 0.9, 0.70, 0.1, seed=1), "ganet")  # drops 20 points on the same cases
+    twin = build_report(_cases(30, 0.9, 0.88, 0.1, seed=1)[:-1], "ganet")  # the strong one, one frame fewer
+    value, interval = gap_difference(strong.rows[-1], weak.rows[-1], "accuracy", "ganet")
+    assert value == pytest.approx(0.18) and interval.excludes_zero
+    value, interval = gap_difference(strong.rows[-1], twin.rows[-1], "accuracy", "ganet")
+    assert abs(value) < 0.01 and not interval.excludes_zero
+    text = compare_markdown([Detector("strong", strong), Detector("weak", weak), Detector("twin", twin)], "ganet",
+                            baseline="weak")
+    separability = text.split("## Separability")[1].split("##")[0]
+    assert "| strong - twin |" in separability and NOT_SEPARABLE in separability.split("| strong - twin |")[1]
+    assert NOT_SEPARABLE not in separability.split("| strong - weak |")[1].split("\n")[0]
+    assert "Not separable on average (accuracy gap): strong and twin." in separability
+    defences = text.split("## Defences")[1].split("##")[0]
+    assert re.search(r"\| strong \| [\d.]+ \(\+18\.00 \[\+\d", defences) and "## Accuracy by type and level" in text

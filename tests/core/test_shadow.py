@@ -63,9 +63,9 @@ def test_severity_tables_are_monotone(name: str) -> None:
     assert all(a >= b for a, b in zip(altitude, altitude[1:]))
     assert all(a <= b for a, b in zip(intensity, intensity[1:]))
     assert all(a >= b for a, b in zip(penumbra, penumbra[1:]))
-    # Either one sun for every level (the level grows the structure), or a sun that gets lower and harder.
+    # Either one sun for every level (the level grows the structure), or a sun that gets lower or harder.
     constant_sun = len(set(altitude)) == len(set(intensity)) == len(set(penumbra)) == 1
-    assert constant_sun or (altitude[0] > altitude[-1] and intensity[0] < intensity[-1])
+    assert constant_sun or altitude[0] > altitude[-1] or intensity[0] < intensity[-1]
 
 
 @pytest.mark.parametrize("severity", LEVELS)

@@ -28,8 +28,8 @@ CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-
                  "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]  # WebGL (viser) without a GPU
 # A small store keeps seeding fast: two clean cases and one illusion type's original and levels.
 SMALL_LIBRARY = ["00_clean/00_straight_urban.json", "00_clean/01_bend_suburban.json",
-                 "30_shadow/fence_shadow/00_original.json", "30_shadow/fence_shadow/01_level1.json",
-                 "30_shadow/fence_shadow/03_level3.json", "30_shadow/fence_shadow/05_level5.json"]
+                 *(f"30_shadow/fence_shadow/00_uphill_rural_noon/{name}.json"
+                   for name in ("00_original", "01_level1", "03_level3", "05_level5"))]
 
 
 def small_scenes(target: Path) -> Path:

@@ -13,7 +13,8 @@ from app.api.limits import UPLOADS_PER_REQUEST
 from app.main import create_app
 from lanevil_core.illusions import REGISTRY
 
-SHADOW_ID = "fence_shadow-03_level3"
+FENCE = "fence_shadow-00_uphill_rural_noon"  # the fence shadow's representative original
+SHADOW_ID = f"{FENCE}-03_level3"
 
 
 def files_under(root: Path) -> set[Path]:
@@ -59,9 +60,9 @@ def test_openapi_describes_the_listing_and_the_envelope(client) -> None:
 
 @pytest.mark.parametrize(("query", "expected"), [
     ("category=clean", {"clean-00_straight_urban", "clean-01_bend_suburban"}),
-    ("category=shadow", {"fence_shadow-00_original", "fence_shadow-01_level1", SHADOW_ID, "fence_shadow-05_level5"}),
-    ("type=fence_shadow&category=shadow", {"fence_shadow-00_original", "fence_shadow-01_level1", SHADOW_ID,
-                                           "fence_shadow-05_level5"}),
+    ("category=shadow", {f"{FENCE}-00_original", f"{FENCE}-01_level1", SHADOW_ID, f"{FENCE}-05_level5"}),
+    ("type=fence_shadow&category=shadow", {f"{FENCE}-00_original", f"{FENCE}-01_level1", SHADOW_ID,
+                                           f"{FENCE}-05_level5"}),
     ("category=traffic", set()),
     ("type=road_crack", set()),
 ])

@@ -13,7 +13,7 @@ from lanevil_core.detect.split import METHODS
 from lanevil_core.labels import h_samples_for
 from lanevil_core.overlay import DETECTION_COLOR
 
-SHADOW_ID = "fence_shadow-03_level3"
+SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 FRAME = f"/api/cases/{SHADOW_ID}/frames"
 SIZE = "width=320&height=180"
 

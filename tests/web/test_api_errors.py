@@ -15,7 +15,7 @@ from app.api.json_body import MAX_DEPTH, line_column
 
 ADMIN = {"Authorization": "Bearer test-admin"}
 JSON = {"content-type": "application/json"}
-SHADOW_ID = "fence_shadow-03_level3"
+SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 
 
 def post_case(client, payload: bytes, headers: dict[str, str] | None = None):
@@ -38,7 +38,7 @@ def test_malformed_json_names_body_with_line_and_column(client) -> None:
     ("PUT", f"/api/cases/{SHADOW_ID}", b'{"title": "x"}'),
     ("PATCH", f"/api/cases/{SHADOW_ID}", b'{"title": "x"}'),
     ("POST", "/api/render", b'{"title": "x"}'),
-    ("POST", "/api/exports", b'{"case_id": "fence_shadow-03_level3"}'),
+    ("POST", "/api/exports", b'{"case_id": "fence_shadow-00_uphill_rural_noon-03_level3"}'),
 ])
 @pytest.mark.parametrize("content_type", ["text/plain", "application/x-www-form-urlencoded", "application/xml", None])
 def test_a_body_not_sent_as_json_is_415(client, method: str, url: str, body: bytes, content_type: str | None) -> None:

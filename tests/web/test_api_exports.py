@@ -13,7 +13,7 @@ from PIL import Image
 import app.api.exports as exports
 from lanevil_core.case import Case
 
-SHADOW_ID = "fence_shadow-03_level3"
+SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 
 
 def wait_for_job(client, url: str, timeout_s: float = 120) -> list[dict]:
@@ -50,8 +50,8 @@ def test_clean_and_original_cases_use_their_folders(client) -> None:
     clean = zipfile.ZipFile(io.BytesIO(client.get("/api/cases/clean-00_straight_urban/export.zip?frames=0").content))
     assert "Clean/clean-00_straight_urban/000000.png" in clean.namelist()
     original = zipfile.ZipFile(io.BytesIO(
-        client.get("/api/cases/fence_shadow-00_original/export.zip?frames=0").content))
-    assert "Shadow/Fence/fence_shadow-00_original/labels.json" in original.namelist()
+        client.get("/api/cases/fence_shadow-00_uphill_rural_noon-00_original/export.zip?frames=0").content))
+    assert "Shadow/Fence/fence_shadow-00_uphill_rural_noon-00_original/labels.json" in original.namelist()
 
 
 def test_long_export_becomes_a_job(client, monkeypatch) -> None:

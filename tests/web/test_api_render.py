@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-SHADOW_ID = "fence_shadow-03_level3"
+SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 FRAME = f"/api/cases/{SHADOW_ID}/frames"
 SMALL = "width=160&height=90"
 

@@ -288,10 +288,10 @@ def test_editor_link_opens_the_cards_case(page, live_server) -> None:
     live_server.app.state.open_in_editor = opened.append
     open_card(page, live_server)
     link = page.locator(f"{CARD} .card__edit")
-    assert link.get_attribute("href") == "/editor?case=fence_shadow-03_level3"
+    assert link.get_attribute("href") == "/editor?case=fence_shadow-00_uphill_rural_noon-03_level3"
     with page.expect_request("**/editor?case=*"):
         link.click(no_wait_after=True)
     deadline = time.monotonic() + 10
     while not opened and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert opened == ["fence_shadow-03_level3"]
+    assert opened == ["fence_shadow-00_uphill_rural_noon-03_level3"]

@@ -110,14 +110,14 @@ def test_api_the_page_builds_on(client) -> None:
     assert [info["name"] for info in registry] == list(REGISTRY)
     assert all(len(info["severity"]) == 5 for info in registry)
     ids = {row["id"] for row in client.get("/api/cases", params={"type": "fence_shadow"}).json()["data"]}
-    assert {"fence_shadow-00_original", "fence_shadow-03_level3"} <= ids
+    assert {"fence_shadow-00_uphill_rural_noon-00_original", "fence_shadow-00_uphill_rural_noon-03_level3"} <= ids
     assert client.get("/api/cases", params={"type": "road_crack"}).json()["data"] == []
-    envelope = client.get("/api/cases/fence_shadow-03_level3").json()
+    envelope = client.get("/api/cases/fence_shadow-00_uphill_rural_noon-03_level3").json()
     assert {"azimuth", "altitude", "intensity"} <= set(envelope["case"]["sun"])
 
 
 def test_frame_url_the_page_builds_renders_a_jpeg(client) -> None:
-    response = client.get("/api/cases/fence_shadow-03_level3/frames/0.jpg",
+    response = client.get("/api/cases/fence_shadow-00_uphill_rural_noon-03_level3/frames/0.jpg",
                           params={"width": 160, "height": 90, "overlay": "true", "severity": 5,
                                   "sun_azimuth": 90, "sun_altitude": 30})
     assert response.status_code == 200
@@ -132,7 +132,7 @@ def test_detector_select_and_score_line(client, page: PageParser) -> None:
     assert "/static/js/latest-score.js" in static_references(page)
     names = [entry["name"] for entry in client.get("/api/detectors").json()["data"]]
     assert "ufld" in names  # the page's default
-    response = client.get("/api/cases/fence_shadow-03_level3/frames/0/detections",
+    response = client.get("/api/cases/fence_shadow-00_uphill_rural_noon-03_level3/frames/0/detections",
                           params={"width": 160, "height": 90, "detector": "hough", "severity": 5, "sun_azimuth": 90,
                                   "sun_altitude": 30})
     assert response.status_code == 200 and 0.0 <= response.json()["accuracy"] <= 1.0

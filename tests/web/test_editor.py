@@ -27,7 +27,7 @@ from lanevil_core.compile import compile_scene
 from lanevil_core.detect.split import METHODS
 from lanevil_core.illusions.shadow import roadside_t
 
-SHADOW = "fence_shadow-03_level3"
+SHADOW = "fence_shadow-00_uphill_rural_noon-03_level3"
 WAIT_S = 120.0
 
 

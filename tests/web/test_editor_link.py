@@ -15,9 +15,9 @@ def opened(app) -> list[str]:
 
 
 def test_a_case_link_opens_the_case_and_redirects(client, opened: list[str]) -> None:
-    response = client.get("/editor?case=fence_shadow-03_level3", follow_redirects=False)
+    response = client.get("/editor?case=fence_shadow-00_uphill_rural_noon-03_level3", follow_redirects=False)
     assert response.status_code == 307 and response.headers["location"] == "http://testserver:8765/"
-    assert opened == ["fence_shadow-03_level3"]
+    assert opened == ["fence_shadow-00_uphill_rural_noon-03_level3"]
     assert client.get("/editor", follow_redirects=False).status_code == 307 and len(opened) == 1
 
 
@@ -29,4 +29,5 @@ def test_a_bad_case_is_refused_naming_it(client, opened: list[str], case: str, s
 
 
 def test_without_the_editor_a_case_link_is_503(client) -> None:
-    assert client.get("/editor?case=fence_shadow-03_level3", follow_redirects=False).status_code == 503
+    response = client.get("/editor?case=fence_shadow-00_uphill_rural_noon-03_level3", follow_redirects=False)
+    assert response.status_code == 503

@@ -19,7 +19,7 @@ SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
 
 def test_sun_override_moves_a_shadow_illusions_own_sun() -> None:
-    case = load_case(SCENES / "30_shadow/fence_shadow/03_level3.json")
+    case = load_case(SCENES / "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
     moved = apply_overrides(case, severity=5, sun_azimuth=120.0, sun_altitude=0.0)
     illusion = moved.illusions[0]
     assert illusion.severity == 5 and illusion.sun_azimuth == 120.0
@@ -29,13 +29,13 @@ def test_sun_override_moves_a_shadow_illusions_own_sun() -> None:
 
 
 def test_sun_override_leaves_illusions_without_sun_fields_alone() -> None:
-    case = load_case(SCENES / "40_reflection/sunlight_reflection/03_level3.json")
+    case = load_case(SCENES / "40_reflection/sunlight_reflection/00_straight_suburban_noon/03_level3.json")
     moved = apply_overrides(case, sun_azimuth=100.0)
     assert moved.illusions[0] == case.illusions[0] and moved.sun.azimuth == 100.0
 
 
 def test_out_of_range_override_is_a_validation_error() -> None:
-    case = load_case(SCENES / "30_shadow/fence_shadow/03_level3.json")
+    case = load_case(SCENES / "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
     with pytest.raises(ValidationError):
         apply_overrides(case, severity=9)
 

@@ -57,7 +57,7 @@ def test_serve_runs_backend_and_editor_and_stops_cleanly(settings: Settings, sto
         assert _wait_ready(editor).status_code == 200  # viser serves its client page over HTTP too
         redirect = httpx.get(api + "editor", follow_redirects=False)
         assert redirect.status_code == 307 and redirect.headers["location"] == editor
-        assert (settings.data_dir / "cases" / "fence_shadow-03_level3.json").is_file()
+        assert (settings.data_dir / "cases" / "fence_shadow-00_uphill_rural_noon-03_level3.json").is_file()
     finally:
         process.send_signal(stop_signal)
         code = process.wait(timeout=30)

@@ -10,7 +10,7 @@ from app.settings import Settings
 
 def test_store_is_seeded_from_scenes(client, state) -> None:
     assert len(state.store) == 6
-    assert state.store.get("fence_shadow-03_level3").severity == 3
+    assert state.store.get("fence_shadow-00_uphill_rural_noon-03_level3").severity == 3
     assert client.get("/docs").status_code == 200
 
 

@@ -128,10 +128,11 @@ def test_concurrent_updates_of_one_version_one_wins(store: CaseStore) -> None:
 
 
 def test_summary_files_stock_originals_under_their_folder_type(tmp_path: Path) -> None:
-    original = Path(__file__).resolve().parents[2] / "scenes/30_shadow/fence_shadow/00_original.json"
+    scenes = Path(__file__).resolve().parents[2] / "scenes"
+    original = scenes / "30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json"
     store = CaseStore(tmp_path / "data")
     record = store.create(Case.model_validate_json(original.read_text()), case_id="orig",
-                          origin="30_shadow/fence_shadow/00_original.json")
+                          origin="30_shadow/fence_shadow/00_uphill_rural_noon/00_original.json")
     summary = record.summary()
     assert (summary["type"], summary["category"], summary["severity"]) == ("fence_shadow", "shadow", 0)
 
@@ -140,7 +141,9 @@ def test_id_helpers() -> None:
     assert check_id("fence_shadow-03_level3") == "fence_shadow-03_level3"
     assert slugify("  Héllo, World ") == "h-llo-world"
     assert stock_id(PurePosixPath("00_clean/00_straight_urban.json")) == "clean-00_straight_urban"
-    assert stock_id(PurePosixPath("30_shadow/fence_shadow/03_level3.json")) == "fence_shadow-03_level3"
+    relative = PurePosixPath("30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
+    assert stock_id(relative) == "fence_shadow-00_uphill_rural_noon-03_level3"  # one folder per original
+    assert stock_id(PurePosixPath("30_shadow/fence_shadow/03_level3.json")) == "fence_shadow-03_level3"  # per type
 
 
 def test_a_new_store_removes_what_a_killed_write_left(tmp_path: Path) -> None:

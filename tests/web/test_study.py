@@ -55,12 +55,12 @@ def small_study(client: TestClient, **extra: Any) -> dict[str, Any]:
     """Two generated frames, two real uploads, a garbled gold item, a trap item and a training item."""
     spec = {"title": "Naturalness", **SIZE, "viewing_seconds": 0.5, "items": [
         {"case_id": "clean-00_straight_urban", "frame": 0},
-        {"case_id": "fence_shadow-03_level3", "frame": 0},
+        {"case_id": "fence_shadow-00_uphill_rural_noon-03_level3", "frame": 0},
         {"upload": "real_a.png"},
         {"upload": "real_b.jpg"},
         {"case_id": "clean-01_bend_suburban", "role": "gold", "garble": True, "expect": [1, 2]},
         {"upload": "real_a.png", "role": "trap", "answer": 2},
-        {"case_id": "fence_shadow-01_level1", "role": "training"},
+        {"case_id": "fence_shadow-00_uphill_rural_noon-01_level1", "role": "training"},
     ], **extra}
     response = create(client, spec, {"real_a.png": image_bytes(1), "real_b.jpg": image_bytes(2, "JPEG")})
     assert response.status_code == 201, response.text
@@ -104,8 +104,8 @@ def test_create_stores_every_image_once(client, state, settings) -> None:
 
 
 def test_large_study_renders_in_a_background_job(client, state) -> None:
-    spec = {"title": "Many frames", **SIZE, "generated": {"cases": ["clean-00_straight_urban",
-                                                                    "fence_shadow-05_level5", "clean-01_bend_suburban"],
+    cases = ["clean-00_straight_urban", "fence_shadow-00_uphill_rural_noon-05_level5", "clean-01_bend_suburban"]
+    spec = {"title": "Many frames", **SIZE, "generated": {"cases": cases,
                                                           "frames": [0, 10, 20]}}
     response = create(client, spec)
     assert response.status_code == 202, response.text
@@ -334,7 +334,7 @@ def test_open_studies_lists_ready_studies_for_everyone(client, state) -> None:
     ready = client.post("/api/study/studies", headers=ADMIN,
                         json={"title": "Open one", **SIZE, "generated": {"cases": ["clean-00_straight_urban"]}}).json()
     spec = {"title": "Still rendering", **SIZE, "generated": {"cases": ["clean-00_straight_urban",
-                                                                       "fence_shadow-05_level5"],
+                                                                       "fence_shadow-00_uphill_rural_noon-05_level5"],
                                                              "frames": [0, 10, 20, 30, 40]}}
     rendering = create(client, spec).json()
     assert rendering["status"] == "rendering"

@@ -16,6 +16,8 @@ from PIL import Image
 from app.study.db import connect, db_path
 from app.study.records import set_status, study_items
 
+FENCE = "fence_shadow-00_uphill_rural_noon"  # the fence shadow's representative original
+
 pytestmark = pytest.mark.browser
 
 ADMIN = {"Authorization": "Bearer test-admin"}
@@ -74,7 +76,7 @@ def test_organiser_creates_a_study_in_the_browser(page, live_server, screenshot_
     page.fill("#spec-height", "90")
     page.fill("#case-filter", "fence level3")
     assert page.locator("#case-list label:visible").count() == 1
-    page.check("#case-list input[value='fence_shadow-03_level3']")
+    page.check("#case-list input[value='fence_shadow-00_uphill_rural_noon-03_level3']")
     page.fill("#case-filter", "")
     page.check("#case-list input[value='clean-00_straight_urban']")
     page.fill("#spec-frames", "0, 10")
@@ -86,7 +88,7 @@ def test_organiser_creates_a_study_in_the_browser(page, live_server, screenshot_
     page.click("[data-add=gold]")
     page.click("[data-add=trap]")
     rows = page.locator("#qc-items tbody tr")
-    rows.nth(0).locator("[data-key=source]").select_option("case:fence_shadow-01_level1")
+    rows.nth(0).locator("[data-key=source]").select_option("case:fence_shadow-00_uphill_rural_noon-01_level1")
     rows.nth(0).locator("[data-key=garble]").uncheck()
     rows.nth(0).locator("[data-key=frame]").fill("500")  # beyond the case's frames: the server names the item
     rows.nth(1).locator("[data-key=source]").select_option("case:clean-01_bend_suburban")
@@ -116,9 +118,9 @@ def test_organiser_creates_a_study_in_the_browser(page, live_server, screenshot_
     finally:
         db.close()
     assert [(item.role, item.case_id or item.upload_name) for item in items] == [
-        ("training", "fence_shadow-01_level1"), ("gold", "clean-01_bend_suburban"), ("trap", "road_b.png"),
-        ("test", "clean-00_straight_urban"), ("test", "clean-00_straight_urban"), ("test", "fence_shadow-03_level3"),
-        ("test", "fence_shadow-03_level3"), ("test", "road_a.png")]
+        ("training", f"{FENCE}-01_level1"), ("gold", "clean-01_bend_suburban"), ("trap", "road_b.png"),
+        ("test", "clean-00_straight_urban"), ("test", "clean-00_straight_urban"), ("test", f"{FENCE}-03_level3"),
+        ("test", f"{FENCE}-03_level3"), ("test", "road_a.png")]
     assert (items[0].frame, items[1].garbled, items[1].gold_min, items[1].gold_max) == (5, 1, 1, 2)
     assert items[2].trap_answer == 4 and items[3].frame == 0 and items[4].frame == 10
     page.screenshot(path=str(screenshot_dir / "study_admin.png"), full_page=True)

@@ -19,6 +19,8 @@ from test_study import ADMIN, image_bytes  # same folder, imported by its base n
 
 from app.study.db import db_path
 
+FENCE = "fence_shadow-00_uphill_rural_noon"  # the fence shadow's representative original
+
 PARTICIPANTS = 100
 
 
@@ -66,7 +68,7 @@ def one_participant(url: str, study_id: str) -> list[int]:
 @pytest.mark.slow
 def test_concurrent_participants_store_every_rating_once(live_server) -> None:
     spec = {"title": "Load", "width": 160, "height": 90,
-            "items": [{"case_id": "clean-00_straight_urban"}, {"case_id": "fence_shadow-05_level5"},
+            "items": [{"case_id": "clean-00_straight_urban"}, {"case_id": f"{FENCE}-05_level5"},
                       {"upload": "a.png"}, {"upload": "b.jpg"}, {"upload": "a.png", "role": "trap", "answer": 2}]}
     study = create_live(live_server.url, spec, {"a.png": image_bytes(1), "b.jpg": image_bytes(2, "JPEG")})
     started = time.perf_counter()
@@ -89,8 +91,8 @@ def test_concurrent_participants_store_every_rating_once(live_server) -> None:
 @pytest.mark.slow
 def test_participant_completes_a_study_in_chromium(live_server, page, screenshot_dir) -> None:
     spec = {"title": "How natural do these road scenes look?", "width": 320, "height": 180, "viewing_seconds": 0.3,
-            "items": [{"case_id": "fence_shadow-01_level1", "role": "training"},
-                      {"case_id": "clean-00_straight_urban"}, {"case_id": "fence_shadow-05_level5", "frame": 30},
+            "items": [{"case_id": "fence_shadow-00_uphill_rural_noon-01_level1", "role": "training"},
+                      {"case_id": "clean-00_straight_urban"}, {"case_id": f"{FENCE}-05_level5", "frame": 30},
                       {"upload": "photo.png"}, {"upload": "photo.png", "role": "trap", "answer": 2}]}
     study = create_live(live_server.url, spec, {"photo.png": photo_bytes((320, 180))})
     roles = {item["id"]: item for item in study["items"]}

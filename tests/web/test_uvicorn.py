@@ -9,7 +9,7 @@ from concurrent.futures import ThreadPoolExecutor
 import httpx
 from PIL import Image
 
-SHADOW_ID = "fence_shadow-03_level3"
+SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 
 
 def test_crud_render_and_conflicts_over_http(live_server) -> None:
