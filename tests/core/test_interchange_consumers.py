@@ -21,10 +21,16 @@ from lanevil_core.interchange.openscenario import EGO_NAME, MODELS, category, pa
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "scenes"
 JUNCTIONS = ["00_clean/05_t_junction_urban.json", "00_clean/06_crossroad_suburban.json"]
+
+
+def _representative(type_folder: str, level: str) -> str:
+    """A level of the type's representative (first) original, relative to ``scenes/``."""
+    return min(SCENES.glob(f"{type_folder}/*/{level}.json")).relative_to(SCENES).as_posix()
+
+
 ROADSIDE = ["00_clean/05_t_junction_urban.json", "00_clean/07_straight_tunnel_approach.json",
-            "30_shadow/wire_shadow/05_level5.json"]
-TRAFFIC = ["20_traffic/vehicle/05_level5.json", "20_traffic/bicycle/05_level5.json",
-           "20_traffic/pedestrian/05_level5.json"]
+            _representative("30_shadow/wire_shadow", "05_level5")]
+TRAFFIC = [_representative(f"20_traffic/{kind}", "05_level5") for kind in ("vehicle", "bicycle", "pedestrian")]
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +169,7 @@ def test_objects_lie_on_their_road_and_off_the_carriageway(exports, name):
 
 
 def test_street_lamps_and_utility_poles_are_written_with_their_footing(exports):
-    for name in ("00_clean/05_t_junction_urban.json", "30_shadow/wire_shadow/05_level5.json"):
+    for name in ("00_clean/05_t_junction_urban.json", ROADSIDE[2]):
         root, _ = exports[name]
         poles = [obj for obj in root.iter("object") if obj.get("type") in ("pole", "streetLamp")]
         assert poles
