@@ -44,16 +44,20 @@ test-browser: $(STAMP)
 	scripts/install-chromium
 	$(PY) -m pytest -q -m browser || test $$? -eq 5
 
-# The shipped learned detectors (lanevil_core/detect/models/ufld and seg): render a diversified clean train split
-# (4,000 frames at 640x360), train both families at 320x180 and copy each model folder's files into place.
-# About 3 min of rendering and 13 min of training on 2 idle cores; MODELS_DATA keeps the renders for reruns.
+# The shipped learned detectors (lanevil_core/detect/models/<family>): render a diversified clean train split
+# (4,000 frames at 640x360), train every family at 320x180 and copy each model folder's files into place.
+# About 3 min of rendering and 13 min of training ufld and seg on 2 idle cores, then the four newer families
+# (docs/learning.md); MODELS_DATA keeps the renders for reruns.
 MODELS_DATA ?= out/models-data
+NEW_FAMILIES ?= laneatt bezier ganet scnn
 SHIPPED := lanevil_core/detect/models
 models: $(STAMP)
 	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA) --train-frames 4000 --size 640x360
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
-	for family in ufld seg; do mkdir -p $(SHIPPED)/$$family && \
+	for family in $(NEW_FAMILIES); do \
+	  $(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/$$family --model $$family --epochs 10; done
+	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
 
