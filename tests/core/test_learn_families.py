@@ -4,8 +4,6 @@ torch, and every family is a method of `lanevil detect`, the drive loop and the 
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -13,12 +11,14 @@ torch = pytest.importorskip("torch")
 
 from test_learn import TINY_SPEC, _train, tiny_dataset  # noqa: E402, F401 (the fixture is used by name)
 
+from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.bezier_curves import encode_curves  # noqa: E402
 from lanevil_core.detect.lane_keypoints import decode_keypoints, encode_keypoints, keypoint_map_size  # noqa: E402
 from lanevil_core.detect.lane_slots import assign_slots, encode_lane_mask, lane_lines  # noqa: E402
 from lanevil_core.detect.learned import LearnedDetector, decode_outputs, lanes_of  # noqa: E402
 from lanevil_core.detect.line_anchors import encode_anchors, line_anchors  # noqa: E402
 from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
+from lanevil_core.drive.detectors import drive_detector  # noqa: E402
 from lanevil_core.labels import TUSIMPLE_H_SAMPLES  # noqa: E402
 
 NEW_FAMILIES = ["laneatt", "bezier", "ganet", "scnn"]
@@ -123,4 +123,10 @@ def test_training_writes_a_model_whose_onnx_matches_torch(tiny_dataset, tmp_path
         assert want.shape == have.shape and np.max(np.abs(want - have)) < 1e-4
     lanes = detector((image[0].transpose(1, 2, 0) * 255).astype(np.uint8), list(range(20, 72, 4)))
     assert all(len(lane) == 13 for lane in lanes)
-    assert Path(tmp_path / "training.json").is_file()
+
+    pred = tmp_path / "pred.json"
+    assert main(["detect", str(tiny_dataset / "train"), "--method", family, "--weights", str(tmp_path),
+                 "--out", str(pred)]) == 0
+    assert len(pred.read_text().splitlines()) == 10
+    drive = drive_detector(family, tmp_path)
+    assert isinstance(drive(np.zeros((72, 128, 3), np.uint8), list(range(20, 72, 4)), []), list)
