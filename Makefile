@@ -56,7 +56,7 @@ models: $(STAMP)
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
 	for family in $(NEW_FAMILIES); do \
-	  $(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/$$family --model $$family --epochs 10; done
+	  $(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/$$family --model $$family --epochs 8; done
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
