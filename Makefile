@@ -55,8 +55,10 @@ models: $(STAMP)
 	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA) --train-frames 4000 --size 640x360
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
-	for family in $(NEW_FAMILIES); do \
-	  $(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/$$family --model $$family --epochs 8; done
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/scnn --model scnn --epochs 8
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt --model laneatt --epochs 8
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet --model ganet --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 6
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done

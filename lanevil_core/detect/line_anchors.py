@@ -28,7 +28,7 @@ POSITIVE_DISTANCE = 0.05  # normalised mean horizontal distance below which an a
 NEGATIVE_DISTANCE = 0.08  # ... above which it is background (between: ignored by the classifier)
 UNCOVERED_DISTANCE = 0.5  # distance counted at a lane row below the anchor's start
 NMS_DISTANCE = 0.03
-SCORE_THRESHOLD = 0.5
+SCORE_THRESHOLD = 0.2  # LaneATT's TuSimple setting (focal-loss scores stay low)
 IGNORE = -1
 
 
