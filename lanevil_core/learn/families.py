@@ -1,8 +1,9 @@
 """Four more detector families on the shared backbone, each with its published method's essentials.
 
 - ``LaneATTNet`` (LaneATT): line anchors from the left, right and bottom borders (``detect.line_anchors``);
-  features pooled along each anchor from a stride-16 map, attention over anchors (each anchor's features attend
-  to all others'), per anchor a lane score and ``2 + anchors`` regressions (bottom row, length, x offset per row).
+  features pooled along each anchor from the stride-8 map the auxiliary lane-mask head also classifies (so the
+  anchors read features trained to find paint), attention over anchors (each anchor's features attend to all
+  others'), per anchor a lane score and ``2 + anchors`` regressions (bottom row, length, x offset per row).
 - ``BezierNet`` (BezierLaneNet): a stride-16 map fused with its horizontally flipped self (feature flip fusion),
   pooled over rows; each column is a query slot giving an existence logit and 4 control points
   (``detect.bezier_curves``); Hungarian matching in ``losses``.
@@ -13,7 +14,8 @@
   downward, upward, rightward and leftward over the stride-8 feature map before the classifier.
 
 While training, ``laneatt``, ``bezier`` and ``ganet`` also carry ``ufld``'s auxiliary lane-mask head (a
-segmentation loss that helps from-scratch training and gives AAM its attention map); it is not exported.
+segmentation loss that helps from-scratch training and gives AAM its attention map); its classifier is not
+exported (``laneatt``'s anchors read its fused stride-8 features).
 """
 
 from __future__ import annotations
@@ -72,8 +74,8 @@ class LaneATTNet(_AuxNet):
 
     def __init__(self, spec: ModelSpec) -> None:
         super().__init__(spec)
-        self.features = StrideSixteen(self.backbone.channels, ANCHOR_CHANNELS)
-        height, width = _stage_sizes(self.backbone, spec.input_size, stage=1)
+        self.reduce = nn.Conv2d(self.aux.classify.in_channels, ANCHOR_CHANNELS, 1)
+        height, width = _stage_sizes(self.backbone, spec.input_size, stage=0)
         anchors = line_anchors()
         count = len(anchors)
         # Anchor feature pooling (LaneATT): per anchor and feature-map row, the cell the anchor line crosses.
@@ -98,11 +100,14 @@ class LaneATTNet(_AuxNet):
 
     def forward(self, image: torch.Tensor) -> dict[str, torch.Tensor]:
         c2, c3, c4 = self.stages(image)
-        features = self.anchor_features(self.features(c3, c4))
+        fused = self.aux.features(c2, c3, c4)
+        features = self.anchor_features(F.relu(self.reduce(fused)))
         weights = torch.softmax(self.attention(features) + self.self_mask, dim=-1)  # (N, A, A), none to itself
         joined = torch.cat([features, torch.bmm(weights, features)], dim=-1)
         out = {"anchor_logits": self.classify(joined)[..., 0], "anchor_regs": self.regress(joined)}
-        return self.with_aux(out, c2, c3, c4)
+        if self.training:
+            out["mask_logits"] = self.aux.logits(fused)
+        return out
 
     def deploy(self, out: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
         return torch.sigmoid(out["anchor_logits"]), out["anchor_regs"]

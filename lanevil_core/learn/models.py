@@ -59,14 +59,21 @@ class MaskHead(nn.Module):
         self.classify = nn.Conv2d(mid, classes, 1)
         self.out_size = out_size  # (width, height)
 
-    def forward(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+    def features(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+        """(N, mid, H/8, W/8): the stages merged at stride 8 and fused (what ``classify`` reads)."""
         size = c2.shape[-2:]
         x = self.lateral[0](c2)
         x = x + F.interpolate(self.lateral[1](c3), size=size, mode="bilinear", align_corners=False)
         x = x + F.interpolate(self.lateral[2](c4), size=size, mode="bilinear", align_corners=False)
-        logits = self.classify(self.fuse(x))
+        return self.fuse(x)
+
+    def logits(self, features: torch.Tensor) -> torch.Tensor:
+        """Class logits at ``out_size`` from ``features``."""
         width, height = self.out_size
-        return F.interpolate(logits, size=(height, width), mode="bilinear", align_corners=False)
+        return F.interpolate(self.classify(features), size=(height, width), mode="bilinear", align_corners=False)
+
+    def forward(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+        return self.logits(self.features(c2, c3, c4))
 
 
 def _stage_sizes(backbone: ResNet, input_size: tuple[int, int], stage: int = -1) -> tuple[int, int]:
