@@ -57,7 +57,7 @@ models: $(STAMP)
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg --model seg --epochs 10
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/scnn --model scnn --epochs 8
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt --model laneatt --epochs 6
-	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet --model ganet --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet --model ganet --epochs 10
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 6
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \

@@ -1,4 +1,4 @@
-"""Training losses of the two detector families.
+"""Training losses of the detector families.
 
 ``ufld`` (as in Ultra Fast Lane Detection): cross-entropy over the ``grid + 1`` classes of every (slot, anchor);
 a similarity loss (L1 between the cell distributions of adjacent anchors: lanes are continuous); a shape loss
@@ -7,8 +7,9 @@ auxiliary lane-mask cross-entropy. ``seg`` and ``scnn``: lane-mask cross-entropy
 SCNN) and binary cross-entropy of slot existence. ``laneatt``: focal loss of the anchor scores, smooth L1 of the
 positive anchors' x offsets, bottom row and length. ``bezier``: query slots matched to the lanes by the Hungarian
 method on sampled curve points (``scipy.optimize.linear_sum_assignment``), L1 of the matched curves' sampled points
-and existence cross-entropy (matched queries weighted as the unmatched together). ``ganet``: CenterNet's focal loss on the keypoint heatmap and L1 of the offsets at the
-keypoints. The last three add the auxiliary lane-mask cross-entropy.
+and existence cross-entropy (matched queries weighted as the unmatched together). ``ganet``: CenterNet's focal
+loss on the keypoint heatmap and L1 of the offsets at the keypoints. The last three add the auxiliary lane-mask
+cross-entropy.
 """
 
 from __future__ import annotations
