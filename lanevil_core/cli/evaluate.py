@@ -54,8 +54,12 @@ def _run_eval(args: argparse.Namespace) -> int:
 def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or "
                                                  "images; a dataset folder stands for its test split")
-    parser.add_argument("--method", choices=("ufld", "seg", "hough", "birdseye"), required=True,
-                        help="learned (ufld: row anchors, seg: segmentation; ONNX) or classical baseline")
+    from ..detect.split import METHODS
+
+    parser.add_argument("--method", choices=METHODS, required=True,
+                        help="learned (ufld: row anchors, seg: segmentation, laneatt: line anchors, bezier: "
+                             "Bézier curves, ganet: keypoints, scnn: message-passing segmentation; ONNX) or "
+                             "classical baseline")
     parser.add_argument("--weights", type=Path, default=None,
                         help="model folder of a learned method (default: the model shipped with lanevil)")
     parser.add_argument("--out", type=Path, required=True, help="predictions file (TuSimple JSON lines)")

@@ -1,4 +1,5 @@
-"""``lanevil train``: fit a learned lane detector (``ufld`` or ``seg``) on a dataset's clean train split."""
+"""``lanevil train``: fit a learned lane detector (one of ``detect.model_spec.FAMILIES``) on a dataset's clean
+train split."""
 
 from __future__ import annotations
 
@@ -15,7 +16,10 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data", type=Path, required=True,
                         help="dataset folder written by `lanevil dataset` (its train/ split and train_label.json)")
     parser.add_argument("--out", type=Path, required=True, help="model folder to write")
-    parser.add_argument("--model", choices=FAMILIES, default="ufld", help="detector family (default ufld)")
+    parser.add_argument("--model", choices=FAMILIES, default="ufld",
+                        help="detector family: ufld (row anchors), seg (segmentation), laneatt (line anchors + "
+                             "attention), bezier (Bézier curves), ganet (keypoints), scnn (message-passing "
+                             "segmentation) (default ufld)")
     parser.add_argument("--backbone", choices=BACKBONES, default="resnet18", help="default resnet18")
     parser.add_argument("--width", type=float, default=0.25,
                         help="backbone channel multiplier (1.0 = published ResNet widths; default 0.25)")
@@ -75,6 +79,7 @@ def _run_train(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Command] = {
-    "train": Command("train a learned lane detector (ufld or seg) on a dataset's clean train split",
+    "train": Command("train a learned lane detector (ufld, seg, laneatt, bezier, ganet or scnn) on a dataset's "
+                     "clean train split",
                      _train_arguments, _run_train),
 }

@@ -2,8 +2,13 @@
 
 A model folder (written by ``lanevil train``) holds ``config.json`` (a ``ModelSpec``), ``model.onnx`` and
 ``training.json``. The network takes ``(N, 3, H, W)`` float32 RGB in 0..1 at the spec's input size and returns
-probabilities: ``row_probs`` ``(N, slots, anchors, grid + 1)`` for ``ufld``, ``mask_probs`` ``(N, slots + 1, h, w)``
-and ``exist_probs`` ``(N, slots)`` for ``seg``. Decoding to TuSimple lanes is ``lane_slots``.
+probabilities and regressions under fixed names, decoded to lane lines by the family's decoder (``DECODERS``):
+
+- ``ufld``: ``row_probs`` ``(N, slots, anchors, grid + 1)`` (``lane_slots``, row anchors);
+- ``seg``, ``scnn``: ``mask_probs`` ``(N, slots + 1, h, w)``, ``exist_probs`` ``(N, slots)`` (``lane_slots``, masks);
+- ``laneatt``: ``anchor_scores`` ``(N, A)``, ``anchor_regs`` ``(N, A, 2 + anchors)`` (``line_anchors``);
+- ``bezier``: ``curve_exist`` ``(N, Q)``, ``curve_points`` ``(N, Q, 4, 2)`` (``bezier_curves``);
+- ``ganet``: ``heat_probs`` ``(N, 1, h, w)``, ``keypoint_offsets`` ``(N, 3, h, w)`` (``lane_keypoints``).
 
 The project ships one small model per family in ``lanevil_core/detect/models/<family>/``; ``--method ufld`` uses
 it when no ``--weights`` folder is given.
@@ -13,21 +18,24 @@ from __future__ import annotations
 
 import functools
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
 
 from ..typed import Float32Array, FloatArray, UInt8Array
+from .bezier_curves import decode_curves
+from .lane_keypoints import decode_keypoints
 from .lane_slots import LaneLine, anchor_reach, decode_lane_masks, decode_row_anchors, tusimple_lanes
+from .line_anchors import decode_anchors, line_anchors
 from .model_spec import FAMILIES, ONNX_FILE, ModelSpec, ModelSpecError
 
 SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 
 
 def shipped_model_dir(family: str) -> Path:
-    """The folder of the model shipped for ``family`` (``ufld`` or ``seg``)."""
+    """The folder of the model shipped for ``family`` (one of ``FAMILIES``)."""
     if family not in FAMILIES:
         raise ModelSpecError(f"no shipped model for {family!r} (choose from {', '.join(FAMILIES)})")
     return SHIPPED_MODELS / family
@@ -50,12 +58,40 @@ def providers() -> list[str]:
     return [p for p in ("CUDAExecutionProvider", "CPUExecutionProvider") if p in available]
 
 
-def decode_outputs(spec: ModelSpec, outputs: dict[str, FloatArray], index: int = 0) -> list[LaneLine | None]:
-    """The lane slots of image ``index`` of a batch of network outputs."""
-    if spec.family == "ufld":
-        return decode_row_anchors(outputs["row_probs"][index], spec.anchor_rows)
+Outputs = dict[str, FloatArray]  # one image's network outputs by name (the batch axis removed)
+Decoder = Callable[[ModelSpec, Outputs], list[LaneLine | None]]
+
+
+def _row_anchors(spec: ModelSpec, out: Outputs) -> list[LaneLine | None]:
+    return decode_row_anchors(out["row_probs"], spec.anchor_rows)
+
+
+def _lane_masks(spec: ModelSpec, out: Outputs) -> list[LaneLine | None]:
     rows = np.linspace(spec.anchor_rows[0], spec.anchor_rows[-1], 2 * spec.anchors)
-    return decode_lane_masks(outputs["mask_probs"][index], outputs["exist_probs"][index], rows)
+    return decode_lane_masks(out["mask_probs"], out["exist_probs"], rows)
+
+
+def _line_anchors(spec: ModelSpec, out: Outputs) -> list[LaneLine | None]:
+    width, height = spec.input_size
+    return decode_anchors(out["anchor_scores"], out["anchor_regs"], line_anchors(), spec.anchor_rows,
+                          width / height, spec.slots)
+
+
+def _curves(spec: ModelSpec, out: Outputs) -> list[LaneLine | None]:
+    return decode_curves(out["curve_exist"], out["curve_points"])
+
+
+def _keypoints(spec: ModelSpec, out: Outputs) -> list[LaneLine | None]:
+    return decode_keypoints(out["heat_probs"][0], out["keypoint_offsets"], spec.slots)
+
+
+DECODERS: dict[str, Decoder] = {"ufld": _row_anchors, "seg": _lane_masks, "scnn": _lane_masks,
+                                "laneatt": _line_anchors, "bezier": _curves, "ganet": _keypoints}
+
+
+def decode_outputs(spec: ModelSpec, outputs: dict[str, FloatArray], index: int = 0) -> list[LaneLine | None]:
+    """The lane lines of image ``index`` of a batch of network outputs (slots for ``ufld``/``seg``/``scnn``)."""
+    return DECODERS[spec.family](spec, {name: value[index] for name, value in outputs.items()})
 
 
 def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: Sequence[float],

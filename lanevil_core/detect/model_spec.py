@@ -14,9 +14,11 @@ from typing import Any, Literal
 from ..typed import FloatArray
 from .lane_slots import anchor_rows
 
-Family = Literal["ufld", "seg"]
+Family = Literal["ufld", "seg", "laneatt", "bezier", "ganet", "scnn"]
 Backbone = Literal["resnet18", "resnet34"]
-FAMILIES: tuple[Family, ...] = ("ufld", "seg")
+# The one list of learned detector families: training, `lanevil detect`, the drive loop, the web app and the
+# editor all take their choices from it (through ``detect.split.METHODS``).
+FAMILIES: tuple[Family, ...] = ("ufld", "seg", "laneatt", "bezier", "ganet", "scnn")
 BACKBONES: tuple[Backbone, ...] = ("resnet18", "resnet34")
 CONFIG_FILE = "config.json"
 ONNX_FILE = "model.onnx"
@@ -33,15 +35,18 @@ class ModelSpec:
     """A learned detector's architecture and output encoding.
 
     Attributes:
-        family: ``ufld`` (row-anchor classification) or ``seg`` (lane-slot segmentation + existence).
+        family: ``ufld`` (row-anchor classification), ``seg`` (lane-slot segmentation + existence), ``laneatt``
+            (line anchors with attention), ``bezier`` (Bézier curves, Hungarian matching), ``ganet`` (keypoints
+            grouped by their start points) or ``scnn`` (segmentation with slice-by-slice message passing).
         backbone: residual network depth, trained from scratch unless initialised from a file.
         width: channel multiplier of the backbone (1.0 = the published ResNet widths 64 ... 512).
         input_size: network input (width, height) in pixels; frames are resized to it.
         slots: lane slots, half left and half right of the camera (see ``lane_slots``).
-        anchors: row anchors (``ufld``), evenly over TuSimple rows 160 ... 710 of a 720-row frame.
+        anchors: row anchors (``ufld``; ``laneatt``'s offset rows), evenly over TuSimple rows 160 ... 710 of a
+            720-row frame.
         grid: column cells per row anchor (``ufld``); class ``grid`` means no lane.
         hidden: units of the row-anchor head's hidden layer (``ufld``).
-        mask_stride: output stride of the lane masks (``seg``, and the auxiliary head of ``ufld``).
+        mask_stride: output stride of the lane masks (``seg``, ``scnn``, and the auxiliary head of the others).
     """
 
     family: Family = "ufld"

@@ -15,13 +15,14 @@ from ..metrics.formats import LaneFileError, read_tusimple, split_folder, split_
 from ..typed import UInt8Array
 from .birdseye import detect_birdseye
 from .hough import detect_hough
+from .model_spec import FAMILIES
 
 Detector = Callable[[UInt8Array, list[int]], list[list[int]]]
 Progress = Callable[[int, int], None]
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 DETECTORS: dict[str, Detector] = {"hough": detect_hough, "birdseye": detect_birdseye}
-LEARNED_METHODS = ("ufld", "seg")
+LEARNED_METHODS: tuple[str, ...] = FAMILIES
 METHODS = (*LEARNED_METHODS, *DETECTORS)
 
 

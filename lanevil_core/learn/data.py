@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -24,8 +24,18 @@ import numpy as np
 import torch
 from torch.utils.data import Dataset
 
-from ..detect.lane_slots import assign_slots, encode_lane_mask, encode_row_anchors, lane_lines, mirror_slots
+from ..detect.bezier_curves import encode_curves
+from ..detect.lane_keypoints import encode_keypoints, keypoint_map_size
+from ..detect.lane_slots import (
+    LaneLine,
+    assign_slots,
+    encode_lane_mask,
+    encode_row_anchors,
+    lane_lines,
+    mirror_slots,
+)
 from ..detect.learned import network_input
+from ..detect.line_anchors import encode_anchors, line_anchors
 from ..detect.model_spec import ModelSpec
 from ..detect.split import read_rgb
 from ..metrics.formats import split_labels
@@ -35,12 +45,32 @@ from .augment import AUGMENT_PROBABILITY, Augment
 
 @dataclass(frozen=True)
 class Targets:
-    """What a network learns from one frame: row-anchor classes ``(slots, anchors)``, lane mask ``(h, w)`` and
-    slot existence ``(slots,)``."""
+    """What a network learns from one frame: row-anchor classes ``(slots, anchors)``, lane mask ``(h, w)``, slot
+    existence ``(slots,)`` and the family's own targets by batch key (``FAMILY_TARGETS``)."""
 
     rows: np.ndarray
     mask: np.ndarray
     exist: np.ndarray
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def _anchor_targets(placed: list[LaneLine | None], spec: ModelSpec) -> dict[str, np.ndarray]:
+    width, height = spec.input_size
+    targets = encode_anchors(placed, line_anchors(), spec.anchor_rows, width / height)
+    return {"anchor_labels": targets.labels, "anchor_regs": targets.regression, "anchor_rows": targets.row_mask}
+
+
+def _curve_targets(placed: list[LaneLine | None], spec: ModelSpec) -> dict[str, np.ndarray]:
+    control, valid = encode_curves(placed)
+    return {"curves": control, "curve_valid": valid}
+
+
+def _keypoint_targets(placed: list[LaneLine | None], spec: ModelSpec) -> dict[str, np.ndarray]:
+    heat, offsets = encode_keypoints(placed, keypoint_map_size(spec.input_size))
+    return {"heat": heat, "keypoint_offsets": offsets}
+
+
+FAMILY_TARGETS = {"laneatt": _anchor_targets, "bezier": _curve_targets, "ganet": _keypoint_targets}
 
 
 def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: ModelSpec, flip: bool) -> Targets:
@@ -48,9 +78,10 @@ def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: Model
     placed = assign_slots(lane_lines(record["lanes"], record["h_samples"], frame_size), spec.slots)
     if flip:
         placed = mirror_slots(placed)
+    extra = FAMILY_TARGETS[spec.family](placed, spec) if spec.family in FAMILY_TARGETS else {}
     return Targets(encode_row_anchors(placed, spec.anchor_rows, spec.grid),
                    encode_lane_mask(placed, spec.mask_size),
-                   np.array([line is not None for line in placed], np.float32))
+                   np.array([line is not None for line in placed], np.float32), extra)
 
 
 def resized(rgb: UInt8Array, input_size: tuple[int, int]) -> UInt8Array:
@@ -96,7 +127,8 @@ class _Frames(Dataset):
         targets = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip)
         return {"image": torch.from_numpy(network_input(image, self.spec.input_size)),
                 "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask),
-                "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index)}
+                "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index),
+                **{key: torch.from_numpy(value) for key, value in targets.extra.items()}}
 
 
 def read_records(label_file: Path) -> list[dict[str, Any]]:

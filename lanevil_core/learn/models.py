@@ -1,4 +1,5 @@
-"""The lane-detector networks: row-anchor classification (``ufld``) and lane-slot segmentation (``seg``).
+"""The lane-detector networks: row-anchor classification (``ufld``) and lane-slot segmentation (``seg``) here;
+``laneatt``, ``bezier``, ``ganet`` and ``scnn`` in ``learn.families``, all on the same backbone.
 
 Both take ``(N, 3, H, W)`` float RGB in 0..1 (normalised inside the network) at the spec's input size.
 
@@ -9,7 +10,8 @@ Both take ``(N, 3, H, W)`` float RGB in 0..1 (normalised inside the network) at 
   convolutions, logits of background + one channel per slot at stride ``mask_stride``; an existence head on the
   pooled last stage says which slots hold a lane.
 
-``Deployed`` wraps either for export: softmax probabilities under fixed output names (see ``detect.learned``).
+``Deployed`` wraps any of them for export: each network's ``OUTPUTS`` (probabilities and regressions under
+fixed names, see ``detect.learned``) from its ``deploy``.
 """
 
 from __future__ import annotations
@@ -57,27 +59,38 @@ class MaskHead(nn.Module):
         self.classify = nn.Conv2d(mid, classes, 1)
         self.out_size = out_size  # (width, height)
 
-    def forward(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+    def features(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+        """(N, mid, H/8, W/8): the stages merged at stride 8 and fused (what ``classify`` reads)."""
         size = c2.shape[-2:]
         x = self.lateral[0](c2)
         x = x + F.interpolate(self.lateral[1](c3), size=size, mode="bilinear", align_corners=False)
         x = x + F.interpolate(self.lateral[2](c4), size=size, mode="bilinear", align_corners=False)
-        logits = self.classify(self.fuse(x))
+        return self.fuse(x)
+
+    def logits(self, features: torch.Tensor) -> torch.Tensor:
+        """Class logits at ``out_size`` from ``features``."""
         width, height = self.out_size
-        return F.interpolate(logits, size=(height, width), mode="bilinear", align_corners=False)
+        return F.interpolate(self.classify(features), size=(height, width), mode="bilinear", align_corners=False)
+
+    def forward(self, c2: torch.Tensor, c3: torch.Tensor, c4: torch.Tensor) -> torch.Tensor:
+        return self.logits(self.features(c2, c3, c4))
 
 
-def _stage_sizes(backbone: ResNet, input_size: tuple[int, int]) -> tuple[int, int]:
-    """(height, width) of the last stage for an input of ``input_size`` (width, height)."""
+def _stage_sizes(backbone: ResNet, input_size: tuple[int, int], stage: int = -1) -> tuple[int, int]:
+    """(height, width) of a stage (default the last) for an input of ``input_size`` (width, height)."""
     with torch.no_grad():
         backbone.eval()
-        _, _, c4 = backbone(torch.zeros(1, 3, input_size[1], input_size[0]))
+        stages = backbone(torch.zeros(1, 3, input_size[1], input_size[0]))
         backbone.train()
-    return int(c4.shape[-2]), int(c4.shape[-1])
+    return int(stages[stage].shape[-2]), int(stages[stage].shape[-1])
 
 
-class _LaneNet(nn.Module):
-    """What both families share: their spec, input normalisation, the backbone and the lane-mask head's shape."""
+class LaneNet(nn.Module):
+    """What every family shares: its spec, input normalisation, the backbone and the lane-mask head's shape.
+
+    ``OUTPUTS`` names what ``deploy`` returns (the exported model's outputs, in order)."""
+
+    OUTPUTS: tuple[str, ...] = ()
 
     def __init__(self, spec: ModelSpec) -> None:
         super().__init__()
@@ -94,8 +107,14 @@ class _LaneNet(nn.Module):
         channels = self.backbone.channels
         return MaskHead(channels, max(16, channels[1]), self.spec.slots + 1, self.spec.mask_size)
 
+    def deploy(self, out: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
+        """The exported outputs ``OUTPUTS`` from the training outputs ``out``."""
+        raise NotImplementedError
 
-class UFLDNet(_LaneNet):
+
+class UFLDNet(LaneNet):
+    OUTPUTS = ("row_probs",)
+
     def __init__(self, spec: ModelSpec) -> None:
         super().__init__(spec)
         h, w = _stage_sizes(self.backbone, spec.input_size)
@@ -115,8 +134,13 @@ class UFLDNet(_LaneNet):
             out["mask_logits"] = self.aux(c2, c3, c4)
         return out
 
+    def deploy(self, out: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
+        return (torch.softmax(out["row_logits"], dim=-1),)
 
-class SegNet(_LaneNet):
+
+class SegNet(LaneNet):
+    OUTPUTS = ("mask_probs", "exist_probs")
+
     def __init__(self, spec: ModelSpec) -> None:
         super().__init__(spec)
         self.head = self.mask_head()
@@ -128,17 +152,20 @@ class SegNet(_LaneNet):
         pooled = torch.flatten(F.adaptive_avg_pool2d(c4, 1), 1)
         return {"mask_logits": self.head(c2, c3, c4), "exist_logits": self.exist(pooled)}
 
-
-LaneNet = UFLDNet | SegNet  # the lane-detector networks (each carries its ``spec``)
+    def deploy(self, out: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
+        return torch.softmax(out["mask_logits"], dim=1), torch.sigmoid(out["exist_logits"])
 
 
 def build_model(spec: ModelSpec) -> LaneNet:
     """The network of a spec, freshly initialised."""
-    return UFLDNet(spec) if spec.family == "ufld" else SegNet(spec)
+    from .families import FAMILY_NETS
+
+    nets: dict[str, type[LaneNet]] = {"ufld": UFLDNet, "seg": SegNet, **FAMILY_NETS}
+    return nets[spec.family](spec)
 
 
 class Deployed(nn.Module):
-    """A trained network in eval mode returning probabilities under the names ``detect.learned`` reads."""
+    """A trained network in eval mode returning its ``OUTPUTS`` under the names ``detect.learned`` reads."""
 
     def __init__(self, model: LaneNet) -> None:
         super().__init__()
@@ -146,13 +173,10 @@ class Deployed(nn.Module):
         self.family = model.spec.family
 
     def output_names(self) -> list[str]:
-        return ["row_probs"] if self.family == "ufld" else ["mask_probs", "exist_probs"]
+        return list(self.model.OUTPUTS)
 
     def forward(self, image: torch.Tensor) -> tuple[torch.Tensor, ...]:
-        out = self.model(image)
-        if self.family == "ufld":
-            return (torch.softmax(out["row_logits"], dim=-1),)
-        return torch.softmax(out["mask_logits"], dim=1), torch.sigmoid(out["exist_logits"])
+        return self.model.deploy(self.model(image))
 
 
 @contextmanager
