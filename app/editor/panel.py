@@ -143,7 +143,7 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         camera_sensor = gui.add_checkbox("Real sensor", False,
                                          hint="auto-exposure, filmic response, noise, motion blur, texture")
         camera_exposure = gui.add_slider("Exposure bias", -3.0, 3.0, 0.1, 0.0, hint="EV (real sensor)")
-        camera_noise = gui.add_slider("Sensor noise", 0.0, 5.0, 0.1, 1.0, hint="1 = a typical small sensor")
+        camera_noise = gui.add_slider("Sensor noise", 0.0, 4.0, 0.1, 1.0, hint="1 = a typical small sensor")
     with gui.add_folder("Export", expand_by_default=False):
         export_case = gui.add_button("Case JSON", icon=viser.Icon.FILE_DOWNLOAD)
         export_frame = gui.add_button("Current frame (PNG + labels)", icon=viser.Icon.PHOTO)
