@@ -350,7 +350,7 @@ class Editor:
                 if field in type(illusion).model_fields:
                     low, high = field_bounds(type(illusion), field)
                     spec[field] = float(np.clip(value, low, high))
-        self._edit(data, "sun " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+        self._edit(data, f"sun {_described(changes)}")
 
     def set_weather_preset(self, name: str) -> None:
         if name == CUSTOM_WEATHER:
@@ -378,14 +378,10 @@ class Editor:
 
     def set_camera(self, **changes: float) -> None:
         """Change camera fields (``fov``, ``z``, ``pitch``, ``roll`` ...)."""
-        data = self._data()
-        data["camera"].update(changes)
-        self._edit(data, "camera " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+        self._edit_camera(None, changes)
 
     def set_lens(self, **changes: float) -> None:
-        data = self._data()
-        data["camera"]["lens"].update(changes)
-        self._edit(data, "lens " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+        self._edit_camera("lens", changes)
 
     def set_camera_part(self, part: str, on: bool) -> None:
         """Put the ``bonnet`` or the ``sensor`` in (with its defaults) or take it out."""
@@ -397,11 +393,16 @@ class Editor:
         self._edit(data, f"{part} {'on' if on else 'off'}")
 
     def set_sensor(self, **changes: float) -> None:
+        self._edit_camera("sensor", changes)
+
+    def _edit_camera(self, part: str | None, changes: dict[str, float]) -> None:
+        """Update the camera's fields, or those of its ``part`` (``lens``, ``sensor``)."""
         data = self._data()
-        if data["camera"]["sensor"] is None:
-            raise EditError("sensor: tick Real sensor first")
-        data["camera"]["sensor"].update(changes)
-        self._edit(data, "sensor " + ", ".join(f"{k} {v:g}" for k, v in changes.items()))
+        fields = data["camera"] if part is None else data["camera"][part]
+        if fields is None:
+            raise EditError(f"{part}: tick Real sensor first")
+        fields.update(changes)
+        self._edit(data, f"{part or 'camera'} {_described(changes)}")
 
     # ------------------------------------------------------------------------------------------ view
 
@@ -672,3 +673,8 @@ def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080, ap
         server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
     bound.append(server.get_port())
     return Editor(state, server)
+
+
+def _described(changes: dict[str, float]) -> str:
+    """``name value, ...`` of an edit's changes, for its undo label."""
+    return ", ".join(f"{k} {v:g}" for k, v in changes.items())

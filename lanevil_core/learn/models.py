@@ -16,6 +16,7 @@ fixed names, see ``detect.learned``) from its ``deploy``.
 
 from __future__ import annotations
 
+import abc
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -85,7 +86,7 @@ def _stage_sizes(backbone: ResNet, input_size: tuple[int, int], stage: int = -1)
     return int(stages[stage].shape[-2]), int(stages[stage].shape[-1])
 
 
-class LaneNet(nn.Module):
+class LaneNet(nn.Module, abc.ABC):
     """What every family shares: its spec, input normalisation, the backbone and the lane-mask head's shape.
 
     ``OUTPUTS`` names what ``deploy`` returns (the exported model's outputs, in order)."""
@@ -107,9 +108,9 @@ class LaneNet(nn.Module):
         channels = self.backbone.channels
         return MaskHead(channels, max(16, channels[1]), self.spec.slots + 1, self.spec.mask_size)
 
+    @abc.abstractmethod
     def deploy(self, out: dict[str, torch.Tensor]) -> tuple[torch.Tensor, ...]:
-        """The exported outputs ``OUTPUTS`` from the training outputs ``out``."""
-        raise NotImplementedError
+        """The exported outputs ``OUTPUTS`` from the training outputs ``out``; every family defines them."""
 
 
 class UFLDNet(LaneNet):
