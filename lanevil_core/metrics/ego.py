@@ -11,6 +11,8 @@ A stricter, simpler question than TuSimple's accuracy, for a user's own labelled
   cover counts as a miss. Its **point accuracy** is that share for its best prediction.
 - An image scores its ego lines (0, 1 or 2 of them); a set of images scores the share of all ego lines matched
   and their mean point accuracy.
+- Everything is in the frame's own pixels: 20 px of a 960x540 frame are 20 of its pixels, not 20 px of the
+  1280x720 grid TuSimple's accuracy is scored on.
 """
 
 from __future__ import annotations

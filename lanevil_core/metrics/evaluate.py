@@ -69,18 +69,18 @@ def _on_grid(record: LaneRecord, gt: LaneRecord | None = None) -> LaneRecord:
                    h_samples=rows if record is gt else record.h_samples)
 
 
-def _grid_width(gt: LaneRecord) -> float:
-    """Width of the pixel frame ``_on_grid`` leaves ``gt`` in: 1280 unless it names a non-16:9 ``image_size``."""
+def _frame_width(gt: LaneRecord) -> float:
+    """Width of ``gt``'s own frame: its ``image_size`` when it names one, else 1280."""
     size = gt.extra.get(IMAGE_SIZE_FIELD)
-    return float(size[0]) if size and not _tusimple_shaped(size) else float(TUSIMPLE_SIZE[0])
+    return float(size[0]) if size else float(TUSIMPLE_SIZE[0])
 
 
 def score_ego_files(gt_path: Path, pred_path: Path) -> ego.EgoSummary:
-    """The ego line match over a TuSimple GT and prediction file (no ``run_time`` needed), on the 1280x720 grid
-    like ``score_tusimple_files``."""
+    """The ego line match over a TuSimple GT and prediction file (no ``run_time`` needed), in each frame's own
+    pixels: the 20 px are pixels of the labelled frame whatever its size (``image_size``, default 1280x720)."""
     pairs = pair_records(read_tusimple(gt_path, "gt"), read_tusimple(pred_path, "pred"), str(gt_path),
                          str(pred_path), require_run_time=False)
-    return ego.summarize_ego(ego.ego_line_match(_on_grid(g), _on_grid(p, g), _grid_width(g)) for g, p in pairs)
+    return ego.summarize_ego(ego.ego_line_match(g, p, _frame_width(g)) for g, p in pairs)
 
 
 def _interpolated(lanes: list[Points], where: str) -> list[Points]:

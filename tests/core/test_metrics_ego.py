@@ -96,12 +96,13 @@ def test_eval_metric_ego(tmp_path, capsys):
     assert "matched 2 (50.00 %)" in capsys.readouterr().out
 
 
-def test_eval_metric_ego_on_a_smaller_16_9_frame_uses_the_1280_grid(tmp_path):
+def test_eval_metric_ego_on_a_smaller_frame_is_scored_in_its_own_pixels(tmp_path):
     rows = [y / 2 for y in ROWS]
-    lanes = [[x / 2 for x in lane] for lane in GT.lanes]
+    lanes = [[x / 2 for x in lane] for lane in GT.lanes]  # ego pair at bottom x 250 and 400, centre 320
     gt_path, pred_path = tmp_path / "gt.json", tmp_path / "pred.json"
     gt_path.write_text(json.dumps({"raw_file": "0.jpg", "h_samples": rows, "lanes": lanes,
                                    "image_size": [640, 360]}) + "\n")
-    # 12 px at 640x360 is 24 px on the 1280x720 grid: beyond the 20 px tolerance
-    pred_path.write_text(json.dumps({"raw_file": "0.jpg", "lanes": [[x + 12 for x in lane] for lane in lanes]}) + "\n")
-    assert evaluate(gt_path, pred_path, "ego")["matched"] == 0
+    for shift, matched in ((12, 2), (20, 2), (21, 0)):  # 20 of the frame's own pixels, not of the 1280 grid
+        pred_path.write_text(json.dumps({"raw_file": "0.jpg", "lanes": [[x + shift for x in lane] for lane in lanes]})
+                             + "\n")
+        assert evaluate(gt_path, pred_path, "ego")["matched"] == matched
