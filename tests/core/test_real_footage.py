@@ -11,6 +11,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from lanevil_core.labels import h_samples_for
@@ -100,3 +101,26 @@ def test_the_committed_labels_have_an_ego_pair_in_every_frame(real_footage):
         record = LaneRecord(real_footage.raw_file(frame["source"]), frame["lanes"], frame["h_samples"], None, 1, {})
         assert ego_lanes(record, width) == {"left": 0, "right": 1}, frame["source"]
         assert all(-2 == x or 0 <= x < width for lane in frame["lanes"] for x in lane)
+
+
+def test_the_label_fit_finds_two_painted_lines_on_a_synthetic_road():
+    """``bench/real_labels_fit.py`` on a grey road with a yellow left line and a dashed white right line."""
+    sys.path.insert(0, str(BENCH))
+    try:
+        import real_labels_fit as fit
+    finally:
+        sys.path.remove(str(BENCH))
+    camera = fit.Camera((640, 400), 700, 420)
+    bgr = np.full((720, 1280, 3), 90, np.uint8)
+    left, right = (lambda y: 640 - 1.6 * (y - 400)), (lambda y: 640 + 1.5 * (y - 400))
+    for y in range(410, 720):
+        width = max(1, round((y - 400) / 25))
+        bgr[y, round(left(y)) - width:round(left(y)) + width + 1] = (0, 200, 230)  # yellow (BGR)
+        if (y // 40) % 2 == 0:  # dashes
+            bgr[y, round(right(y)) - width:round(right(y)) + width + 1] = (235, 235, 235)
+    rows, lanes = fit.fit_frame(bgr, camera, {})
+    assert rows == h_samples_for(720)
+    for lane, line in zip(lanes, (left, right), strict=True):
+        labelled = [(x, y) for x, y in zip(lane, rows, strict=True) if x >= 0]
+        assert len(labelled) >= 20 and labelled[-1][1] == 700  # down to the bottom road row
+        assert max(abs(x - line(y)) for x, y in labelled) <= 3
