@@ -21,17 +21,17 @@ from typing import Any, Generic, Literal, TypeVar
 import numpy as np
 from pydantic.fields import FieldInfo
 
-from lanevil_core.benchmark_layout import frame_file
 from lanevil_core.case import Case, case_json
-from lanevil_core.compile import compile_scene, roadside_key
-from lanevil_core.detector_catalog import available_detector
-from lanevil_core.encode import jpeg_bytes, png_bytes
-from lanevil_core.frame_detection import FrameDetection, detect_frame
+from lanevil_core.detect.catalog import available_detector
+from lanevil_core.detect.frame_detection import FrameDetection, detect_frame
+from lanevil_core.export.encode import jpeg_bytes, png_bytes
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.labels import CULANE_SIZE, culane_lines, tusimple_record
-from lanevil_core.overlay import draw_detections, draw_lanes
+from lanevil_core.labels.lanes import CULANE_SIZE, culane_lines, tusimple_record
+from lanevil_core.labels.overlay import draw_detections, draw_lanes
+from lanevil_core.library.benchmark_layout import frame_file
+from lanevil_core.pipeline.compile import compile_scene, roadside_key
 from lanevil_core.render import all_cores, render_frame
-from lanevil_core.scene import CompiledScene
+from lanevil_core.world.scene import CompiledScene
 
 ImageFormat = Literal["png", "jpg"]
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}

@@ -28,7 +28,7 @@ from typing import Any, Literal
 
 from lanevil_core.case import Case
 from lanevil_core.drive.loop import DriveSettings
-from lanevil_core.export import export_case
+from lanevil_core.export.case import export_case
 
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled"]
 Progress = Callable[[int, int], None]

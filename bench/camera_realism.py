@@ -20,9 +20,9 @@ import numpy as np
 from PIL import Image
 
 from lanevil_core.case import load_case
-from lanevil_core.compile import compile_scene
+from lanevil_core.metrics.realism import frame_statistics, summary
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.presets import CAMERA_PRESET_NAMES, camera_preset_values
-from lanevil_core.realism import frame_statistics, summary
 from lanevil_core.render import render_frame
 
 ROOT = Path(__file__).resolve().parents[1]

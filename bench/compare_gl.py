@@ -37,18 +37,18 @@ from typing import Any
 
 import numpy as np
 
-from lanevil_core.bench import BENCH_SIZES, frames_to_time
 from lanevil_core.camera import PinholeCamera
 from lanevil_core.case import load_case
-from lanevil_core.compile import compile_scene
-from lanevil_core.encode import png_bytes
+from lanevil_core.export.encode import png_bytes
+from lanevil_core.pipeline.bench import BENCH_SIZES, frames_to_time
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 from lanevil_core.render.lighting import SKY_SCALE, SUN_SCALE
 from lanevil_core.render.packed import PackedScene, pack_scene
 from lanevil_core.render.post import WHITE_POINT
 from lanevil_core.render.shadow_map import CASCADE_FAR_M, GROUND_BAND_M, light_rotation
-from lanevil_core.scene import ID_SKY, CompiledScene
 from lanevil_core.typed import Float32Array, FloatArray, UInt8Array
+from lanevil_core.world.scene import ID_SKY, CompiledScene
 
 ROOT = Path(__file__).resolve().parents[1]
 # a low sun, long fence shadows

@@ -20,7 +20,7 @@ import numpy as np
 
 from lanevil_core.detect.learned import LearnedDetector, shipped_model_dir
 from lanevil_core.detect.model_spec import ModelSpec
-from lanevil_core.labels import TUSIMPLE_H_SAMPLES
+from lanevil_core.labels.lanes import TUSIMPLE_H_SAMPLES
 
 
 def train_seconds_per_epoch(family: str, size: tuple[int, int], steps: int, epoch_frames: int,

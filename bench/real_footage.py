@@ -237,8 +237,8 @@ def clip_shares(split_dir: Path, pred: Path) -> dict[str, float]:
 
 def command_realism(args: argparse.Namespace) -> None:
     """Mean ± std of every ``lanevil realism`` statistic: one column per real split and per folder of renders."""
-    from lanevil_core.realism import STATISTICS, folder_statistics, summary
-    from lanevil_core.realism_report import LABELS
+    from lanevil_core.metrics.realism import STATISTICS, folder_statistics, summary
+    from lanevil_core.report.realism import LABELS
 
     folders = {f"real {split}": args.cache / split for split in SPLITS}
     folders.update({f"ours {path.name}": path for path in args.ours})

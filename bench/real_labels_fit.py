@@ -29,7 +29,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from lanevil_core.labels import h_samples_for
+from lanevil_core.labels.lanes import h_samples_for
 
 ROOT = Path(__file__).resolve().parents[1]
 NO_POINT = -2

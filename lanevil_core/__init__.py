@@ -17,16 +17,16 @@ from .case import (
     parse_case,
     save_case,
 )
-from .compile import compile_scene
-from .encode import jpeg_bytes, png_bytes
-from .export import export_case
+from .export.case import export_case
+from .export.encode import jpeg_bytes, png_bytes
 from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
-from .labels import culane_lines, tusimple_record
-from .overlay import draw_lanes
-from .paint import RoadPaint
+from .labels.lanes import culane_lines, tusimple_record
+from .labels.overlay import draw_lanes
+from .pipeline.compile import compile_scene
 from .render import Frame, render_frame, render_view
-from .road_layout import RoadNetwork, build_network
-from .scene import CompiledScene
+from .world.paint import RoadPaint
+from .world.road_layout import RoadNetwork, build_network
+from .world.scene import CompiledScene
 
 __all__ = [
     "CATEGORIES",

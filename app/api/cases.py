@@ -20,8 +20,8 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field, ValidationError
 
 from lanevil_core.case import Case
-from lanevil_core.compile import check_mesh_files
 from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
+from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..state import AppState
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id

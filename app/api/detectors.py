@@ -2,7 +2,7 @@
 
 A detection runs a detector (``lanevil_core.detect``: learned ONNX models or classical OpenCV baselines) on the
 rendered frame and scores it against the frame's ground truth with the official TuSimple metric
-(``lanevil_core.frame_detection``); the frame service caches it next to the frame. Unknown or unavailable
+(``lanevil_core.detect.frame_detection``); the frame service caches it next to the frame. Unknown or unavailable
 detectors are a 422 naming ``detector``.
 """
 
@@ -15,8 +15,8 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Query
 from pydantic import BaseModel, Field
 
+from lanevil_core.detect.catalog import available_detector, detector_infos
 from lanevil_core.detect.split import METHODS
-from lanevil_core.detector_catalog import available_detector, detector_infos
 from lanevil_core.metrics.formats import LaneFileError
 
 from .deps import RecordDep, StateDep

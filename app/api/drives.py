@@ -15,10 +15,10 @@ from fastapi import APIRouter, Request
 from fastapi.responses import FileResponse, JSONResponse
 from pydantic import BaseModel, Field
 
-from lanevil_core.compile import check_mesh_files
 from lanevil_core.drive.detectors import DRIVE_DETECTORS, GROUND_TRUTH
 from lanevil_core.drive.loop import DriveSettings
 from lanevil_core.drive.outputs import PATH_PLOT_FILE, SUMMARY_FILE, TRACE_FILE, TRACE_PLOT_FILE
+from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..frames import case_hash
 from ..jobs import Job, drive_job

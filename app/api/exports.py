@@ -19,8 +19,8 @@ from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import FileResponse, JSONResponse
 from pydantic import BaseModel, ConfigDict, Field
 
-from lanevil_core.benchmark_layout import case_folder
-from lanevil_core.compile import check_mesh_files
+from lanevil_core.library.benchmark_layout import case_folder
+from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..frames import case_hash
 from ..jobs import Job, JobStatus, export_zip

@@ -13,7 +13,7 @@ from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Query, Response
 
-from lanevil_core.labels import CULANE_SIZE, TUSIMPLE_SIZE
+from lanevil_core.labels.lanes import CULANE_SIZE, TUSIMPLE_SIZE
 
 from .deps import RecordDep, StateDep
 from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody

@@ -7,8 +7,8 @@ being placed fools the detector. Lanes and scores come from the frame service (`
 
 from __future__ import annotations
 
+from lanevil_core.detect.frame_detection import FrameDetection
 from lanevil_core.detect.split import METHODS
-from lanevil_core.frame_detection import FrameDetection
 
 from .text import escape_markdown
 

@@ -20,12 +20,12 @@ import viser
 
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Bonnet, Case, CaseError, Sensor, parse_case
-from lanevil_core.compile import check_mesh_files, roadside_key
 from lanevil_core.illusions import REGISTRY, Illusion, MeshFileError
 from lanevil_core.metrics.formats import LaneFileError
+from lanevil_core.pipeline.compile import check_mesh_files, roadside_key
 from lanevil_core.presets import camera_preset_values, preset_values
-from lanevil_core.road_layout import RoadNetwork
-from lanevil_core.scene import CompiledScene
+from lanevil_core.world.road_layout import RoadNetwork
+from lanevil_core.world.scene import CompiledScene
 
 from ..meshes import MeshUploadError, store_mesh
 from ..state import AppState

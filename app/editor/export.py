@@ -11,9 +11,9 @@ import threading
 from collections.abc import Callable
 from pathlib import PurePosixPath
 
-from lanevil_core.benchmark_layout import case_folder, frame_file
 from lanevil_core.case import Case, case_json
-from lanevil_core.encode import png_bytes
+from lanevil_core.export.encode import png_bytes
+from lanevil_core.library.benchmark_layout import case_folder, frame_file
 
 from ..jobs import Job, export_zip
 from ..state import AppState

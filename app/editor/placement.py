@@ -1,7 +1,7 @@
 """Where a click lands on the road, in road coordinates, and what that means for an illusion's fields.
 
 Pure functions over numpy arrays. A click in the 3D view arrives as a ray in the world frame (+Z up); it is
-intersected with the swept road surface (``lanevil_core.road_mesh.road_surface``) and the hit is expressed in the
+intersected with the swept road surface (``lanevil_core.world.road_mesh.road_surface``) and the hit is expressed in the
 main road's frame: ``s_road`` along the reference line, ``t_road`` to its left (both metres). An illusion stores its
 position as ``s`` (every type) and, where the type has them, ``side`` (left/right of the road) and ``offset``
 (lateral distance beyond the paved edge).
@@ -17,10 +17,10 @@ import numpy as np
 from lanevil_core.case import Case
 from lanevil_core.illusions import Illusion
 from lanevil_core.illusions.shadow import roadside_t
-from lanevil_core.road_geometry import ReferenceLine
-from lanevil_core.road_layout import RoadNetwork
-from lanevil_core.road_mesh import RoadSurface
 from lanevil_core.typed import FloatArray
+from lanevil_core.world.road_geometry import ReferenceLine
+from lanevil_core.world.road_layout import RoadNetwork
+from lanevil_core.world.road_mesh import RoadSurface
 
 EDGE_EPS = 1e-9  # barycentric slack, so a ray through an edge between two faces hits one of them
 RAY_EPS = 1e-9

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lanevil_core.case import Case
-from lanevil_core.scene import CompiledScene
+from lanevil_core.world.scene import CompiledScene
 
 PREVIEW_SIZE = (640, 360)
 

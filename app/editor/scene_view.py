@@ -25,12 +25,12 @@ from PIL import Image
 
 from lanevil_core.camera import PinholeCamera, ego_camera
 from lanevil_core.case import Case
-from lanevil_core.paint import MATERIAL_ALBEDO, paint_mesh
-from lanevil_core.primitives import flat_trimesh
-from lanevil_core.road_layout import RoadNetwork
-from lanevil_core.road_mesh import RoadSurface, road_surface
-from lanevil_core.scene import CompiledScene, Mesh, SurfaceLayer
 from lanevil_core.typed import Float32Array, FloatArray, IntArray
+from lanevil_core.world.paint import MATERIAL_ALBEDO, paint_mesh
+from lanevil_core.world.primitives import flat_trimesh
+from lanevil_core.world.road_layout import RoadNetwork
+from lanevil_core.world.road_mesh import RoadSurface, road_surface
+from lanevil_core.world.scene import CompiledScene, Mesh, SurfaceLayer
 
 DECAL_LIFT_M = 0.02  # decals float this far above the asphalt (paint sits at 0.01 m)
 DECAL_STEP_S_M = 1.0

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from lanevil_core.case import Case, write_atomic
-from lanevil_core.encode import png_bytes
+from lanevil_core.export.encode import png_bytes
 
 from ..frames import FrameService
 from ..jobs import Job, JobManager

@@ -13,9 +13,9 @@ from functools import lru_cache
 import numpy as np
 
 from ..case import Camera, Case
-from ..road_geometry import ReferenceLine
-from ..road_layout import RoadNetwork
 from ..typed import FloatArray
+from ..world.road_geometry import ReferenceLine
+from ..world.road_layout import RoadNetwork
 from .lens import NO_DISTORTION, Distortion, distort, is_pinhole, undistort, valid_radius2
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..case import Case
 from ..files import remove_stale_temps
-from ..frame_range import parse_frame_range
+from .frame_range import parse_frame_range
 
 PROG = "lanevil"
 SCENES_DIR = Path("scenes")
@@ -84,7 +84,7 @@ def parse_size(text: str) -> tuple[int, int]:
 
 def parse_formats(text: str) -> frozenset[str]:
     """Comma-separated export formats."""
-    from ..export import FORMATS
+    from ..export.case import FORMATS
 
     formats = frozenset(part.strip() for part in text.split(",") if part.strip())
     unknown = sorted(formats - set(FORMATS))
@@ -124,7 +124,7 @@ def image_path(path: Path, flag: str = "--out") -> Path:
 
 def encode_image(rgb: np.ndarray, path: Path) -> bytes:
     """(H, W, 3) uint8 pixels encoded as ``path``'s suffix says (PNG or JPEG)."""
-    from ..encode import jpeg_bytes, png_bytes
+    from ..export.encode import jpeg_bytes, png_bytes
 
     return png_bytes(rgb) if IMAGE_FORMATS[path.suffix.lower()] == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
 

@@ -40,9 +40,9 @@ def render_image(case: Case, frame_index: int, size: tuple[int, int] | None, ove
                  meshes_dir: Path | None = None) -> tuple[np.ndarray, dict]:
     """Render one frame; return the (H, W, 3) uint8 image (lanes drawn when ``overlay``) and its TuSimple record.
     A vehicle's ``mesh_file`` is read from ``meshes_dir``."""
-    from ..compile import compile_scene
-    from ..labels import tusimple_record
-    from ..overlay import draw_lanes
+    from ..labels.lanes import tusimple_record
+    from ..labels.overlay import draw_lanes
+    from ..pipeline.compile import compile_scene
     from ..render import render_frame
 
     scene = compile_scene(case, meshes_dir=meshes_dir)
@@ -91,7 +91,7 @@ def _run_interchange(case: Case, args: argparse.Namespace) -> None:
 
 
 def _run_export(args: argparse.Namespace) -> int:
-    from ..export import export_case
+    from ..export.case import export_case
 
     if args.out.exists() and not args.out.is_dir():
         raise UsageError(f"--out {args.out}: is a file; give a folder to export into")
@@ -130,8 +130,8 @@ def preview_path(case_path: Path, out_dir: Path, root: Path = SCENES_DIR) -> Pat
 
 
 def _run_preview(args: argparse.Namespace) -> int:
-    from ..encode import png_bytes
-    from ..overlay import draw_lanes
+    from ..export.encode import png_bytes
+    from ..labels.overlay import draw_lanes
 
     paths = args.cases or stock_scenes()
     if not paths:
@@ -162,7 +162,7 @@ def _bench_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_bench(args: argparse.Namespace) -> int:
-    from ..bench import bench_cases, format_rows, format_table, illusion_benchmark, run_benchmark
+    from ..pipeline.bench import bench_cases, format_rows, format_table, illusion_benchmark, run_benchmark
 
     if args.frames_per_case < 1:
         raise UsageError("--frames-per-case must be at least 1")

@@ -103,8 +103,8 @@ def _report_arguments(parser: argparse.ArgumentParser) -> None:
 def _run_report(args: argparse.Namespace) -> int:
     from ..metrics.evaluate import score_tusimple_files
     from ..metrics.formats import split_labels
-    from ..report import build_report, write_report
-    from ..report_compare import SEED_MARK, Detector, defence_and_seed, write_comparison
+    from ..report.compare import SEED_MARK, Detector, defence_and_seed, write_comparison
+    from ..report.robustness import build_report, write_report
 
     names = args.name or [path.stem for path in args.pred]
     if len(names) != len(args.pred):

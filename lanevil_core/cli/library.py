@@ -71,8 +71,8 @@ def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run_sheet(args: argparse.Namespace) -> int:
     from ..dataset.progress import progress_bar
-    from ..encode import png_bytes
-    from ..sheet import contact_sheet, sheet_frames
+    from ..export.encode import png_bytes
+    from ..report.sheet import contact_sheet, sheet_frames
 
     types = None
     if args.types:
@@ -94,7 +94,7 @@ def _library_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_library(args: argparse.Namespace) -> int:
-    from ..stock import write_library
+    from ..library.stock import write_library
 
     written = write_library(args.out)
     print(f"{len(written)} cases in {args.out}")

@@ -22,8 +22,8 @@ def _realism_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_realism(args: argparse.Namespace) -> int:
-    from ..realism import ANALYSIS_WIDTH, RealismError, folder_statistics, summary, summary_dict
-    from ..realism_report import comparison_rows, report_markdown, table_text
+    from ..metrics.realism import ANALYSIS_WIDTH, RealismError, folder_statistics, summary, summary_dict
+    from ..report.realism import comparison_rows, report_markdown, table_text
 
     folders = {side: path for side, path in (("real", args.real), ("ours", args.ours)) if path is not None}
     if not folders:

@@ -20,7 +20,7 @@ import numba
 import numpy as np
 import PIL
 
-from ..benchmark_layout import frame_file
+from ..library.benchmark_layout import frame_file
 from .plan import SPLIT_LABELS, DatasetPlan, PlannedCase
 
 MANIFEST_FILE = "manifest.json"

@@ -26,7 +26,10 @@ from typing import Any
 
 import numpy as np
 
-from ..benchmark_layout import (
+from ..camera.variation import random_camera
+from ..case import Case, case_json, load_case, parse_case
+from ..illusions import REGISTRY
+from ..library.benchmark_layout import (
     CATEGORY_FOLDERS,
     TYPE_FOLDERS,
     case_folder,
@@ -35,9 +38,6 @@ from ..benchmark_layout import (
     folder_type,
     frame_file,
 )
-from ..camera.variation import random_camera
-from ..case import Case, case_json, load_case, parse_case
-from ..illusions import REGISTRY
 from ..presets import PRESET_NAMES, camera_preset_values, preset_values
 from ..typed import LineType
 
@@ -229,7 +229,7 @@ def threads_map(fn: Callable[[Any], Any], items: list[Any]) -> Iterable[Any]:
 
 
 def _in_view(job: tuple[Case, int]) -> tuple[int, ...]:
-    from ..illusion_effect import in_view_frames
+    from ..pipeline.illusion_effect import in_view_frames
 
     return in_view_frames(*job)
 

@@ -16,14 +16,14 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
-from ..benchmark_layout import frame_file
 from ..case import case_json, parse_case
-from ..compile import compile_scene, roadside_key
-from ..encode import jpeg_bytes, png_bytes
-from ..labels import tusimple_record
+from ..export.encode import jpeg_bytes, png_bytes
+from ..labels.lanes import tusimple_record
+from ..library.benchmark_layout import frame_file
+from ..pipeline.compile import compile_scene, roadside_key
 from ..render import render_frame
-from ..scene import CompiledScene
 from ..typed import BoolArray, UInt8Array
+from ..world.scene import CompiledScene
 from .plan import FORMATS, RenderTask
 
 JPEG_QUALITY = 95
@@ -94,7 +94,7 @@ _CLEAN_VIEWS: OrderedDict[tuple[str, int, tuple[int, int]], tuple[UInt8Array, Bo
 
 def _cached_clean_view(case_sha256: str, scene: CompiledScene, frame_index: int,
                        size: tuple[int, int]) -> tuple[UInt8Array, BoolArray]:
-    from ..illusion_effect import clean_view
+    from ..pipeline.illusion_effect import clean_view
 
     key = (case_sha256, frame_index, size)
     with _SCENES_LOCK:
@@ -113,7 +113,7 @@ def _cached_clean_view(case_sha256: str, scene: CompiledScene, frame_index: int,
 def illusion_changes(task: RenderTask, scene: CompiledScene) -> dict[int, dict[str, float]]:
     """Per frame of a case with an illusion (compiled: ``scene``): the share of the lane band it changes and its
     effect there (``illusion_effect``, measured on small renders against the case without its illusions)."""
-    from ..illusion_effect import SHARE_SIZE, clean_of, scene_changes
+    from ..pipeline.illusion_effect import SHARE_SIZE, clean_of, scene_changes
 
     case = parse_case(task.case_text)
     if not case.illusions:

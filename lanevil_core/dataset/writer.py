@@ -21,8 +21,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from ..benchmark_layout import LABELS_FILE, frame_file
 from ..case import write_atomic
+from ..library.benchmark_layout import LABELS_FILE, frame_file
 from .manifest import MANIFEST_FILE, manifest_bytes
 from .plan import SPLIT_LABELS, PlannedCase
 from .worker import FrameResult

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..labels import MAX_LANES, RANGE_M
+from ..labels.lanes import MAX_LANES, RANGE_M
 from ..typed import BoolArray, FloatArray, IndexArray, UInt8Array
 from .common import GroundCamera, lane_columns, sample_rows, useful_lanes
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..camera import Intrinsics, intrinsics_for
 from ..case import Camera
-from ..labels import NO_POINT
+from ..labels.lanes import NO_POINT
 from ..typed import FloatArray
 
 

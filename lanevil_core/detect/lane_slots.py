@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..labels import NO_POINT, TUSIMPLE_H_SAMPLES, TUSIMPLE_SIZE
+from ..labels.lanes import NO_POINT, TUSIMPLE_H_SAMPLES, TUSIMPLE_SIZE
 from ..typed import FloatArray, Int64Array
 
 BOTTOM_FIT_POINTS = 8  # lowest points of a lane fitted to find where it meets the image bottom

@@ -10,7 +10,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..labels import h_samples_for
+from ..labels.lanes import h_samples_for
 from ..metrics.formats import LaneFileError, read_tusimple, split_folder, split_labels
 from ..typed import UInt8Array
 from .birdseye import detect_birdseye

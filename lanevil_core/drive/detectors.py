@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ..detect.split import METHODS, detector_for
-from ..labels import on_tusimple_grid
+from ..labels.lanes import on_tusimple_grid
 from ..metrics.tusimple import score_image
 from ..typed import UInt8Array
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scene import CompiledScene
 from ..typed import FloatArray
+from ..world.scene import CompiledScene
 
 VIEW_RANGE_M = 50.0
 VERTICES_PER_MESH = 64  # vertices sampled per mesh for its stations

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..camera import PinholeCamera
-from ..labels import NO_POINT
+from ..labels.lanes import NO_POINT
 from ..typed import FloatArray
 
 FIT_RANGE_M = (3.0, 30.0)  # lane points used, metres ahead of the vehicle origin

@@ -16,11 +16,11 @@ import numpy as np
 
 from ..camera import mounted_camera, pose_camera
 from ..case import Case
-from ..compile import compile_scene
-from ..labels import h_samples_for, tusimple_record
+from ..labels.lanes import h_samples_for, tusimple_record
+from ..pipeline.compile import compile_scene
 from ..render import render_view
-from ..scene import CompiledScene
 from ..typed import FloatArray, UInt8Array
+from ..world.scene import CompiledScene
 from .controllers import ControllerName, controller_for
 from .detectors import GROUND_TRUTH, drive_detector, frame_accuracy
 from .illusion_view import illusion_span

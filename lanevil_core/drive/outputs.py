@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..case import Case, write_atomic
-from ..compile import compile_scene
+from ..pipeline.compile import compile_scene
 from .loop import DriveSettings, DriveTrace, Progress, drive_case
 from .plots import path_plot, plots_available, trace_plot
 from .summary import DriveSummary, summarize

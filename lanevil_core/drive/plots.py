@@ -9,7 +9,7 @@ import importlib.util
 
 import numpy as np
 
-from ..encode import figure_png
+from ..export.encode import figure_png
 from .illusion_view import VIEW_RANGE_M
 from .loop import DriveTrace
 from .summary import DEVIATION_THRESHOLD_M, SUCCESS_WINDOW_S, DriveSummary

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..camera import VehiclePose
 from ..case import Case
-from ..road_layout import RoadNetwork
+from ..world.road_layout import RoadNetwork
 
 END_MARGIN_M = 40.0  # a drive stops this far before the end of the road (the camera needs road ahead)
 CAR_WIDTH_M = 1.8

@@ -15,9 +15,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from ..benchmark_layout import case_illusion_type, folder_type
 from ..case import Case, load_case, write_atomic
 from ..illusions import CATEGORIES, REGISTRY
+from ..library.benchmark_layout import case_illusion_type, folder_type
 from .loop import DriveSettings
 from .outputs import drive_to_folder
 from .summary import DriveSummary

@@ -12,7 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..overlay import lane_color
+from ..labels.overlay import lane_color
 from ..typed import UInt8Array
 from .loop import StepView
 from .summary import DEVIATION_THRESHOLD_M

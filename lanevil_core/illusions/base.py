@@ -16,8 +16,8 @@ from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
 
 if TYPE_CHECKING:
     from ..case import Case
-    from ..road_layout import RoadNetwork
-    from ..scene import Environment, Mesh, PointLight, SurfaceLayer
+    from ..world.road_layout import RoadNetwork
+    from ..world.scene import Environment, Mesh, PointLight, SurfaceLayer
 
 Category = Literal["road_damage", "traffic", "shadow", "reflection"]
 CATEGORIES: tuple[Category, ...] = ("road_damage", "traffic", "shadow", "reflection")

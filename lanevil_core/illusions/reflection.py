@@ -12,11 +12,11 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
-from ..environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, sun_direction
-from ..primitives import pose_on_road, transformed
-from ..props import car, van
-from ..scene import PointLight, SurfaceLayer
-from ..structures import streetlight, streetlight_lamp_offset
+from ..world.environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, sun_direction
+from ..world.primitives import pose_on_road, transformed
+from ..world.props import car, van
+from ..world.scene import PointLight, SurfaceLayer
+from ..world.structures import streetlight, streetlight_lamp_offset
 from .base import Category, CompileContext, Illusion, Level, register
 
 PUDDLE_TEXEL_M = 0.1

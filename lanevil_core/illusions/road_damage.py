@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
-from .. import surface_textures as tex
-from ..environment import sun_direction
-from ..scene import SurfaceLayer
+from ..world import surface_textures as tex
+from ..world.environment import sun_direction
+from ..world.scene import SurfaceLayer
 from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
@@ -185,7 +185,7 @@ class RoadCrack(_SurfaceDamage):
         self._emit(ctx, area, layers.cracks, layers.wet, over_paint=True, name="cracks")
         wear = _setting(self, "paint_wear")
         if wear > 0:
-            from ..paint import MATERIAL_ALBEDO  # paint -> case -> illusions: circular at import time
+            from ..world.paint import MATERIAL_ALBEDO  # paint -> case -> illusions: circular at import time
 
             rgba, _ = tex.worn_paint(np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape, area.texel,
                                      [area.local_t(t) for t in lines], wear, MATERIAL_ALBEDO[0])
@@ -432,7 +432,7 @@ class GuardRail(Illusion):
 
     def compile(self, ctx: CompileContext) -> None:
         # Imported here: structures -> road_layout -> case -> illusions would be circular at import time.
-        from ..structures import ground_height, guard_rail
+        from ..world.structures import ground_height, guard_rail
 
         main = ctx.network.main
         s0 = self.start_s(ctx.case)

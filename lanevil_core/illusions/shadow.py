@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictFloat
 
-from ..environment import sun_direction
-from ..primitives import pose_on_road, transformed
-from ..structures import (
+from ..world.environment import sun_direction
+from ..world.primitives import pose_on_road, transformed
+from ..world.structures import (
     SlotDirection,
     clear_runs,
     fence,
@@ -33,8 +33,8 @@ from .base import Category, CompileContext, Illusion, Level, register
 
 if TYPE_CHECKING:
     from ..case import Case
-    from ..road_geometry import ReferenceLine
-    from ..road_layout import RoadPiece
+    from ..world.road_geometry import ReferenceLine
+    from ..world.road_layout import RoadPiece
 
 Side = Literal["left", "right"]
 Albedo = Annotated[float, Field(ge=0.0, le=1.0)]

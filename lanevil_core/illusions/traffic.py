@@ -25,15 +25,15 @@ import numpy as np
 import trimesh
 from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 
-from .. import props
-from ..primitives import pose_on_road, rotation_z, to_mesh, transformed
-from ..scene import Mesh
+from ..world import props
+from ..world.primitives import pose_on_road, rotation_z, to_mesh, transformed
+from ..world.scene import Mesh
 from .base import Category, CompileContext, Illusion, Level, MeshFileError, register
 
 if TYPE_CHECKING:
     from ..case import Case
-    from ..road_layout import RoadPiece
     from ..typed import FloatArray
+    from ..world.road_layout import RoadPiece
 
 EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
 EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position

@@ -18,7 +18,7 @@ def write_interchange(case: Case, out_dir: str | Path, opendrive: bool = True,
     """Write ``road.xodr`` (with ``opendrive`` or ``openscenario``: the scenario refers to it) and, with
     ``openscenario``, ``scenario.xosc`` into ``out_dir``, plus the case itself (``case.json``, whose weather numbers
     ``scripts/carla_run.py`` applies); returns the interchange files written."""
-    from ..compile import compile_scene
+    from ..pipeline.compile import compile_scene
     from .opendrive import write_opendrive
     from .openscenario import write_openscenario
 

@@ -32,9 +32,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..case import DOUBLE_LINE_SPACING_M, Case, Marking, write_atomic
-from ..road_geometry import Piece, ReferenceLine
-from ..road_layout import RoadNetwork, build_network, reference_pieces
-from ..scene import CompiledScene, Mesh
+from ..world.road_geometry import Piece, ReferenceLine
+from ..world.road_layout import RoadNetwork, build_network, reference_pieces
+from ..world.scene import CompiledScene, Mesh
 
 if TYPE_CHECKING:
     from scenariogeneration import xodr
@@ -445,7 +445,7 @@ def _connecting_road(road_id: int, first: _Leg, second: _Leg, network: RoadNetwo
 
 def write_opendrive(case: Case, out_dir: str | Path, scene: CompiledScene | None = None) -> Path:
     """Write ``out_dir/road.xodr``; returns its path."""
-    from ..compile import compile_scene
+    from ..pipeline.compile import compile_scene
 
     document = opendrive(case, scene if scene is not None else compile_scene(case))
     path = Path(out_dir) / "road.xodr"

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..case import Case
-from ..scene import CompiledScene, Mesh
+from ..world.scene import CompiledScene, Mesh
 from .opendrive import MAIN_ROAD_ID, THROUGH_ROAD_ID, junction_radius
 
 if TYPE_CHECKING:
@@ -233,7 +233,7 @@ def scenario(case: Case, scene: CompiledScene, road_file: str = "road.xodr") -> 
 
 def write_openscenario(case: Case, out_dir: str | Path, scene: CompiledScene | None = None) -> Path:
     """Write ``out_dir/scenario.xosc`` (referring to ``road.xodr`` beside it); returns its path."""
-    from ..compile import compile_scene
+    from ..pipeline.compile import compile_scene
 
     path = Path(out_dir) / "scenario.xosc"
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -43,13 +43,13 @@ import torch
 import torch.nn.functional as F
 
 from ..case import Case, case_json, load_case
-from ..compile import compile_scene
 from ..dataset.plan import train_variation
-from ..illusion_effect import CHANGED_LEVEL, lane_band, luminance, with_illusion
 from ..illusions import REGISTRY
-from ..labels import h_samples_for, tusimple_record
+from ..labels.lanes import h_samples_for, tusimple_record
+from ..pipeline.compile import compile_scene
+from ..pipeline.illusion_effect import CHANGED_LEVEL, lane_band, luminance, with_illusion
 from ..render import render_frame
-from ..scene import FIRST_OBJECT_ID, ID_ROAD
+from ..world.scene import FIRST_OBJECT_ID, ID_ROAD
 from .data import resized, targets_for
 from .models import LaneNet, running_statistics
 

@@ -177,8 +177,8 @@ class RenderedFrames(_Frames):
 
     def _render(self, path: Path, frame_index: int) -> tuple[UInt8Array, dict[str, Any]]:
         from ..case import load_case
-        from ..compile import compile_scene
-        from ..labels import tusimple_record
+        from ..labels.lanes import tusimple_record
+        from ..pipeline.compile import compile_scene
         from ..render import render_frame
 
         scene = self._scenes.pop(path, None) or compile_scene(load_case(path))

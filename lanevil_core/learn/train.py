@@ -25,7 +25,7 @@ from torch.utils.data import DataLoader
 from ..detect.learned import decode_outputs, lanes_of
 from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
 from ..files import write_atomic
-from ..labels import on_tusimple_grid
+from ..labels.lanes import on_tusimple_grid
 from ..metrics.formats import split_labels
 from ..metrics.tusimple import score_image
 from .aam import (

@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from ..labels import CULANE_SIZE, IMAGE_SIZE_FIELD, TUSIMPLE_SIZE, on_tusimple_grid
+from ..labels.lanes import CULANE_SIZE, IMAGE_SIZE_FIELD, TUSIMPLE_SIZE, on_tusimple_grid
 from . import culane, ego, tusimple
 from .formats import (
     CULANE_SUFFIX,

@@ -11,11 +11,11 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from ..paint import MATERIAL_ALBEDO, stripe_index
-from ..road_layout import RoadNetwork
-from ..road_mesh import RoadSurface, road_surface
-from ..scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..world.paint import MATERIAL_ALBEDO, stripe_index
+from ..world.road_layout import RoadNetwork
+from ..world.road_mesh import RoadSurface, road_surface
+from ..world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
 from .raster import depth_orthographic
 
 

@@ -14,9 +14,9 @@ from ..camera import PinholeCamera
 from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
-from ..paint import MATERIAL_ALBEDO
-from ..scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
+from ..world.paint import MATERIAL_ALBEDO
+from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
 from .develop import develop, motion_blur
 from .lighting import face_sun_terms

@@ -20,8 +20,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..paint import MATERIAL_ALBEDO
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
 from .lighting import (

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from lanevil_core.camera import Intrinsics, PinholeCamera, ego_camera
 from lanevil_core.case import Case
-from lanevil_core.road_layout import build_network
+from lanevil_core.world.road_layout import build_network
 
 finite = st.floats(-50, 50, allow_nan=False)
 

@@ -15,7 +15,7 @@ from lanevil_core.camera.cover import cover_camera
 from lanevil_core.camera.lens import distort, undistort
 from lanevil_core.camera.sensor import KEY, development, filmic, metered_gain, white_balance_gains
 from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
-from lanevil_core.compile import compile_scene
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import render_frame
 
@@ -125,7 +125,7 @@ def test_sensor_noise_is_there_and_scales(make_case: Callable[..., Case]) -> Non
 def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: Callable[..., Case]) -> None:
     """A metered camera shows sun-lit asphalt bright and its shadow dark: the ratio of the two is lower than the
     ideal render's, as on a photograph."""
-    from lanevil_core.scene import ID_ROAD
+    from lanevil_core.world.scene import ID_ROAD
 
     ratios = []
     for sensor in (None, {"noise": 0.0, "shutter": 0.0, "vignetting": 0.0, "sharpen": 0.0}):

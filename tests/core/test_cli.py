@@ -13,10 +13,11 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from lanevil_core import bench, cli, files
+from lanevil_core import cli, files
 from lanevil_core.case import save_case
 from lanevil_core.cli import base as cli_base
 from lanevil_core.cli import core as cli_core
+from lanevil_core.pipeline import bench
 
 
 @pytest.fixture

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from lanevil_core.case import parse_case
-from lanevil_core.compile import compile_scene, roadside_key
+from lanevil_core.pipeline.compile import compile_scene, roadside_key
 
 
 def _assert_same(a, b) -> None:
@@ -43,8 +43,8 @@ class _NoCase:
 
 
 def test_renderer_labels_and_exporter_read_nothing_of_the_case(make_case) -> None:
-    from lanevil_core.export import scene_glb
-    from lanevil_core.labels import culane_lines, tusimple_record
+    from lanevil_core.export.case import scene_glb
+    from lanevil_core.labels.lanes import culane_lines, tusimple_record
     from lanevil_core.render import render_frame
 
     types = ("white_solid", "white_dashed", "yellow_double_solid", "none", "white_solid")

@@ -20,7 +20,7 @@ from lanevil_core.dataset import Settings, generate_dataset
 from lanevil_core.dataset.local import LocalPool, run_local
 from lanevil_core.dataset.plan import PlanError, RenderTask
 from lanevil_core.dataset.worker import FrameResult, TaskDone
-from lanevil_core.labels import h_samples_for
+from lanevil_core.labels.lanes import h_samples_for
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 SIZE = "160x90"
@@ -266,9 +266,9 @@ def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path
 
 
 def test_levels_of_a_folder_share_the_worker_s_original_renders() -> None:
-    from lanevil_core.compile import compile_scene
     from lanevil_core.dataset import worker
-    from lanevil_core.illusion_effect import SHARE_SIZE, clean_of, scene_changes
+    from lanevil_core.pipeline.compile import compile_scene
+    from lanevil_core.pipeline.illusion_effect import SHARE_SIZE, clean_of, scene_changes
 
     folder = SCENES / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
     frames = (0, 30)

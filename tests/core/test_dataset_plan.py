@@ -6,13 +6,13 @@ from pathlib import Path, PurePosixPath
 
 import pytest
 
-from lanevil_core.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS
 from lanevil_core.case import Case
 from lanevil_core.dataset import PlanError, Settings, build_plan, discover_cases, evenly_spaced
 from lanevil_core.dataset.manifest import _PACKAGE, source_files
 from lanevil_core.dataset.plan import SourceCase, render_tasks, train_variation
+from lanevil_core.library.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS
+from lanevil_core.library.stock import ORIGINALS, original_folder
 from lanevil_core.presets import PRESET_NAMES
-from lanevil_core.stock import ORIGINALS, original_folder
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
@@ -105,7 +105,7 @@ def test_renderer_sources_reach_the_render_path_only() -> None:
 
 
 def test_in_view_sampling_picks_frames_that_show_the_illusion(stock: list[SourceCase]) -> None:
-    from lanevil_core.illusion_effect import IN_VIEW_SHARE, SHARE_SIZE, clean_of, frame_changes
+    from lanevil_core.pipeline.illusion_effect import IN_VIEW_SHARE, SHARE_SIZE, clean_of, frame_changes
 
     fence = [source for source in stock if str(source.relative.parent) == original_folder("fence_shadow")]
     plan = build_plan(fence, Settings(frames_per_case=4))

@@ -13,14 +13,14 @@ import pytest
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, load_case
 from lanevil_core.cli import main
-from lanevil_core.compile import compile_scene
 from lanevil_core.detect import DETECTORS, GroundCamera, detect_split
 from lanevil_core.detect.common import lane_columns
-from lanevil_core.encode import png_bytes
-from lanevil_core.labels import tusimple_record
+from lanevil_core.export.encode import png_bytes
+from lanevil_core.labels.lanes import tusimple_record
 from lanevil_core.metrics.tusimple import score_image, summarize
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
-from lanevil_core.road_layout import build_network
+from lanevil_core.world.road_layout import build_network
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes" / "00_clean"
 CLEAN = ("00_straight_urban", "01_bend_suburban", "05_t_junction_urban")

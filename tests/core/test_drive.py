@@ -12,7 +12,6 @@ import pytest
 from lanevil_core import cli
 from lanevil_core.camera import VehiclePose, ego_camera, mounted_camera, pose_camera
 from lanevil_core.case import load_case, save_case
-from lanevil_core.compile import compile_scene
 from lanevil_core.drive import (
     DriveSettings,
     DriveStep,
@@ -28,8 +27,9 @@ from lanevil_core.drive import (
     summarize,
 )
 from lanevil_core.drive.lane_estimate import LanePath
-from lanevil_core.labels import h_samples_for, lane_labels, tusimple_columns
-from lanevil_core.road_layout import build_network
+from lanevil_core.labels.lanes import h_samples_for, lane_labels, tusimple_columns
+from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.road_layout import build_network
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 SMALL = (320, 180)

@@ -9,8 +9,8 @@ import pytest
 from PIL import Image
 
 from lanevil_core.case import Case
-from lanevil_core.compile import compile_scene
-from lanevil_core.encode import png_bytes
+from lanevil_core.export.encode import png_bytes
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 from lanevil_core.typed import UInt8Array
 

@@ -12,10 +12,10 @@ import trimesh
 from PIL import Image
 
 from lanevil_core.case import Case, load_case
-from lanevil_core.encode import png_bytes
-from lanevil_core.export import export_case
-from lanevil_core.paint import dash_spans, paint_mesh
-from lanevil_core.road_layout import build_network
+from lanevil_core.export.case import export_case
+from lanevil_core.export.encode import png_bytes
+from lanevil_core.world.paint import dash_spans, paint_mesh
+from lanevil_core.world.road_layout import build_network
 
 CASE = Case.model_validate({"ego": {"frames": 50}, "scene": {"density": 0.3}})
 

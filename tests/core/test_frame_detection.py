@@ -9,14 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lanevil_core import detector_catalog
-from lanevil_core.compile import compile_scene
+from lanevil_core.detect import catalog as detector_catalog
+from lanevil_core.detect.catalog import available_detector, detector_info, detector_infos, detector_version
+from lanevil_core.detect.frame_detection import detect_frame, score_frame_lanes
 from lanevil_core.detect.split import METHODS
-from lanevil_core.detector_catalog import available_detector, detector_info, detector_infos, detector_version
-from lanevil_core.frame_detection import detect_frame, score_frame_lanes
-from lanevil_core.labels import h_samples_for, tusimple_record
+from lanevil_core.labels.lanes import h_samples_for, tusimple_record
+from lanevil_core.labels.overlay import DETECTION_COLOR, LANE_COLORS, draw_detections, draw_lanes
 from lanevil_core.metrics.formats import LaneFileError
-from lanevil_core.overlay import DETECTION_COLOR, LANE_COLORS, draw_detections, draw_lanes
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 
 
@@ -84,7 +84,7 @@ def test_detections_are_drawn_in_their_own_colour() -> None:
 
 
 def test_detection_modules_import_no_web_framework() -> None:
-    code = ("import sys, lanevil_core.detector_catalog, lanevil_core.frame_detection; "
+    code = ("import sys, lanevil_core.detect.catalog, lanevil_core.detect.frame_detection; "
             "print(','.join(m for m in ('fastapi', 'viser', 'uvicorn', 'starlette', 'torch') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=Path(__file__).resolve().parents[2])

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Case, case_json, parse_case
-from lanevil_core.compile import compile_scene
-from lanevil_core.illusion_effect import band_change, lane_band
 from lanevil_core.illusions import CATEGORIES, REGISTRY
-from lanevil_core.labels import tusimple_record
+from lanevil_core.labels.lanes import tusimple_record
+from lanevil_core.library.stock import original_case, perturbed_case
+from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.pipeline.illusion_effect import band_change, lane_band
 from lanevil_core.render import render_frame
-from lanevil_core.stock import original_case, perturbed_case
 
 TYPES = list(REGISTRY)
 LEVELS = [1, 2, 3, 4, 5]

@@ -13,10 +13,10 @@ import pytest
 
 from lanevil_core import cli
 from lanevil_core.case import load_case, save_case
-from lanevil_core.compile import compile_scene
 from lanevil_core.interchange import write_interchange
 from lanevil_core.interchange.opendrive import MARK_TYPES, junction_radius, opendrive, xodr_text
 from lanevil_core.interchange.openscenario import EGO_NAME, participants
+from lanevil_core.pipeline.compile import compile_scene
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 CLEAN = sorted((SCENES / "00_clean").glob("*.json"))

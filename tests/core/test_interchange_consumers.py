@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import load_case
-from lanevil_core.compile import compile_scene
 from lanevil_core.interchange import write_interchange
 from lanevil_core.interchange.opendrive import CLEARANCE_M, JUNCTION_ID, MARK_TYPES, THROUGH_ROAD_ID, junction_radius
 from lanevil_core.interchange.openscenario import EGO_NAME, MODELS, category, participants
+from lanevil_core.pipeline.compile import compile_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "scenes"

@@ -8,12 +8,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from lanevil_core import labels as L
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import DOUBLE_LINE_SPACING_M
-from lanevil_core.compile import compile_scene
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.scene import FIRST_OBJECT_ID, ID_ROAD
+from lanevil_core.labels import lanes as L
+from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.scene import FIRST_OBJECT_ID, ID_ROAD
 
 
 def _tusimple_labels(scene, camera, frame=None):
@@ -300,7 +300,7 @@ def test_labels_sit_on_the_paint_through_a_distorting_lens_and_a_bonnet(make_cas
 
 def test_labels_stop_at_the_bonnet(make_case):
     from lanevil_core.render import render_frame
-    from lanevil_core.scene import ID_EGO
+    from lanevil_core.world.scene import ID_EGO
 
     case = make_case(camera={"preset": "dashcam", "width": 640, "height": 360, "sensor": None})
     scene = compile_scene(case)

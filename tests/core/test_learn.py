@@ -25,7 +25,7 @@ from lanevil_core.detect.lane_slots import (  # noqa: E402
 from lanevil_core.detect.learned import LearnedDetector, lanes_of, shipped_model_dir  # noqa: E402
 from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
 from lanevil_core.detect.split import detect_split  # noqa: E402
-from lanevil_core.labels import TUSIMPLE_H_SAMPLES, on_tusimple_grid  # noqa: E402
+from lanevil_core.labels.lanes import TUSIMPLE_H_SAMPLES, on_tusimple_grid  # noqa: E402
 from lanevil_core.metrics.tusimple import score_image  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -201,7 +201,7 @@ def test_aam_mixing_touches_only_masked_pixels():
 
 def test_aam_patch_mask_leaves_out_the_bank_frames_own_paint():
     from lanevil_core.learn.aam import illusion_mask
-    from lanevil_core.scene import ID_ROAD, ID_SKY
+    from lanevil_core.world.scene import ID_ROAD, ID_SKY
 
     unpainted = np.full((10, 12, 3), 60, np.uint8)
     clean = unpainted.copy()

@@ -19,7 +19,7 @@ from lanevil_core.detect.learned import LearnedDetector, decode_outputs, lanes_o
 from lanevil_core.detect.line_anchors import encode_anchors, line_anchors  # noqa: E402
 from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
 from lanevil_core.drive.detectors import drive_detector  # noqa: E402
-from lanevil_core.labels import TUSIMPLE_H_SAMPLES  # noqa: E402
+from lanevil_core.labels.lanes import TUSIMPLE_H_SAMPLES  # noqa: E402
 
 NEW_FAMILIES = ["laneatt", "bezier", "ganet", "scnn"]
 
@@ -96,8 +96,8 @@ def test_laneatt_anchors_leave_every_border():
 
 
 def test_every_family_is_a_detect_drive_and_catalog_method():
+    from lanevil_core.detect.catalog import detector_infos
     from lanevil_core.detect.split import METHODS
-    from lanevil_core.detector_catalog import detector_infos
     from lanevil_core.drive.detectors import DRIVE_DETECTORS
 
     assert set(FAMILIES) <= set(METHODS) and set(FAMILIES) <= set(DRIVE_DETECTORS)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lanevil_core.labels import CULANE_SIZE
+from lanevil_core.labels.lanes import CULANE_SIZE
 from lanevil_core.metrics.culane import (
     MatchCounts,
     interpolate_lane,

@@ -93,7 +93,7 @@ def test_culane_folder_errors(tmp_path, capsys):
 
 
 def test_records_of_smaller_renders_are_scored_on_the_1280_grid(tmp_path):
-    from lanevil_core.labels import h_samples_for
+    from lanevil_core.labels.lanes import h_samples_for
     from lanevil_core.metrics import score_tusimple_files
 
     rows = h_samples_for(360)
@@ -108,7 +108,7 @@ def test_records_of_smaller_renders_are_scored_on_the_1280_grid(tmp_path):
 
 
 def test_a_640_render_records_its_size_and_a_1280_render_stays_standard():
-    from lanevil_core.labels import image_size_field
+    from lanevil_core.labels.lanes import image_size_field
 
     assert image_size_field((640, 360)) == {"image_size": [640, 360]}
     assert image_size_field((1280, 720)) == {}

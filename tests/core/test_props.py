@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lanevil_core import props
 from lanevil_core.case import Road
-from lanevil_core.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
-from lanevil_core.road_layout import build_network
-from lanevil_core.scene import Mesh
+from lanevil_core.world import props
+from lanevil_core.world.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
+from lanevil_core.world.road_layout import build_network
+from lanevil_core.world.scene import Mesh
 
 
 def extents(mesh: Mesh) -> np.ndarray:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lanevil_core.labels import h_samples_for
+from lanevil_core.labels.lanes import h_samples_for
 from lanevil_core.metrics.ego import ego_lanes
 from lanevil_core.metrics.evaluate import evaluate
 from lanevil_core.metrics.formats import LaneRecord

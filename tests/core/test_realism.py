@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from lanevil_core import cli
-from lanevil_core.realism import (
+from lanevil_core.metrics.realism import (
     STATISTICS,
     RealismError,
     analysis_image,
@@ -23,7 +23,7 @@ from lanevil_core.realism import (
     spectrum_slope,
     summary,
 )
-from lanevil_core.realism_report import verdict
+from lanevil_core.report.realism import verdict
 
 HEIGHT, WIDTH = 720, 1280  # the analysis size, so no resize blurs the synthetic properties
 

@@ -13,9 +13,9 @@ import pytest
 from PIL import Image
 
 from lanevil_core.case import Case, load_case
-from lanevil_core.compile import compile_scene
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import Frame, render_frame
-from lanevil_core.scene import FIRST_OBJECT_ID, ID_ROAD, ID_SKY
+from lanevil_core.world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_SKY
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
@@ -32,7 +32,7 @@ def _small(case: Case, size: tuple[int, int] = (320, 180)) -> Case:
 
 
 def test_core_imports_no_web_framework() -> None:
-    code = ("import sys, lanevil_core, lanevil_core.cli, lanevil_core.export, lanevil_core.render; "
+    code = ("import sys, lanevil_core, lanevil_core.cli, lanevil_core.export.case, lanevil_core.render; "
             "bad = [m for m in ('fastapi', 'viser', 'uvicorn', 'starlette') if m in sys.modules]; "
             "print(','.join(bad))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
@@ -106,7 +106,7 @@ def test_every_stock_case_loads_with_a_title() -> None:
 
 def test_stock_library_matches_its_source() -> None:
     from lanevil_core.case import case_json
-    from lanevil_core.stock import library
+    from lanevil_core.library.stock import library
 
     lib = library()
     on_disk = {str(p.relative_to(ROOT / "scenes")): p.read_text() for p in _scene_files()}

@@ -10,17 +10,17 @@ from pathlib import Path
 
 import pytest
 
-from lanevil_core.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, frame_file
 from lanevil_core.case import load_case
 from lanevil_core.cli import main
-from lanevil_core.compile import compile_scene
-from lanevil_core.encode import png_bytes
+from lanevil_core.export.encode import png_bytes
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.labels import tusimple_record
+from lanevil_core.labels.lanes import tusimple_record
+from lanevil_core.library.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, frame_file
 from lanevil_core.metrics.evaluate import ScoredImage, score_tusimple_files
 from lanevil_core.metrics.tusimple import ImageScore, f1_ganet
+from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
-from lanevil_core.report import ALL, build_report, markdown, severity_csv
+from lanevil_core.report.robustness import ALL, build_report, markdown, severity_csv
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 SIZE = (320, 180)
@@ -146,8 +146,8 @@ def test_a_dataset_folder_stands_for_its_test_split(tiny_split, tmp_path, capsys
 
 
 def test_paint_free_control_and_several_detectors(tmp_path):
-    from lanevil_core.report_compare import Detector, write_comparison
-    from lanevil_core.report_compare import markdown as compare_markdown
+    from lanevil_core.report.compare import Detector, write_comparison
+    from lanevil_core.report.compare import markdown as compare_markdown
 
     def images(clean: float, perturbed: float, no_paint: float) -> list[ScoredImage]:
         control = scored("Shadow", "Fence", 0, no_paint)
@@ -171,8 +171,8 @@ def test_paint_free_control_and_several_detectors(tmp_path):
 
 
 def test_defences_over_seeds_compare_each_run_with_its_own_seed_s_baseline():
-    from lanevil_core.report_compare import Detector, defence_and_seed
-    from lanevil_core.report_compare import markdown as compare_markdown
+    from lanevil_core.report.compare import Detector, defence_and_seed
+    from lanevil_core.report.compare import markdown as compare_markdown
 
     def report(clean: float, perturbed: float):
         return build_report([scored("Shadow", "Fence", 0, clean), scored("Shadow", "Fence", 5, perturbed)], "ganet")
@@ -193,7 +193,7 @@ def test_defences_over_seeds_compare_each_run_with_its_own_seed_s_baseline():
 
 
 def test_level5_drop_by_type_marks_drops_that_grow_with_the_level():
-    from lanevil_core.report_compare import Detector, grows_with_level, type_table
+    from lanevil_core.report.compare import Detector, grows_with_level, type_table
 
     def ladder(type_name: str, accuracies: list[float]) -> list[ScoredImage]:
         return [scored("Shadow", type_name, level, acc) for level, acc in enumerate(accuracies)]
@@ -247,7 +247,7 @@ def test_gap_interval_contains_the_gap_and_narrows_with_more_cases():
 
 
 def test_cases_not_frames_are_resampled():
-    from lanevil_core.report_interval import CaseSums, case_unit
+    from lanevil_core.report.interval import CaseSums, case_unit
 
     images = _cases(4, 0.9, 0.8, 0.1)
     assert case_unit(images[0]) == "Shadow/Fence/00_case"
@@ -256,7 +256,7 @@ def test_cases_not_frames_are_resampled():
 
 
 def test_report_prints_and_writes_intervals(tmp_path):
-    from lanevil_core.report import report_csv, write_report
+    from lanevil_core.report.robustness import report_csv, write_report
 
     report = build_report(_cases(12, 0.9, 0.8, 0.1), "ganet")
     assert re.search(r"\| Shadow \| Fence \| 36/180 \| [\d.]+ \| [\d.]+ \| -10\.00 \[-\d+\.\d\d, -\d+\.\d\d\] \|",
@@ -270,8 +270,8 @@ def test_report_prints_and_writes_intervals(tmp_path):
 
 
 def test_compare_says_which_detectors_are_separable():
-    from lanevil_core.report_compare import NOT_SEPARABLE, Detector, gap_difference
-    from lanevil_core.report_compare import markdown as compare_markdown
+    from lanevil_core.report.compare import NOT_SEPARABLE, Detector, gap_difference
+    from lanevil_core.report.compare import markdown as compare_markdown
 
     strong = build_report(_cases(30, 0.9, 0.88, 0.1, seed=1), "ganet")  # drops 2 points
     weak = build_report(_cases(30, 0.9, 0.70, 0.1, seed=1), "ganet")  # drops 20 points on the same cases

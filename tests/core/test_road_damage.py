@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Case, CaseError, case_json, parse_case
-from lanevil_core.compile import compile_scene
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.illusions.road_damage import MAX_LAYER_TEXELS
-from lanevil_core.scene import CompiledScene
+from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.scene import CompiledScene
 
 SURFACE_TYPES = ("road_crack", "road_repair", "tire_marks")
 DAMAGE_TYPES = (*SURFACE_TYPES, "guard_rail")

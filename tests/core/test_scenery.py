@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Case
-from lanevil_core.road_layout import RoadNetwork, RoadPiece, build_network
-from lanevil_core.scene import Mesh
-from lanevil_core.scenery import corridor_half_width, roadside_meshes
 from lanevil_core.typed import SCENE_KINDS
+from lanevil_core.world.road_layout import RoadNetwork, RoadPiece, build_network
+from lanevil_core.world.scene import Mesh
+from lanevil_core.world.scenery import corridor_half_width, roadside_meshes
 
 OVERHEAD_CLEARANCE_M = 4.5  # what is this high above the road (a lamp arm, a tunnel lintel) may span it
 # Structures allowed inside the roadside strips (but never on the carriageway).

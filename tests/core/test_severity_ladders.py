@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from lanevil_core.illusion_effect import ladder, lane_band
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.stock import ORIGINALS, original_case, original_id
+from lanevil_core.library.stock import ORIGINALS, original_case, original_id
+from lanevil_core.pipeline.illusion_effect import ladder, lane_band
 
 FRAMES = (0, 6, 12)  # the illusions stand about 14-22 m ahead of the ego's start: in view and near
 SIZE = (256, 144)

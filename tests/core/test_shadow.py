@@ -7,10 +7,10 @@ import pytest
 from pydantic import ValidationError
 
 from lanevil_core.case import Case, case_json, parse_case
-from lanevil_core.compile import compile_scene
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.road_geometry import ReferenceLine
-from lanevil_core.scene import CompiledScene
+from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.road_geometry import ReferenceLine
+from lanevil_core.world.scene import CompiledScene
 
 SHADOW_TYPES = ("streetlight_shadow", "fence_shadow", "rail_shadow", "wire_shadow")
 LEVELS = (1, 2, 3, 4, 5)

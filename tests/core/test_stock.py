@@ -7,7 +7,7 @@ import re
 from collections import Counter
 
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.stock import (
+from lanevil_core.library.stock import (
     ORIGINAL_FILE,
     ORIGINALS,
     illusion_cases,
@@ -69,7 +69,7 @@ def test_a_perturbed_case_differs_from_its_original_only_in_its_illusion() -> No
 def test_layout_names_the_type_and_case_of_either_layout() -> None:
     from pathlib import PurePosixPath
 
-    from lanevil_core.benchmark_layout import case_name, folder_type
+    from lanevil_core.library.benchmark_layout import case_name, folder_type
 
     per_original = PurePosixPath("30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
     per_type = PurePosixPath("30_shadow/fence_shadow/03_level3.json")

@@ -7,10 +7,10 @@ import pytest
 import trimesh
 
 from lanevil_core.case import Road
-from lanevil_core.road_geometry import ReferenceLine
-from lanevil_core.road_layout import build_network
-from lanevil_core.scene import Mesh
-from lanevil_core.structures import (
+from lanevil_core.world.road_geometry import ReferenceLine
+from lanevil_core.world.road_layout import build_network
+from lanevil_core.world.scene import Mesh
+from lanevil_core.world.structures import (
     FOOTING_M,
     clear_runs,
     fence,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lanevil_core import surface_textures as tex
+from lanevil_core.world import surface_textures as tex
 
 TEXEL = 0.03
 SHAPE = (500, 300)  # 15 m along s by 9 m across t

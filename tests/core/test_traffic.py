@@ -13,11 +13,11 @@ from pydantic import ValidationError
 
 from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, case_meshes_dir, parse_case
-from lanevil_core.environment import environment_for
 from lanevil_core.illusions import REGISTRY, CompileContext, MeshFileError
 from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
-from lanevil_core.road_layout import build_network
-from lanevil_core.scene import Mesh
+from lanevil_core.world.environment import environment_for
+from lanevil_core.world.road_layout import build_network
+from lanevil_core.world.scene import Mesh
 
 TRAFFIC = ("pedestrian", "vehicle", "bicycle")
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from lanevil_core import detector_catalog
+from lanevil_core.detect import catalog as detector_catalog
 from lanevil_core.detect.split import METHODS
-from lanevil_core.labels import h_samples_for
-from lanevil_core.overlay import DETECTION_COLOR
+from lanevil_core.labels.lanes import h_samples_for
+from lanevil_core.labels.overlay import DETECTION_COLOR
 
 SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"
 FRAME = f"/api/cases/{SHADOW_ID}/frames"

@@ -20,12 +20,12 @@ from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
 from app.editor.session import CaseSession
 from app.frames import FrameService
 from app.state import AppState
-from lanevil_core import detector_catalog
-from lanevil_core.benchmark_layout import illusion_folder
 from lanevil_core.case import parse_case
-from lanevil_core.compile import compile_scene
+from lanevil_core.detect import catalog as detector_catalog
 from lanevil_core.detect.split import METHODS
 from lanevil_core.illusions.shadow import roadside_t
+from lanevil_core.library.benchmark_layout import illusion_folder
+from lanevil_core.pipeline.compile import compile_scene
 
 SHADOW = "fence_shadow-00_uphill_rural_noon-03_level3"
 WAIT_S = 120.0

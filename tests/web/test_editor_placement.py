@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 from app.editor.placement import anchor_road, placement_fields, ray_surface_hit, road_coordinates
 from lanevil_core.case import parse_case
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.road_layout import build_network
-from lanevil_core.road_mesh import road_surface
+from lanevil_core.world.road_layout import build_network
+from lanevil_core.world.road_mesh import road_surface
 
 ROADS = {road_type: build_network(parse_case({"road": {"type": road_type, "radius": 60}}).road, "suburban")
          for road_type in ("straight", "bend", "s_curve", "uphill")}

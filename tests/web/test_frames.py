@@ -12,8 +12,8 @@ from pydantic import ValidationError
 
 from app.frames import FrameService, RenderBusy, RenderSlots, apply_overrides, case_hash
 from lanevil_core.case import load_case
-from lanevil_core.compile import roadside_key
 from lanevil_core.illusions import REGISTRY
+from lanevil_core.pipeline.compile import roadside_key
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 

@@ -1,0 +1,1 @@
+"""Files out: image encoders, and a case's frames, labels and 3D scene."""

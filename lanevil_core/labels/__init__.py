@@ -1,0 +1,1 @@
+"""Lane ground truth (TuSimple records, CULane lines) and lanes drawn on images."""

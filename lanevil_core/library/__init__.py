@@ -1,0 +1,1 @@
+"""The stock case library and the published dataset's folder names."""

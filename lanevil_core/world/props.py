@@ -1,0 +1,454 @@
+"""Procedural low-poly props: vehicles, people, bicycles, trees, buildings, barriers, a tunnel portal.
+
+Every builder returns a ``Mesh`` in its own local frame: +X forward, +Y left, +Z up, origin on the ground at
+the centre of the footprint. Place it with ``primitives.transformed(mesh, primitives.pose_on_road(...))``.
+Dimensions are real (metres); colours are linear albedo.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from ..typed import FloatArray
+from .primitives import ColorLike, PointsLike, beam, box, cylinder, loft, merge, prism, quad, to_mesh, translation
+from .scene import Mesh
+
+# Linear albedos shared by several props.
+GLASS = (0.012, 0.016, 0.022)
+TYRE = (0.018, 0.018, 0.02)
+RIM = (0.22, 0.22, 0.23)
+TRIM = (0.03, 0.03, 0.032)
+HEADLIGHT = (0.8, 0.8, 0.75)
+TAILLIGHT = (0.55, 0.01, 0.01)
+CONCRETE = (0.36, 0.35, 0.33)
+BARK = (0.09, 0.055, 0.03)
+HEADLIGHT_GLOW = (6.0, 5.6, 4.8)
+TAILLIGHT_GLOW = (2.5, 0.05, 0.02)
+
+SHIRTS = ((0.5, 0.04, 0.03), (0.03, 0.08, 0.35), (0.6, 0.6, 0.58), (0.05, 0.05, 0.05), (0.08, 0.25, 0.07),
+          (0.7, 0.45, 0.02), (0.35, 0.12, 0.3), (0.8, 0.22, 0.02))
+TROUSERS = ((0.02, 0.03, 0.1), (0.03, 0.03, 0.03), (0.15, 0.12, 0.08), (0.18, 0.18, 0.19), (0.05, 0.08, 0.2))
+SKINS = ((0.6, 0.38, 0.27), (0.45, 0.27, 0.17), (0.25, 0.13, 0.07), (0.12, 0.06, 0.035), (0.7, 0.5, 0.38))
+HAIRS = ((0.02, 0.015, 0.01), (0.12, 0.06, 0.02), (0.35, 0.25, 0.1), (0.3, 0.3, 0.3))
+FACADES = ((0.45, 0.4, 0.33), (0.3, 0.3, 0.3), (0.35, 0.12, 0.07), (0.55, 0.53, 0.5), (0.4, 0.3, 0.2),
+           (0.2, 0.22, 0.25))
+ROOFS = ((0.2, 0.05, 0.03), (0.06, 0.06, 0.07), (0.15, 0.1, 0.07))
+LEAVES = ((0.04, 0.11, 0.025), (0.06, 0.14, 0.03), (0.03, 0.08, 0.03), (0.08, 0.13, 0.02))
+
+
+def _pick(rng: np.random.Generator, palette: tuple[tuple[float, float, float], ...]) -> FloatArray:
+    return np.asarray(palette[int(rng.integers(len(palette)))], np.float64)
+
+
+def _panel(corners: PointsLike, outward: ColorLike, color: ColorLike, **kw) -> Mesh:
+    """A one-sided quad over (4, 3) ``corners`` (in order around it) facing ``outward`` (3,)."""
+    corners = np.asarray(corners, np.float64)
+    normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+    if np.dot(normal, outward) < 0:
+        corners = corners[::-1]
+    return quad(corners, color, **kw)
+
+
+def _slanted_panel(a_xz: ColorLike, b_xz: ColorLike, half_y: float, inset: float, outward_xz: ColorLike,
+                   color: ColorLike) -> Mesh:
+    """A window on the slanted face through (x, z) points a and b, across |y| < half_y, inset along the edge
+    by ``inset`` and lifted 2.5 cm off the face."""
+    a, b = np.asarray(a_xz, np.float64), np.asarray(b_xz, np.float64)
+    n = np.asarray(outward_xz, np.float64)
+    n = n / np.linalg.norm(n)
+    edge = (b - a) / np.linalg.norm(b - a)
+    a, b = a + edge * inset + 0.025 * n, b - edge * inset + 0.025 * n
+    corners = [(a[0], -half_y, a[1]), (b[0], -half_y, b[1]), (b[0], half_y, b[1]), (a[0], half_y, a[1])]
+    return _panel(corners, (n[0], 0.0, n[1]), color)
+
+
+def _side_panels(polygon_xz: PointsLike, half_y: float, color: ColorLike) -> list[Mesh]:
+    """The same (4, 2) window outline on both sides (|y| = half_y + 2 cm), each facing outwards."""
+    polygon_xz = np.asarray(polygon_xz, np.float64)
+    panels = []
+    for side in (-1.0, 1.0):
+        y = side * (half_y + 0.02)
+        corners = [(x, y, z) for x, z in polygon_xz]
+        panels.append(_panel(corners, (0.0, side, 0.0), color))
+    return panels
+
+
+def _wheels(xs: ColorLike, radius: float, half_track: float, tyre_width: float) -> list[Mesh]:
+    """Dark tyres with grey hubs at the axle positions ``xs``, both sides."""
+    parts = []
+    for x in xs:
+        for side in (-1.0, 1.0):
+            y_out, y_in = side * half_track, side * (half_track - tyre_width)
+            parts.append(cylinder(radius, color=TYRE, segment=[(x, y_in, radius), (x, y_out, radius)], sections=12))
+            parts.append(cylinder(radius * 0.55, color=RIM, segment=[(x, y_out - side * 0.02, radius),
+                                                                     (x, y_out + side * 0.012, radius)], sections=8))
+    return parts
+
+
+def _lamps(x: float, z: float, half_y: float, extents: ColorLike, color: ColorLike,
+           glow: ColorLike | None) -> list[Mesh]:
+    """A pair of lamp boxes centred at (x, +-half_y, z)."""
+    return [box(extents, (x, side * half_y, z), color, emission=glow) for side in (-1.0, 1.0)]
+
+
+def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, length: float = 4.5,
+        width: float = 1.8, height: float = 1.45, name: str = "car") -> Mesh:
+    """A saloon car (about 440 faces): body, glasshouse with dark windows, four wheels, head and tail lights."""
+    hx, hy = length / 2, width / 2
+    body = prism([(-hx, 0.22), (hx - 0.05, 0.22), (hx, 0.5), (hx - 0.2, 0.8), (-hx + 0.1, 0.86), (-hx, 0.6)],
+                 -hy, hy, color)
+    zb, zt = 0.82, height
+    rear_b, front_b, front_t, rear_t = -0.41 * length, 0.19 * length, 0.0, -0.32 * length
+    cabin_hy = hy - 0.07
+    cabin = prism([(rear_b, zb), (front_b, zb), (front_t, zt), (rear_t, zt)], -cabin_hy, cabin_hy, color)
+    parts = [body, cabin,
+             _slanted_panel((front_b, zb), (front_t, zt), cabin_hy - 0.06, 0.05, (zt - zb, front_b - front_t), GLASS),
+             _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (zb - zt, rear_t - rear_b), GLASS)]
+    parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, True),
+                          cabin_hy, GLASS)
+    parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, False),
+                          cabin_hy, GLASS)
+    parts += _wheels((0.3 * length, -0.3 * length), 0.33, hy + 0.01, 0.22)
+    parts += _lamps(hx - 0.1, 0.63, hy - 0.28, (0.18, 0.36, 0.12), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
+    parts += _lamps(-hx + 0.02, 0.72, hy - 0.22, (0.1, 0.34, 0.13), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
+    parts.append(box((0.1, width - 0.1, 0.16), (hx - 0.02, 0.0, 0.3), TRIM))
+    parts.append(box((0.1, width - 0.1, 0.16), (-hx + 0.02, 0.0, 0.32), TRIM))
+    return merge(parts, name=name, kind="vehicle", gloss=0.6)
+
+
+def _window_outline(rear: tuple[float, float], front: tuple[float, float], zb: float, zt: float, pillar: float,
+                    front_window: bool) -> FloatArray:
+    """(4, 2) x-z outline of the front or rear side window inside a trapezoid cabin side."""
+    z0, z1 = zb + 0.07, zt - 0.06
+
+    def along(edge: tuple[float, float], z: float) -> float:
+        return edge[0] + (edge[1] - edge[0]) * (z - zb) / (zt - zb)
+
+    if front_window:
+        return np.array([(pillar + 0.05, z0), (along(front, z0) - 0.08, z0), (along(front, z1) - 0.08, z1),
+                         (pillar + 0.05, z1)])
+    return np.array([(along(rear, z0) + 0.08, z0), (pillar - 0.05, z0), (pillar - 0.05, z1),
+                     (along(rear, z1) + 0.08, z1)])
+
+
+def van(color: ColorLike = (0.6, 0.6, 0.6), *, lights_on: bool = False, length: float = 5.2, width: float = 2.0,
+        height: float = 2.3, name: str = "van") -> Mesh:
+    """A panel van (about 410 faces): tall body with a short sloped nose, cab windows, four wheels, lamps."""
+    hx, hy = length / 2, width / 2
+    nose_z, shield_x = 1.15, hx - 0.95
+    body = prism([(-hx, 0.3), (hx, 0.3), (hx, 0.95), (hx - 0.25, nose_z), (shield_x, height), (-hx, height)],
+                 -hy, hy, color)
+    parts = [body, _slanted_panel((hx - 0.25, nose_z), (shield_x, height), hy - 0.1, 0.08,
+                                  (height - nose_z, shield_x - hx + 0.25), GLASS)]
+    z0, z1 = 1.3, height - 0.2
+    x_front = hx - 0.25 - (hx - 0.25 - shield_x) * (np.array([z0, z1]) - nose_z) / (height - nose_z) - 0.12
+    parts += _side_panels([(hx - 1.9, z0), (x_front[0], z0), (x_front[1], z1), (hx - 1.9, z1)], hy, GLASS)
+    parts += [_panel([(-hx - 0.01, side * 0.08, 1.35), (-hx - 0.01, side * (hy - 0.12), 1.35),
+                      (-hx - 0.01, side * (hy - 0.12), height - 0.2), (-hx - 0.01, side * 0.08, height - 0.2)],
+                     (-1.0, 0.0, 0.0), GLASS) for side in (-1.0, 1.0)]
+    parts += _wheels((hx - 0.9, -hx + 1.0), 0.36, hy + 0.01, 0.24)
+    parts += _lamps(hx - 0.05, 0.82, hy - 0.25, (0.12, 0.36, 0.16), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
+    parts += _lamps(-hx + 0.02, 0.9, hy - 0.1, (0.08, 0.14, 0.4), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
+    parts.append(box((0.12, width - 0.05, 0.22), (hx, 0.0, 0.42), TRIM))
+    return merge(parts, name=name, kind="vehicle", gloss=0.5)
+
+
+def truck(color: ColorLike = (0.05, 0.12, 0.4), *, cargo_color: ColorLike = (0.6, 0.6, 0.58), lights_on: bool = False,
+          length: float = 8.0, width: float = 2.5, height: float = 3.4, name: str = "truck") -> Mesh:
+    """A box truck (about 580 faces): cab with windscreen, cargo box, dark chassis, six wheels, lamps."""
+    hx, hy = length / 2, width / 2
+    cab_x0, cab_top = hx - 1.9, min(height - 0.3, 3.0)
+    parts = [box((1.9, width, cab_top - 0.55), (hx - 0.95, 0.0, (cab_top + 0.55) / 2), color),
+             box((length - 2.05, width, height - 1.05), ((-hx + cab_x0 - 0.15) / 2, 0.0, (height + 1.05) / 2),
+                 cargo_color),
+             box((length - 0.6, width - 0.7, 0.5), (0.0, 0.0, 0.8), TRIM),
+             box((0.2, width, 0.3), (hx - 0.08, 0.0, 0.55), TRIM)]
+    x_glass, z_top = hx + 0.02, cab_top - 0.15
+    parts.append(_panel([(x_glass, -hy + 0.1, 1.75), (x_glass, hy - 0.1, 1.75), (x_glass, hy - 0.1, z_top),
+                         (x_glass, -hy + 0.1, z_top)], (1.0, 0.0, 0.0), GLASS))
+    parts += _side_panels([(cab_x0 + 0.9, 1.75), (hx - 0.12, 1.75), (hx - 0.12, cab_top - 0.2),
+                           (cab_x0 + 0.9, cab_top - 0.2)], hy, GLASS)
+    parts += _wheels((hx - 1.2, -hx + 1.5, -hx + 2.6), 0.5, hy - 0.02, 0.3)
+    parts += _lamps(hx - 0.03, 0.95, hy - 0.3, (0.1, 0.4, 0.2), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
+    parts += _lamps(-hx + 0.02, 1.2, hy - 0.2, (0.08, 0.25, 0.15), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
+    return merge(parts, name=name, kind="vehicle", gloss=0.4)
+
+
+def _choose(rng: np.random.Generator | None, given: ColorLike | None, palette: tuple) -> FloatArray:
+    if given is not None:
+        return np.asarray(given, np.float64)
+    return _pick(rng, palette) if rng is not None else np.asarray(palette[0], np.float64)
+
+
+def pedestrian(rng: np.random.Generator | None = None, *, shirt: ColorLike | None = None,
+               trousers: ColorLike | None = None, skin: ColorLike | None = None, height: float = 1.75,
+               walking: bool = False, name: str = "pedestrian") -> Mesh:
+    """A person facing +X (about 200 faces): legs, shoes, torso, arms, hands, head with hair.
+
+    Colours not given are drawn from ``rng`` (first palette entry without one); ``walking`` spreads the legs
+    and swings the arms in mid-stride.
+    """
+    shirt, trousers = _choose(rng, shirt, SHIRTS), _choose(rng, trousers, TROUSERS)
+    skin, hair = _choose(rng, skin, SKINS), _choose(rng, None, HAIRS)
+    k = height / 1.75
+    stride, swing = (0.28, 0.22) if walking else (0.0, 0.03)
+    hip_z, shoulder_z = 0.92 * k, 1.44 * k
+    parts = []
+    for side, phase in ((-1.0, 1.0), (1.0, -1.0)):
+        foot = np.array([phase * stride * k, side * 0.1 * k, 0.07 * k])
+        parts.append(beam((0.0, side * 0.1 * k, hip_z + 0.04 * k), foot, 0.15 * k, 0.14 * k, trousers))
+        parts.append(box((0.26 * k, 0.1 * k, 0.08 * k), foot + (0.05 * k, 0.0, -0.03 * k), TRIM))
+        hand = np.array([-phase * swing * k, side * 0.27 * k, 0.84 * k])
+        parts.append(beam((0.0, side * 0.24 * k, shoulder_z), hand, 0.09 * k, 0.1 * k, shirt))
+        parts.append(box((0.07 * k, 0.06 * k, 0.1 * k), hand + (0.0, 0.0, -0.06 * k), skin))
+    parts.append(prism([(-0.17 * k, hip_z - 0.04 * k), (0.17 * k, hip_z - 0.04 * k), (0.22 * k, shoulder_z + 0.04 * k),
+                        (-0.22 * k, shoulder_z + 0.04 * k)], -0.12 * k, 0.12 * k, shirt, axis="x"))
+    parts.append(box((0.09 * k, 0.09 * k, 0.1 * k), (0.0, 0.0, shoulder_z + 0.07 * k), skin))
+    parts.append(_head(0.115 * k, np.array([0.0, 0.0, height - 0.12 * k]), skin, hair))
+    return merge(parts, name=name, kind="pedestrian")
+
+
+def _head(radius: float, center: FloatArray, skin: FloatArray, hair: FloatArray) -> Mesh:
+    """A low-poly head (80 faces) with the top and back of the head in the hair colour."""
+    tm = trimesh.creation.icosphere(subdivisions=1, radius=radius)
+    tm.apply_scale((0.9, 0.82, 1.05))
+    tm.apply_transform(translation(center))
+    c = tm.triangles_center - center
+    hairy = (c[:, 2] > 0.35 * radius) | ((c[:, 0] < -0.35 * radius) & (c[:, 2] > -0.3 * radius))
+    return to_mesh(tm, np.where(hairy[:, None], hair, skin))
+
+
+def _knee(hip: FloatArray, foot: FloatArray, bone: float) -> FloatArray:
+    """Knee position bending forward (+X) for a two-bone leg of equal bones ``bone``."""
+    mid, span = 0.5 * (hip + foot), foot - hip
+    d = float(np.linalg.norm(span))
+    rise = np.sqrt(max(bone**2 - (0.5 * d) ** 2, 0.0))
+    forward = np.array([span[2], 0.0, -span[0]]) / max(d, 1e-9)
+    if forward[0] < 0:
+        forward = -forward
+    return mid + forward * rise
+
+
+def bicycle_with_rider(rng: np.random.Generator | None = None, *, frame_color: ColorLike | None = None,
+                       shirt: ColorLike | None = None, trousers: ColorLike | None = None,
+                       name: str = "bicycle") -> Mesh:
+    """A bicycle (1.8 m long, wheels in the x-z plane) ridden by a seated person facing +X (about 640 faces)."""
+    frame_color = _choose(rng, frame_color, SHIRTS[1:] + SHIRTS[:1])
+    shirt, trousers = _choose(rng, shirt, SHIRTS), _choose(rng, trousers, TROUSERS)
+    skin, hair = _choose(rng, None, SKINS), _choose(rng, None, HAIRS)
+    r, hub = 0.34, 0.54
+    parts = []
+    for x in (-hub, hub):
+        tm = trimesh.creation.torus(major_radius=r - 0.02, minor_radius=0.022, major_sections=16, minor_sections=4)
+        tm.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+        tm.apply_translation((x, 0.0, r))
+        parts.append(to_mesh(tm, TYRE))
+        parts += [beam((x - (r - 0.04), 0.0, r), (x + r - 0.04, 0.0, r), 0.01, 0.01, RIM),
+                  beam((x, 0.0, 0.04), (x, 0.0, 2 * r - 0.04), 0.01, 0.01, RIM)]
+    rear, front = np.array([-hub, 0.0, r]), np.array([hub, 0.0, r])
+    bracket, seat = np.array([-0.05, 0.0, 0.3]), np.array([-0.22, 0.0, 0.86])
+    head_top, head_low = np.array([0.36, 0.0, 0.88]), np.array([0.41, 0.0, 0.66])
+    for p0, p1 in ((rear, bracket), (rear, seat), (bracket, seat), (seat, head_top), (bracket, head_low),
+                   (head_low, front), (head_low, head_top)):
+        parts.append(beam(p0, p1, 0.035, 0.035, frame_color))
+    grips = head_top + (0.05, 0.0, 0.1)
+    parts.append(beam(grips + (0.0, -0.26, 0.0), grips + (0.0, 0.26, 0.0), 0.03, 0.03, TRIM))
+    parts.append(box((0.24, 0.12, 0.05), seat + (0.0, 0.0, 0.04), TRIM))
+    parts += _rider(seat + (0.0, 0.0, 0.08), bracket, grips, shirt, trousers, skin, hair)
+    return merge(parts, name=name, kind="bicycle")
+
+
+def _rider(hip_c: FloatArray, bracket: FloatArray, grips: FloatArray, shirt: FloatArray, trousers: FloatArray,
+           skin: FloatArray, hair: FloatArray) -> list[Mesh]:
+    shoulder_c = hip_c + (0.3, 0.0, 0.5)
+    parts = [beam(hip_c, shoulder_c, 0.4, 0.24, shirt)]
+    neck = shoulder_c + (0.06, 0.0, 0.09)
+    parts.append(box((0.09, 0.09, 0.1), neck, skin))
+    parts.append(_head(0.115, neck + (0.05, 0.0, 0.15), skin, hair))
+    for side, crank in ((-1.0, 0.0), (1.0, np.pi)):
+        y = side * 0.1
+        hip = hip_c + (0.0, y, 0.0)
+        pedal = bracket + (0.17 * np.cos(crank), y + side * 0.05, 0.17 * np.sin(crank + 0.4))
+        knee = _knee(hip, pedal, 0.46)
+        parts += [beam(hip, knee, 0.14, 0.14, trousers), beam(knee, pedal, 0.11, 0.11, trousers),
+                  box((0.22, 0.09, 0.07), pedal + (0.04, 0.0, 0.0), TRIM)]
+        shoulder = shoulder_c + (0.0, side * 0.2, -0.03)
+        hand = grips + (0.0, side * 0.22, 0.0)
+        parts += [beam(shoulder, hand, 0.09, 0.09, shirt), box((0.08, 0.06, 0.07), hand, skin)]
+    return parts
+
+
+def tree(rng: np.random.Generator, *, conifer: bool | None = None, height: float | None = None,
+         name: str = "tree") -> Mesh:
+    """A tree 4-12 m tall: trunk and a lumpy icosphere crown, or a conifer of three stacked cones."""
+    conifer = bool(rng.random() < 0.35) if conifer is None else conifer
+    height = float(rng.uniform(5.0, 11.0)) if height is None else height
+    if conifer:
+        trunk_h = 0.2 * height
+        parts = [cylinder(0.1 + 0.012 * height, trunk_h + 0.3, (0.0, 0.0, trunk_h / 2 - 0.15), BARK, sections=6)]
+        for i, frac in enumerate((0.0, 0.3, 0.55)):
+            radius = 0.22 * height * (1.0 - 0.3 * i)
+            base = trunk_h + frac * (height - trunk_h)
+            cone = trimesh.creation.cone(radius, height - base, sections=8, transform=translation((0, 0, base)))
+            parts.append(to_mesh(cone, _leaf_colors(rng, len(cone.faces), 0.7)))
+        return merge(parts, name=name, kind="tree")
+    radius = float(rng.uniform(0.28, 0.36)) * height
+    trunk_h = height - 1.7 * radius
+    parts = [cylinder(0.08 + 0.02 * height, trunk_h + 0.5, (0.0, 0.0, trunk_h / 2), BARK, sections=6)]
+    crown = trimesh.creation.icosphere(subdivisions=1, radius=radius)
+    crown.vertices = crown.vertices * (1.0 + 0.18 * rng.uniform(-1.0, 1.0, (len(crown.vertices), 1)))
+    crown.apply_scale((1.0, 1.0, float(rng.uniform(0.85, 1.1))))
+    crown.apply_translation((0.0, 0.0, height - radius))
+    parts.append(to_mesh(crown, _leaf_colors(rng, len(crown.faces))))
+    return merge(parts, name=name, kind="tree")
+
+
+def bush(rng: np.random.Generator, *, radius: float | None = None, name: str = "bush") -> Mesh:
+    """A low shrub (80 faces): a squashed, lumpy icosphere sitting on the ground."""
+    radius = float(rng.uniform(0.6, 1.3)) if radius is None else radius
+    tm = trimesh.creation.icosphere(subdivisions=1, radius=radius)
+    tm.vertices = tm.vertices * (1.0 + 0.15 * rng.uniform(-1.0, 1.0, (len(tm.vertices), 1)))
+    tm.apply_scale((1.0, 1.0, 0.65))
+    tm.apply_translation((0.0, 0.0, 0.45 * radius))
+    return to_mesh(tm, _leaf_colors(rng, len(tm.faces)), name=name, kind="bush")
+
+
+def _leaf_colors(rng: np.random.Generator, m: int, shade: float = 1.0) -> FloatArray:
+    """(m, 3) foliage colours: one green from the palette, varied face by face so flat shading reads as leaves."""
+    base = _pick(rng, LEAVES) * shade
+    return base * rng.uniform(0.75, 1.25, (m, 1))
+
+
+def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0, height: float = 15.0, *,
+             facade: ColorLike | None = None, shopfront: bool = False, name: str = "building") -> Mesh:
+    """An apartment or office block: ``width`` along X, ``depth`` along Y, a grid of dark windows on every
+    facade, a parapet; ``shopfront`` darkens the ground floor of the front (+Y) facade."""
+    facade = _choose(rng, facade, FACADES)
+    hx, hy = width / 2, depth / 2
+    parts = [box((width, depth, height + 0.5), (0.0, 0.0, height / 2 - 0.25), facade),
+             box((width + 0.2, depth + 0.2, 0.6), (0.0, 0.0, height + 0.1), facade * 0.7)]
+    storeys = max(int(height // 3.2), 1)
+    pitch = float(rng.uniform(2.6, 3.6))
+    glass = np.asarray(GLASS) * 2.0
+    first = 1 if shopfront else 0
+    if shopfront:
+        parts.append(box((width - 1.0, 0.1, 2.6), (0.0, hy, 1.6), glass))
+    for axis_len, across, sign, along_x in ((width, hy, 1.0, True), (width, hy, -1.0, True),
+                                           (depth, hx, 1.0, False), (depth, hx, -1.0, False)):
+        parts += _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass)
+    return merge(parts, name=name, kind="building", gloss=0.1)
+
+
+def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys: int, pitch: float,
+                 first_storey: int, color: FloatArray) -> list[Mesh]:
+    """Window quads on one facade: the facade plane sits at ``sign * across`` (y if ``along_x`` else x)."""
+    columns = max(int(span // pitch), 1)
+    centres = (np.arange(columns) - (columns - 1) / 2) * (span / columns)
+    half_w = min(0.7, 0.3 * span / columns)
+    levels = np.arange(first_storey, storeys) * 3.2
+    if levels.size == 0:
+        return []
+    c, z = (grid.ravel() for grid in np.meshgrid(centres, levels))
+    a, b, z0, z1 = c - half_w, c + half_w, z + 0.95, z + 2.55
+    plane = np.full_like(a, sign * (across + 0.01))
+    u = np.stack([a, b, b, a], 1)  # (n, 4) along the facade
+    v = np.stack([z0, z0, z1, z1], 1)
+    w = np.broadcast_to(plane[:, None], u.shape)
+    corners = np.stack([u, w, v] if along_x else [w, u, v], -1).reshape(-1, 3)
+    quads = np.arange(len(a))[:, None] * 4
+    faces = np.concatenate([quads + [0, 1, 2], quads + [0, 2, 3]])
+    # The (u, v) order is counter-clockwise seen from +Y for an x-running facade and from -X otherwise.
+    if (sign > 0) == along_x:
+        faces = faces[:, ::-1]
+    return [Mesh(corners, faces, np.asarray(color, np.float32))]
+
+
+def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
+          name: str = "house") -> Mesh:
+    """A detached house: walls, a gable roof (ridge along X), windows all round and a door on the +Y front."""
+    storeys = int(rng.integers(1, 3)) if storeys is None else storeys
+    wall_h = 2.9 * storeys
+    hx, hy = width / 2, depth / 2
+    wall = _choose(rng, None, FACADES[:2] + FACADES[3:5])
+    roof_h = float(rng.uniform(0.3, 0.45)) * depth
+    parts = [box((width, depth, wall_h + 0.3), (0.0, 0.0, wall_h / 2 - 0.15), wall),
+             prism([(-hy - 0.4, wall_h - 0.05), (hy + 0.4, wall_h - 0.05), (0.0, wall_h + roof_h)],
+                   -hx - 0.3, hx + 0.3, _pick(rng, ROOFS), axis="x")]
+    glass = np.asarray(GLASS) * 2.0
+    pitch = float(rng.uniform(2.8, 3.6))
+    for span, across, sign, along_x in ((width, hy, 1.0, True), (width, hy, -1.0, True),
+                                        (depth, hx, 1.0, False), (depth, hx, -1.0, False)):
+        parts += _window_grid(span, across, sign, along_x, storeys, pitch, 0, glass)
+    parts.append(_panel([(hx * 0.5 - 0.5, hy + 0.02, 0.0), (hx * 0.5 + 0.5, hy + 0.02, 0.0),
+                         (hx * 0.5 + 0.5, hy + 0.02, 2.1), (hx * 0.5 - 0.5, hy + 0.02, 2.1)],
+                        (0.0, 1.0, 0.0), (0.12, 0.06, 0.03)))
+    return merge(parts, name=name, kind="building", gloss=0.05)
+
+
+# New Jersey barrier cross-section (y, z), metres: 0.61 m base, 0.15 m top, 0.81 m tall.
+JERSEY_PROFILE = ((-0.305, 0.0), (0.305, 0.0), (0.305, 0.075), (0.2, 0.33), (0.075, 0.81), (-0.075, 0.81),
+                  (-0.2, 0.33), (-0.305, 0.075))
+
+
+def jersey_barrier(length: float = 4.0, color: ColorLike = CONCRETE, name: str = "barrier") -> Mesh:
+    """One concrete New Jersey barrier segment along X (28 faces), sunk 5 cm into the ground."""
+    profile = np.array(JERSEY_PROFILE) - (0.0, 0.05)
+    return prism(profile, -length / 2, length / 2, color, axis="x", name=name, kind="barrier")
+
+
+def tunnel_portal(width: float = 14.0, height: float = 6.0, *, lining: float = 8.0, hill_height: float = 16.0,
+                  hill_width: float = 45.0, hill_depth: float = 12.0, name: str = "tunnel portal") -> Mesh:
+    """A tunnel mouth facing -X: a concrete portal wall around a ``width`` x ``height`` opening, a dark lining
+    running ``lining`` m into +X, and a hillside rising around and over it up to x = ``hill_depth``.
+
+    The opening spans |y| < width/2, 0 < z < height at x = 0; nothing else enters that box. At x = hill_depth
+    the hill's cross-section on each side is ``hill_profile(width / 2 + 0.4, ...)`` so a swept continuation
+    joins it.
+    """
+    hw, wall = width / 2, 1.2
+    top = height + 2.2
+    lining_dark = (0.03, 0.03, 0.03)
+    parts = [box((0.8, wall + 1.5, top + 0.5), (-0.4, side * (hw + (wall + 1.5) / 2), (top - 0.5) / 2), CONCRETE)
+             for side in (-1.0, 1.0)]
+    parts.append(box((0.8, width + 0.1, top - height), (-0.4, 0.0, (top + height) / 2), CONCRETE))
+    parts.append(box((1.2, width + 2 * wall + 3.4, 0.35), (-0.5, 0.0, top + 0.1), np.asarray(CONCRETE) * 0.8))
+    parts += [box((lining, 0.4, height + 0.5), (lining / 2, side * (hw + 0.2), height / 2 - 0.25), lining_dark)
+              for side in (-1.0, 1.0)]
+    parts.append(box((lining, width + 0.8, 0.4), (lining / 2, 0.0, height + 0.2), lining_dark))
+    crest = max(hill_height, top + 2.0)
+    for side in (-1.0, 1.0):
+        parts.append(_hill_side(hw + 0.4, hw + wall + 1.5, hill_width, crest, hill_depth, side))
+    top_mass = prism([(-0.8, top), (hill_depth, top), (hill_depth, crest), (3.0, crest)], -hw - wall - 1.6,
+                     hw + wall + 1.6, EARTH[0], axis="y")
+    parts.append(top_mass)
+    return merge(parts, name=name, kind="tunnel")
+
+
+EARTH = ((0.06, 0.1, 0.03), (0.08, 0.11, 0.035), (0.1, 0.09, 0.045), (0.05, 0.08, 0.03))
+
+
+def hill_profile(inner: float, hill_width: float, crest: float) -> FloatArray:
+    """(5, 2) convex (|t|, h) cross-section of the hill beside a tunnel, from the tube wall at ``inner`` out."""
+    return np.array([(inner, -0.3), (inner + hill_width, -0.3), (inner + hill_width, 0.25 * crest),
+                     (inner + 0.45 * hill_width, 0.85 * crest), (inner, crest)])
+
+
+def earth_colors(centers: FloatArray) -> FloatArray:
+    """(m, 3) hillside greens and browns, varied face by face from the face centres (m, 3)."""
+    palette = np.asarray(EARTH)
+    key = np.floor(np.abs(centers @ np.array([0.37, 0.61, 0.23]))).astype(np.int64)
+    return palette[key % len(palette)] * (0.85 + 0.3 * ((key * 7) % 5) / 4)[:, None]
+
+
+def _hill_side(inner: float, portal_edge: float, hill_width: float, crest: float, depth: float,
+               side: float) -> Mesh:
+    """The hill beside the portal on ``side``: a loft from its foot in front of the portal (its inner edge
+    at the portal wall's outer edge) back to the ``hill_profile`` section at x = depth."""
+    back = [(depth, t, h) for t, h in hill_profile(inner, hill_width, crest)]
+    front = [(-10.0, portal_edge, -0.3), (-4.0, inner + hill_width, -0.3), (0.0, inner + hill_width, 0.25 * crest),
+             (2.0, inner + 0.45 * hill_width, 0.85 * crest), (1.0, portal_edge, crest)]
+    rings = np.array([front, back]) * (1.0, side, 1.0)
+    hill = loft(rings, name="hillside", kind="terrain")
+    hill.colors = earth_colors(hill.vertices[hill.faces].mean(1)).astype(np.float32)
+    return hill

@@ -1,0 +1,362 @@
+"""What stands beside the road, by scene kind: buildings, houses, trees, bushes, barriers, a tunnel portal.
+
+Props stand beyond every road piece's carriageway and its non-terrain cross-section strips (shoulders, kerbs,
+sidewalks, gravel); the only exceptions are structures meant to be there (highway barriers on the gravel verge,
+streetlights on the sidewalk, the tunnel mouth over the road). Placement is deterministic given the rng.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..case import Case
+from ..typed import FloatArray
+from . import props
+from .environment import is_night
+from .primitives import merge, pose_on_road, swept, transformed
+from .road_layout import RoadNetwork, RoadPiece
+from .scene import Mesh
+
+CLEAR_MARGIN_M = 0.3  # free space kept between a prop's footprint and any road corridor
+GROUP_LENGTH_M = 100.0  # small props (trees, bushes, barriers) are merged into one mesh per side and stretch
+TUNNEL_HEIGHT_M = 6.0
+ROW_RETRY_STEP_M = 3.0
+
+
+def corridor_half_width(piece: RoadPiece) -> float:
+    """|t| up to which the piece's carriageway and non-terrain strips reach (m)."""
+    return piece.half_width + sum(strip.width for strip in piece.strips[:-1])
+
+
+def ground_h(piece: RoadPiece) -> float:
+    """Height of the terrain strip above the carriageway (m)."""
+    return piece.strips[-1].height if piece.strips else 0.0
+
+
+class Clearance:
+    """Which world points fall inside a road corridor, and which spots props already took."""
+
+    def __init__(self, network: RoadNetwork, stride: int = 10) -> None:
+        self.pieces = network.pieces
+        self._samples = [(p.line.s[::stride], p.line.xy[::stride], p.line.heading[::stride]) for p in network.pieces]
+        self.taken = np.zeros((0, 4, 2))  # footprints of the props placed so far, (n, 4, 2) corners
+        self.closed_s: list[tuple[float, float]] = []  # main-road stretches where nothing may stand beside it
+
+    def road_frame(self, index: int, p_xy: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(n,) s and t of world points (n, 2) in piece ``index``'s road frame (nearest sample, refined)."""
+        s, xy, heading = self._samples[index]
+        d2 = ((p_xy[:, None, :] - xy[None, :, :]) ** 2).sum(-1)
+        near = np.argmin(d2, axis=1)
+        delta = p_xy - xy[near]
+        tangent = np.stack([np.cos(heading[near]), np.sin(heading[near])], -1)
+        normal = np.stack([-tangent[:, 1], tangent[:, 0]], -1)
+        return s[near] + (delta * tangent).sum(-1), (delta * normal).sum(-1)
+
+    def on_road(self, p_xy: FloatArray, margin: float = CLEAR_MARGIN_M, skip: int | None = None) -> bool:
+        """Whether any point (n, 2) lies within ``margin`` of some piece's corridor (piece ``skip`` ignored)."""
+        for index, piece in enumerate(self.pieces):
+            if index == skip:
+                continue
+            s, t = self.road_frame(index, p_xy)
+            inside = (s > -margin) & (s < piece.line.length + margin)
+            if np.any(inside & (np.abs(t) < corridor_half_width(piece) + margin)):
+                return True
+        return False
+
+    def free(self, corners_xy: FloatArray, gap: float = 0.5) -> bool:
+        """Whether the footprint (4, 2) keeps ``gap`` from every footprint taken so far and stands beside no
+        closed stretch of the main road."""
+        if self.closed_s:
+            s, _ = self.road_frame(0, corners_xy.mean(0, keepdims=True))
+            if any(s0 <= s[0] <= s1 for s0, s1 in self.closed_s):
+                return False
+        return not np.any(overlapping(corners_xy, self.taken, gap))
+
+    def take(self, corners_xy: FloatArray) -> None:
+        self.taken = np.concatenate([self.taken, np.asarray(corners_xy, np.float64)[None]])
+
+
+def _edge_normals(quads: FloatArray) -> FloatArray:
+    """(..., 2, 2) unit normals of the first two edges of convex quads (..., 4, 2)."""
+    edges = quads[..., 1:3, :] - quads[..., 0:2, :]
+    normals = np.stack([-edges[..., 1], edges[..., 0]], -1)
+    return normals / np.maximum(np.linalg.norm(normals, axis=-1, keepdims=True), 1e-12)
+
+
+def overlapping(quad: FloatArray, quads: FloatArray, gap: float) -> np.ndarray:
+    """(n,) whether the rectangle ``quad`` (4, 2) comes within ``gap`` of each rectangle of ``quads``
+    (n, 4, 2) (separating-axis test)."""
+    if len(quads) == 0:
+        return np.zeros(0, bool)
+    axes = np.concatenate([np.broadcast_to(_edge_normals(quad), (len(quads), 2, 2)), _edge_normals(quads)], 1)
+    pa = np.einsum("kj,naj->nak", quad, axes)
+    pb = np.einsum("nkj,naj->nak", quads, axes)
+    separated = (pa.max(-1) + gap < pb.min(-1)) | (pb.max(-1) + gap < pa.min(-1))
+    return ~separated.any(1)
+
+
+@dataclass
+class Spot:
+    """A candidate place beside piece ``index``: road frame (s, t), yaw, the footprint's half extents."""
+
+    index: int
+    s: float
+    t: float
+    yaw: float
+    half_x: float
+    half_y: float
+    T_world_local: FloatArray = field(default_factory=lambda: np.eye(4))
+
+
+def try_place(clear: Clearance, piece: RoadPiece, spot: Spot) -> bool:
+    """Pose ``spot`` on its piece; accept it if its footprint is off every corridor, beyond no sharp inside
+    bend, and free of other props (then mark it taken)."""
+    if not 0.0 <= spot.s <= piece.line.length:
+        return False
+    curvature = float(np.interp(spot.s, piece.line.s, piece.line.curvature))
+    if curvature * spot.t > 0 and abs(spot.t) + spot.half_y > 0.6 / abs(curvature):
+        return False  # beyond the terrain on the inside of a bend
+    # On a slope the footprint's downhill end must not float: sink the prop by the rise over its half length.
+    sink = abs(float(piece.line.grade_at(spot.s))) * max(spot.half_x, spot.half_y)
+    spot.T_world_local = pose_on_road(piece.line, spot.s, spot.t, spot.yaw, ground_h(piece) - sink)
+    xs, ys = (-spot.half_x, 0.0, spot.half_x), (-spot.half_y, 0.0, spot.half_y)
+    corners = np.array([(x, y, 0.0) for x in xs for y in ys])
+    p_xy = (corners @ spot.T_world_local[:3, :3].T + spot.T_world_local[:3, 3])[:, :2]
+    s_back, t_back = clear.road_frame(spot.index, p_xy[4:5])
+    if abs(s_back[0] - spot.s) > 1.0 or abs(t_back[0] - spot.t) > 1.0:
+        return False  # the spot folds onto another part of the road
+    footprint = p_xy[[0, 2, 8, 6]]
+    if clear.on_road(p_xy) or not clear.free(footprint):
+        return False
+    clear.take(footprint)
+    return True
+
+
+def sides(network: RoadNetwork) -> Iterator[tuple[int, RoadPiece, int]]:
+    """(piece index, piece, side) for both sides of every piece; side +1 left, -1 right."""
+    for index, piece in enumerate(network.pieces):
+        for side in (-1, 1):
+            yield index, piece, side
+
+
+def stations(s0: float, s1: float, spacing: float, rng: np.random.Generator, jitter: float = 0.4) -> FloatArray:
+    """Positions from s0 to s1 about ``spacing`` apart, each moved by up to +-jitter * spacing."""
+    if spacing <= 0 or s1 <= s0:
+        return np.zeros(0)
+    base = np.arange(s0 + 0.5 * spacing, s1, spacing)
+    return base + rng.uniform(-jitter, jitter, base.size) * spacing
+
+
+def facing_yaw(side: int) -> float:
+    """Yaw that turns a prop's +Y (its front) towards the road from ``side``."""
+    return 0.0 if side < 0 else np.pi
+
+
+def _grouped(placed: list[tuple[float, Mesh]], name: str, kind: str) -> list[Mesh]:
+    """Merge (s, world mesh) pairs into one mesh per GROUP_LENGTH_M of road."""
+    groups: dict[int, list[Mesh]] = {}
+    for s, mesh in placed:
+        groups.setdefault(int(s // GROUP_LENGTH_M), []).append(mesh)
+    return [merge(meshes, name=f"{name} {k * GROUP_LENGTH_M:.0f}-{(k + 1) * GROUP_LENGTH_M:.0f} m", kind=kind)
+            for k, meshes in sorted(groups.items())]
+
+
+def plant(rng: np.random.Generator, bush_share: float, conifer_share: float) -> tuple[float, Callable[[], Mesh]]:
+    """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh."""
+    if rng.random() < bush_share:
+        radius = float(rng.uniform(0.6, 1.3))
+        return 1.2 * radius, lambda: props.bush(rng, radius=radius)
+    conifer = bool(rng.random() < conifer_share)
+    height = float(rng.uniform(5.0, 11.0))
+    return (0.23 if conifer else 0.43) * height, lambda: props.tree(rng, conifer=conifer, height=height)
+
+
+def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, spacing: float,
+             setback: tuple[float, float], bush_share: float = 0.3, conifer_share: float = 0.35) -> list[Mesh]:
+    """Trees and bushes along both sides of every piece, ``setback`` (min, max) m beyond the corridor."""
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        placed: list[tuple[float, Mesh]] = []
+        for s in stations(piece.s_start, piece.line.length, spacing, rng):
+            half, build = plant(rng, bush_share, conifer_share)
+            t = side * (corridor_half_width(piece) + float(rng.uniform(*setback)) + half)
+            spot = Spot(index, float(s), t, float(rng.uniform(0, 2 * np.pi)), half, half)
+            if try_place(clear, piece, spot):
+                placed.append((float(s), transformed(build(), spot.T_world_local)))
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"trees {label} piece {index}", "tree")
+    return out
+
+
+def rows_of(network: RoadNetwork, clear: Clearance, rng: np.random.Generator,
+            make: Callable[[np.random.Generator], tuple[float, float, Callable[[], Mesh]]],
+            setback: tuple[float, float], gap: tuple[float, float], kind: str) -> list[Mesh]:
+    """Buildings in a row along both sides of every piece: ``make`` returns (width, depth, local mesh builder)."""
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        s = piece.s_start + float(rng.uniform(0.0, gap[1]))
+        while s < piece.line.length:
+            width, depth, build = make(rng)
+            t = side * (corridor_half_width(piece) + float(rng.uniform(*setback)) + depth / 2)
+            spot = Spot(index, s + width / 2, t, facing_yaw(side), width / 2, depth / 2)
+            if try_place(clear, piece, spot):
+                mesh = transformed(build(), spot.T_world_local)
+                mesh.name = f"{kind} {len(out) + 1}"
+                out.append(mesh)
+                s += width + float(rng.uniform(*gap))
+            else:  # something stands there: try the next building a little further on
+                s += ROW_RETRY_STEP_M
+    return out
+
+
+def barriers(network: RoadNetwork, clear: Clearance, segment: float = 4.0) -> list[Mesh]:
+    """Concrete barriers along the outer edge of the first roadside strip (the hard shoulder), both sides."""
+    out: list[Mesh] = []
+    template = props.jersey_barrier(segment - 0.03)
+    for index, piece, side in sides(network):
+        t = side * (piece.half_width + piece.strips[0].width + 0.45)
+        h = piece.strips[1].height if len(piece.strips) > 2 else 0.0
+        placed = []
+        for s in np.arange(piece.s_start + segment / 2, piece.line.length - segment / 2, segment):
+            T = pose_on_road(piece.line, float(s), t, 0.0, h)
+            ends = np.array([[-segment / 2, -0.35, 0, 1], [segment / 2, -0.35, 0, 1], [-segment / 2, 0.35, 0, 1],
+                             [segment / 2, 0.35, 0, 1]]) @ T.T
+            if not clear.on_road(ends[:, :2], margin=0.1, skip=index):
+                placed.append((float(s), transformed(template, T)))
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"barrier {label} piece {index}", "barrier")
+    return out
+
+
+def streetlights(network: RoadNetwork, clear: Clearance, spacing: float, emissive: bool) -> list[Mesh]:
+    """Street lamps on the sidewalk (the first raised strip), every ``spacing`` m on both sides, arms over the
+    road; none where a junction arm or its sidewalk passes."""
+    try:
+        from .structures import streetlight
+    except ImportError:  # streetlights are optional
+        return []
+    template = streetlight(emissive=emissive)
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+        if not raised:
+            continue
+        t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.6)
+        h = piece.strips[raised[0]].height
+        placed = []
+        offset = spacing / 2 if side > 0 else 0.0
+        for s in np.arange(piece.s_start + 5.0 + offset, piece.line.length - 2.0, spacing):
+            T = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
+            if not clear.on_road(T[None, :2, 3], margin=1.0, skip=index):
+                placed.append((float(s), transformed(template, T)))
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"streetlights {label} piece {index}", "pole")
+    return out
+
+
+def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
+    """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
+    the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
+    line = network.main.line
+    s_portal = float(min(case.ego.start_s + rng.uniform(150.0, 250.0), line.length - 30.0))
+    opening = corridor_half_width(network.main) + 0.2
+    hill_depth, crest, hill_width = 12.0, 16.0, 45.0
+    portal = props.tunnel_portal(2 * opening, TUNNEL_HEIGHT_M, hill_height=crest, hill_depth=hill_depth,
+                                 hill_width=hill_width)
+    meshes = [transformed(portal, pose_on_road(line, s_portal, 0.0))]
+    s_in = np.append(np.arange(s_portal + 6.0, line.length, 5.0), line.length)
+    s_hill = np.append(np.arange(s_portal + hill_depth - 0.5, line.length, 5.0), line.length)
+    dark = (0.03, 0.03, 0.03)
+    section = props.hill_profile(opening + 0.4, hill_width, crest)
+    for side in (-1.0, 1.0):
+        wall = [(side * opening, -0.2), (side * (opening + 0.4), -0.2), (side * (opening + 0.4), TUNNEL_HEIGHT_M + 0.4),
+                (side * opening, TUNNEL_HEIGHT_M + 0.4)]
+        meshes.append(swept(line, s_in, wall, dark, name="tunnel wall", kind="tunnel"))
+        hill = swept(line, s_hill, section * (side, 1.0), name="hillside", kind="terrain")
+        hill.colors = props.earth_colors(hill.vertices[hill.faces].mean(1)).astype(np.float32)
+        meshes.append(hill)
+    roof = [(-opening - 0.4, TUNNEL_HEIGHT_M), (opening + 0.4, TUNNEL_HEIGHT_M), (opening + 0.4, crest),
+            (-opening - 0.4, crest)]
+    meshes.append(swept(line, s_in, roof, props.EARTH[0], name="tunnel roof", kind="tunnel"))
+    end = [(-opening, -0.2), (opening, -0.2), (opening, TUNNEL_HEIGHT_M), (-opening, TUNNEL_HEIGHT_M)]
+    meshes.append(swept(line, [line.length - 0.5, line.length], end, dark, name="tunnel end", kind="tunnel"))
+    return meshes, s_portal
+
+
+def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density = case.scene.density
+
+    def block(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
+        width, depth = float(r.uniform(12.0, 28.0)), float(r.uniform(10.0, 18.0))
+        height = float(r.choice([9.6, 12.8, 16.0, 19.2, 25.6]))
+        shop = bool(r.random() < 0.5)
+        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop)
+
+    meshes = streetlights(network, clear, 30.0, emissive=is_night(case.sun.altitude))
+    if density > 0:  # a few street trees first; the blocks fill the frontage around them
+        meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
+                           conifer_share=0.1)
+        meshes += rows_of(network, clear, rng, block, (0.5, 2.5), (1.0 / density, 10.0 / density), "building")
+    return meshes
+
+
+def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density = case.scene.density
+    if density <= 0:
+        return []
+
+    def home(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
+        width, depth = float(r.uniform(8.0, 14.0)), float(r.uniform(7.0, 10.0))
+        return width, depth, lambda: props.house(r, width, depth)
+
+    meshes = greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
+    meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
+    return meshes
+
+
+def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    meshes = barriers(network, clear)
+    if case.scene.density > 0:
+        meshes += greenery(network, clear, rng, 22.0 / case.scene.density, (6.0, 35.0), bush_share=0.35,
+                           conifer_share=0.5)
+    return meshes
+
+
+def _rural(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density = case.scene.density
+    if density <= 0:
+        return []
+
+    def farm(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
+        width, depth = float(r.uniform(9.0, 16.0)), float(r.uniform(7.0, 11.0))
+        return width, depth, lambda: props.house(r, width, depth, storeys=1, name="farmhouse")
+
+    meshes = greenery(network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)
+    meshes += rows_of(network, clear, rng, farm, (25.0, 45.0), (90.0 / density, 200.0 / density), "farmhouse")
+    return meshes
+
+
+def _tunnel_approach(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    meshes, s_portal = tunnel(case, network, rng)
+    clear.closed_s.append((s_portal - 11.0, network.main.line.length))  # the hill claims the ground
+    if case.scene.density > 0:
+        meshes += greenery(network, clear, rng, 12.0 / case.scene.density, (0.5, 20.0), bush_share=0.5,
+                           conifer_share=0.6)
+    return meshes
+
+
+SCENES: dict[str, Callable[[Case, RoadNetwork, np.random.Generator, Clearance], list[Mesh]]] = {
+    "urban": _urban,
+    "suburban": _suburban,
+    "highway": _highway,
+    "rural": _rural,
+    "tunnel_approach": _tunnel_approach,
+}
+
+
+def roadside_meshes(case: Case, network: RoadNetwork, rng: np.random.Generator) -> list[Mesh]:
+    """World-frame meshes of everything beside the road for the case's scene kind and density."""
+    return SCENES[case.scene.kind](case, network, rng, Clearance(network))
