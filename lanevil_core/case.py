@@ -25,9 +25,6 @@ SCHEMA_VERSION: Literal[1] = 1
 PAINT_WIDTH_M = 0.15
 DASH_M = 3.0
 GAP_M = 9.0
-DOUBLE_LINE_SPACING_M = 0.12  # clear space between the two lines of a double marking
-BOTTS_DOT_DIAMETER_M = 0.12
-BOTTS_DOT_SPACING_M = 1.2
 
 
 class _Model(BaseModel):

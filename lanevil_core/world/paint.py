@@ -10,12 +10,19 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..case import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, DOUBLE_LINE_SPACING_M, Marking, Road
 from ..typed import Float32Array, FloatArray, IntArray
 from .road_layout import RoadNetwork
+
+if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
+    from ..case import Marking, Road
+
+DOUBLE_LINE_SPACING_M = 0.12  # clear space between the two lines of a double marking
+BOTTS_DOT_DIAMETER_M = 0.12
+BOTTS_DOT_SPACING_M = 1.2
 
 # Linear albedo of the cross-section materials (index = typed.MATERIALS).
 MATERIAL_ALBEDO = np.array([

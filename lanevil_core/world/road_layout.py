@@ -8,12 +8,15 @@ right, in the +s direction): boundary k sits at ``t = (n - k) * lane_width``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..case import Road
 from ..typed import FloatArray, Material, SceneKind
 from .road_geometry import GradeChange, Piece, ReferenceLine
+
+if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
+    from ..case import Road
 
 LEAD_IN_M = 40.0  # straight road before any bend or slope starts
 TRANSITION_M = 30.0  # clothoid length between line and arc

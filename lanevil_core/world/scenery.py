@@ -9,16 +9,19 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..case import Case
 from ..typed import FloatArray
 from . import props
 from .environment import is_night
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
+
+if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
+    from ..case import Case
 
 CLEAR_MARGIN_M = 0.3  # free space kept between a prop's footprint and any road corridor
 GROUP_LENGTH_M = 100.0  # small props (trees, bushes, barriers) are merged into one mesh per side and stretch

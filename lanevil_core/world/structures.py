@@ -15,7 +15,7 @@ height of the ground there above the carriageway surface (see ``ground_height``)
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -23,10 +23,8 @@ import trimesh
 from ..typed import FloatArray, IntArray
 from .primitives import merge, to_mesh
 from .road_geometry import ReferenceLine
+from .road_layout import RoadPiece
 from .scene import Mesh
-
-if TYPE_CHECKING:  # road_layout imports the case model, which imports the illusions that import this module
-    from .road_layout import RoadPiece
 
 Color = tuple[float, float, float]
 SlotDirection = Literal["s", "t"]  # slots of a deck run along the road (s) or across it (t)

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from lanevil_core.camera import ego_camera
-from lanevil_core.case import DOUBLE_LINE_SPACING_M
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.labels import lanes as L
 from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.paint import DOUBLE_LINE_SPACING_M
 from lanevil_core.world.scene import FIRST_OBJECT_ID, ID_ROAD
 
 
