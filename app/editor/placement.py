@@ -17,6 +17,7 @@ import numpy as np
 from lanevil_core.case import Case
 from lanevil_core.illusions import Illusion
 from lanevil_core.illusions.shadow import roadside_t
+from lanevil_core.pipeline.compile import ego_drive
 from lanevil_core.typed import FloatArray
 from lanevil_core.world.road_geometry import ReferenceLine
 from lanevil_core.world.road_layout import RoadNetwork
@@ -142,7 +143,8 @@ def anchor_road(illusion: Illusion, case: Case, network: RoadNetwork) -> tuple[f
     """(s_road, t_road) where the editor draws an illusion's handle: its start along the road and, for types
     standing on one side, that side's edge (plus its offset); otherwise the ego's lane centre."""
     first_s = getattr(illusion, "first_s", None)
-    s_road = float(first_s(case) if callable(first_s) else illusion.start_s(case))
+    drive = ego_drive(case)
+    s_road = float(first_s(drive) if callable(first_s) else illusion.start_s(drive))
     side = getattr(illusion, "side", None)
     if side in ("left", "right"):
         sign = 1.0 if side == "left" else -1.0

@@ -8,7 +8,7 @@ from pydantic import Field
 
 # Import order is registry order: the benchmark's category order.
 from . import road_damage, traffic, shadow, reflection  # noqa: F401  # isort: skip
-from .base import CATEGORIES, REGISTRY, Category, CompileContext, Illusion, MeshFileError, register
+from .base import CATEGORIES, REGISTRY, Category, CompileContext, EgoDrive, Illusion, MeshFileError, register
 
 ILLUSION_TYPES: tuple[str, ...] = tuple(REGISTRY)
 
@@ -28,6 +28,7 @@ __all__ = [
     "REGISTRY",
     "Category",
     "CompileContext",
+    "EgoDrive",
     "Illusion",
     "MeshFileError",
     "IllusionSpec",

@@ -15,7 +15,6 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
 
 if TYPE_CHECKING:
-    from ..case import Case
     from ..world.road_layout import RoadNetwork
     from ..world.scene import Environment, Mesh, PointLight, SurfaceLayer
 
@@ -26,11 +25,23 @@ CATEGORIES: tuple[Category, ...] = ("road_damage", "traffic", "shadow", "reflect
 DEFAULT_AHEAD_M = 22.0
 
 
+@dataclass(frozen=True)
+class EgoDrive:
+    """What an illusion reads of its case: the ego's lane and its scripted drive along the main road."""
+
+    lane: int  # the ego's lane of its direction, 0 = next to the centre line
+    start_s: float  # where the drive starts on the main road (m)
+    end_s: float  # where the ego is at the last frame (m)
+    road_length: float  # the case's road length (m)
+
+
 @dataclass
 class CompileContext:
-    """What an illusion may read (case, road) and add to (meshes, layers, lights, environment)."""
+    """What an illusion may read (the case's seed, the ego's drive, the road) and add to (meshes, layers, lights,
+    environment). Built by ``compile_scene`` from the case, so the illusions need not know the case model."""
 
-    case: Case
+    seed: int  # the case's seed
+    drive: EgoDrive
     network: RoadNetwork
     env: Environment
     meshes: list[Mesh] = field(default_factory=list)
@@ -41,7 +52,7 @@ class CompileContext:
 
     def rng(self, seed: int) -> np.random.Generator:
         """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""
-        return np.random.default_rng([self.case.seed, self.source + 1, seed])
+        return np.random.default_rng([self.seed, self.source + 1, seed])
 
     def add_mesh(self, mesh: Mesh) -> None:
         mesh.source = self.source
@@ -90,9 +101,9 @@ class Illusion(BaseModel):
         """The severity table row of this illusion's level (subclasses narrow the type to their row's)."""
         return self.SEVERITY[self.severity - 1]
 
-    def start_s(self, case: Case) -> float:
+    def start_s(self, drive: EgoDrive) -> float:
         """Where along the road the illusion starts."""
-        return self.s if self.s is not None else case.ego.start_s + DEFAULT_AHEAD_M
+        return self.s if self.s is not None else drive.start_s + DEFAULT_AHEAD_M
 
     def compile(self, ctx: CompileContext) -> None:  # pragma: no cover - every registered type overrides
         raise TypeError(f"{type(self).__name__} does not define compile()")

@@ -64,8 +64,8 @@ def _wet_road(ctx: CompileContext, rng: np.random.Generator, s0: float, length: 
 
 
 def _drive_end(ctx: CompileContext) -> float:
-    case = ctx.case
-    return min(case.ego_s(case.ego.frames - 1) + 80.0, case.road.length)
+    drive = ctx.drive
+    return min(drive.end_s + 80.0, drive.road_length)
 
 
 def _road_heading_deg(ctx: CompileContext, s: float) -> float:
@@ -113,7 +113,7 @@ class SunlightReflection(Illusion):
 
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
-        s0 = self.start_s(ctx.case) - 20.0
+        s0 = self.start_s(ctx.drive) - 20.0
         heading = _road_heading_deg(ctx, s0 + 40.0)
         _set_sun(ctx, heading + self.sun_offset, level.sun_altitude, level.sun_intensity)
         ctx.env.penumbra = min(ctx.env.penumbra, 0.01)
@@ -172,7 +172,7 @@ class StreetlightReflection(Illusion):
         env.sky_zenith = (NIGHT_ZENITH + (env.sky_zenith - NIGHT_ZENITH) * dusk).astype(np.float32)
         env.sky_horizon = (NIGHT_HORIZON + (env.sky_horizon - NIGHT_HORIZON) * dusk).astype(np.float32)
         env.headlights = HEADLIGHT_INTENSITY if self.headlights else 0.0
-        s0 = max(self.start_s(ctx.case) - 20.0, 0.0)
+        s0 = max(self.start_s(ctx.drive) - 20.0, 0.0)
         s1 = s0 + self.length if self.length is not None else _drive_end(ctx)
         spacing = self.spacing if self.spacing is not None else level.spacing
         color = LAMP_COLORS[self.lamp_color]
@@ -230,7 +230,7 @@ class VehicleReflection(Illusion):
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         rng = ctx.rng(self.seed)
-        s_first = self.s if self.s is not None else ctx.case.ego.start_s + VEHICLE_AHEAD_M
+        s_first = self.s if self.s is not None else ctx.drive.start_s + VEHICLE_AHEAD_M
         piece = ctx.network.main
         heading = _road_heading_deg(ctx, s_first)
         _set_sun(ctx, heading + 20.0, level.sun_altitude, 1.3)
@@ -238,7 +238,7 @@ class VehicleReflection(Illusion):
         lanes = ctx.network.lanes_per_direction
         palette = ((0.02, 0.02, 0.025), (0.6, 0.6, 0.62), (0.35, 0.02, 0.02), (0.02, 0.06, 0.25), (0.8, 0.8, 0.78))
         for k in range(count):
-            lane = (ctx.case.ego.lane + k) % lanes
+            lane = (ctx.drive.lane + k) % lanes
             s = s_first + k * self.gap * (0.6 if k % 2 else 1.0) + float(rng.uniform(0.0, 3.0))
             t = ctx.network.lane_center_t(lane) + float(rng.uniform(-0.3, 0.3))
             paint = self.color if self.color is not None else palette[int(rng.integers(len(palette)))]

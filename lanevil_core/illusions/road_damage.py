@@ -15,11 +15,12 @@ from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
 from ..world import surface_textures as tex
 from ..world.environment import sun_direction
+from ..world.paint import MATERIAL_ALBEDO
 from ..world.scene import SurfaceLayer
-from .base import Category, CompileContext, Illusion, Level, register
+from ..world.structures import ground_height, guard_rail
+from .base import Category, CompileContext, EgoDrive, Illusion, Level, register
 
 if TYPE_CHECKING:
-    from ..case import Case
     from ..typed import Float32Array
 
 MAX_LAYER_TEXELS = 4_000_000  # one SurfaceLayer's texture at most; longer damage is split along s
@@ -52,14 +53,14 @@ class _SurfaceDamage(Illusion):
     extent: StrictFloat = Field(80.0, gt=0, le=400, description="length along the road (m)")
     margin: StrictFloat = Field(0.5, ge=0, le=5, description="reach beyond each carriageway edge (m)")
 
-    def start_s(self, case: Case) -> float:
+    def start_s(self, drive: EgoDrive) -> float:
         """Where along the road the damage starts: by default where the ego camera's view of the road begins."""
-        return self.s if self.s is not None else case.ego.start_s + NEAR_AHEAD_M
+        return self.s if self.s is not None else drive.start_s + NEAR_AHEAD_M
 
     def _area(self, ctx: CompileContext) -> _Area | None:
         """Where the texture lies, or None when nothing of the road is left past the start."""
         main = ctx.network.main
-        s0 = self.start_s(ctx.case)
+        s0 = self.start_s(ctx.drive)
         s1 = min(s0 + self.extent, main.line.length)
         t0 = -main.half_width - self.margin
         rows = int(np.floor((s1 - s0) / self.TEXEL))
@@ -87,7 +88,7 @@ def _setting(illusion: Illusion, key: str) -> Any:
 
 
 def _ego_center_t(ctx: CompileContext) -> float:
-    return ctx.network.lane_center_t(ctx.case.ego.lane)
+    return ctx.network.lane_center_t(ctx.drive.lane)
 
 
 def _lines_near_ego(ctx: CompileContext) -> list[float]:
@@ -185,8 +186,6 @@ class RoadCrack(_SurfaceDamage):
         self._emit(ctx, area, layers.cracks, layers.wet, over_paint=True, name="cracks")
         wear = _setting(self, "paint_wear")
         if wear > 0:
-            from ..world.paint import MATERIAL_ALBEDO  # paint -> case -> illusions: circular at import time
-
             rgba, _ = tex.worn_paint(np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape, area.texel,
                                      [area.local_t(t) for t in lines], wear, MATERIAL_ALBEDO[0])
             self._emit(ctx, area, rgba, None, over_paint=True, name="worn paint")
@@ -426,16 +425,13 @@ class GuardRail(Illusion):
         """This illusion's row of ``SEVERITY``."""
         return self.SEVERITY[self.severity - 1]
 
-    def start_s(self, case: Case) -> float:
+    def start_s(self, drive: EgoDrive) -> float:
         """Where along the road the rails start: by default beside the ego, so they line the whole view."""
-        return self.s if self.s is not None else case.ego.start_s
+        return self.s if self.s is not None else drive.start_s
 
     def compile(self, ctx: CompileContext) -> None:
-        # Imported here: structures -> road_layout -> case -> illusions would be circular at import time.
-        from ..world.structures import ground_height, guard_rail
-
         main = ctx.network.main
-        s0 = self.start_s(ctx.case)
+        s0 = self.start_s(ctx.drive)
         s1 = min(s0 + self.extent, main.line.length)
         if s1 - s0 < 1.0:
             return

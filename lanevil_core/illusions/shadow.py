@@ -29,10 +29,9 @@ from ..world.structures import (
     power_lines,
     streetlight,
 )
-from .base import Category, CompileContext, Illusion, Level, register
+from .base import Category, CompileContext, EgoDrive, Illusion, Level, register
 
 if TYPE_CHECKING:
-    from ..case import Case
     from ..world.road_geometry import ReferenceLine
     from ..world.road_layout import RoadPiece
 
@@ -109,11 +108,11 @@ class SunShadowIllusion(Illusion):
         ctx.env.sun_intensity = float(level.sun_intensity if self.sun_intensity is None else self.sun_intensity)
         ctx.env.penumbra = float(level.penumbra)
 
-    def extent(self, case: Case, length: float | None) -> tuple[float, float]:
+    def extent(self, drive: EgoDrive, length: float | None) -> tuple[float, float]:
         """(s0, s1) along the main road: from ``start_s`` over ``length``, or to past the end of the drive."""
-        s0 = self.start_s(case)
-        s1 = s0 + length if length is not None else case.ego_s(case.ego.frames - 1) + BEYOND_DRIVE_M
-        s1 = min(s1, case.road.length - ROAD_END_MARGIN_M)
+        s0 = self.start_s(drive)
+        s1 = s0 + length if length is not None else drive.end_s + BEYOND_DRIVE_M
+        s1 = min(s1, drive.road_length - ROAD_END_MARGIN_M)
         return s0, max(s1, s0 + 1.0)
 
 
@@ -204,7 +203,7 @@ class StreetlightShadow(SunShadowIllusion):
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         piece = ctx.network.main
-        s0, s1 = self.extent(ctx.case, self.length)
+        s0, s1 = self.extent(ctx.drive, self.length)
         spacing = self.spacing if self.spacing is not None else level.spacing
         signs = (-1.0, 1.0) if self.side == "both" else (side_sign(self.side),)
         self.apply_sun(ctx, s0, signs[0])
@@ -265,7 +264,7 @@ class FenceShadow(SunShadowIllusion):
         level = self.level()
         piece = ctx.network.main
         sign = side_sign(self.side)
-        s0, s1 = self.extent(ctx.case, self.length)
+        s0, s1 = self.extent(ctx.drive, self.length)
         self.apply_sun(ctx, s0, sign)
         t_fence = roadside_t(piece, self.offset, sign)
         for index, (a, b) in enumerate(clear_runs(s0, s1, t_fence, blocked(ctx, piece))):
@@ -320,8 +319,8 @@ class RailShadow(SunShadowIllusion):
         level = self.level()
         piece = ctx.network.main
         deck_length = self.deck_length if self.deck_length is not None else level.deck_length
-        s_center = min(self.start_s(ctx.case) + deck_length / 2,
-                       ctx.case.road.length - ROAD_END_MARGIN_M - deck_length / 2)
+        s_center = min(self.start_s(ctx.drive) + deck_length / 2,
+                       ctx.drive.road_length - ROAD_END_MARGIN_M - deck_length / 2)
         self.apply_sun(ctx, s_center, side_sign(self.side))
         span = 2.0 * abs(roadside_t(piece, self.margin, 1.0))
         ctx.add_mesh(overhead_rail(piece.line, s_center, span, deck_length, level.slot_width, level.slot_pitch,
@@ -382,7 +381,7 @@ class WireShadow(SunShadowIllusion):
         level = self.level()
         piece = ctx.network.main
         sign = side_sign(self.side)
-        s0, s1 = self.extent(ctx.case, self.length)
+        s0, s1 = self.extent(ctx.drive, self.length)
         t_row = roadside_t(piece, self.offset, sign)
         sag = 0.25 + 0.01 * self.pole_spacing
         self.apply_sun(ctx, s0, sign, self._sun_ahead(ctx, t_row, level.height - sag / 2))
@@ -397,7 +396,7 @@ class WireShadow(SunShadowIllusion):
     def _sun_ahead(self, ctx: CompileContext, t_row: float, height: float) -> float:
         """Degrees ahead of square-on that put the shadow of wires ``height`` m up at ``t_row`` on the centre of
         the ego's lane (as far across as the sun's altitude allows)."""
-        t_target = ctx.network.lane_center_t(ctx.case.ego.lane)
+        t_target = ctx.network.lane_center_t(ctx.drive.lane)
         reach = abs(t_row - t_target)
         along = reach * np.tan(np.radians(self.altitude())) / height  # cos(ahead) that lands the shadow there
         return float(np.degrees(np.arccos(np.clip(along, np.cos(np.radians(MAX_AHEAD_DEG)), 1.0))))

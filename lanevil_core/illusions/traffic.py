@@ -28,10 +28,9 @@ from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 from ..world import props
 from ..world.primitives import pose_on_road, rotation_z, to_mesh, transformed
 from ..world.scene import Mesh
-from .base import Category, CompileContext, Illusion, Level, MeshFileError, register
+from .base import Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
 
 if TYPE_CHECKING:
-    from ..case import Case
     from ..typed import FloatArray
     from ..world.road_layout import RoadPiece
 
@@ -71,9 +70,8 @@ class Slot:
 class Footprints:
     """The ego's free path and the ground participants took so far, in the main road's (s, t) frame."""
 
-    def __init__(self, case: Case, t_ego: float) -> None:
-        end_s = case.ego_s(case.ego.frames - 1)
-        self.path_s = (case.ego.start_s - 3.0, end_s + EGO_CLEAR_AHEAD_M)
+    def __init__(self, drive: EgoDrive, t_ego: float) -> None:
+        self.path_s = (drive.start_s - 3.0, drive.end_s + EGO_CLEAR_AHEAD_M)
         self.t_ego = t_ego
         self.taken: list[tuple[float, float, float, float]] = []  # s, t, half extents along s and t
 
@@ -148,21 +146,21 @@ class TrafficIllusion(Illusion):
     def participants(self) -> int:
         return int(self.level().count if self.count is None else self.count)
 
-    def first_s(self, case: Case) -> float:
+    def first_s(self, drive: EgoDrive) -> float:
         """Where the first group stands: ``s`` if given, else ``distance`` (or the table's) ahead of the start."""
         if self.s is not None:
             return self.s
-        return case.ego.start_s + float(self.level().distance if self.distance is None else self.distance)
+        return drive.start_s + float(self.level().distance if self.distance is None else self.distance)
 
     def group_stations(self, ctx: CompileContext, groups: int) -> list[float]:
         """s of every group: from the first, ``spacing`` apart, or spread evenly up to ``BEYOND_DRIVE_M`` past
         the ego's last position."""
-        case, length = ctx.case, ctx.network.main.line.length
-        first = self.first_s(case)
+        drive, length = ctx.drive, ctx.network.main.line.length
+        first = self.first_s(drive)
         if self.spacing is not None:
             step = self.spacing
         else:
-            reach = case.ego_s(case.ego.frames - 1) + BEYOND_DRIVE_M
+            reach = drive.end_s + BEYOND_DRIVE_M
             step = max((reach - first) / max(groups - 1, 1), 8.0)
         stations = [first + k * step for k in range(groups)]
         return [s for s in stations if s < length - ROAD_END_MARGIN_M]
@@ -207,7 +205,7 @@ class TrafficIllusion(Illusion):
                   follow_grade: bool = True) -> None:
         """Build participant ``index`` with ``make`` for every slot and put it there, squeezed off the ego's path
         and inside the paved road (slots with no room are skipped)."""
-        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        free = Footprints(ctx.drive, ctx.network.lane_center_t(ctx.drive.lane))
         for index, slot in enumerate(slots):
             mesh = make(index)
             placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
@@ -247,14 +245,14 @@ def paved_reach(piece: RoadPiece) -> float:
 
 def line_order(ctx: CompileContext) -> list[float]:
     """t of the main road's lane lines nearest the ego's lane centre first (the ego lane's own lines lead)."""
-    t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+    t_ego = ctx.network.lane_center_t(ctx.drive.lane)
     boundaries = [float(t) for t in ctx.network.main.boundaries_t]
     return sorted(boundaries, key=lambda t: (abs(t - t_ego), t))
 
 
 def lane_centres(ctx: CompileContext) -> list[float]:
     """t of every lane centre of both directions, nearest the ego's lane first (the ego lane itself last)."""
-    t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+    t_ego = ctx.network.lane_center_t(ctx.drive.lane)
     b = ctx.network.main.boundaries_t
     centres = [float(t) for t in 0.5 * (b[:-1] + b[1:]) if abs(t - t_ego) > 1e-6]
     return sorted(centres, key=lambda t: (abs(t - t_ego), t)) + [t_ego]
@@ -428,7 +426,7 @@ class Vehicle(TrafficIllusion):
         lane_change = float(level.lane_change if self.lane_change is None else self.lane_change)
         total = self.participants()
         stations = self.group_stations(ctx, math.ceil(total / per_row))
-        free = Footprints(ctx.case, ctx.network.lane_center_t(ctx.case.ego.lane))
+        free = Footprints(ctx.drive, ctx.network.lane_center_t(ctx.drive.lane))
         loaded = self.load_mesh(ctx) if self.mesh_file else None
         index = 0
         for row, s in enumerate(stations):
@@ -448,10 +446,10 @@ class Vehicle(TrafficIllusion):
 
     def _row_lanes(self, ctx: CompileContext, s: float, per_row: int, row: int) -> list[float]:
         """Lane centres (t) of one row: lanes beside the ego's, the ego's own only past its free path."""
-        network, case = ctx.network, ctx.case
+        network, drive = ctx.network, ctx.drive
         n = network.lanes_per_direction
-        ego_index = n + case.ego.lane  # lanes numbered left to right over both directions
-        free_beyond = case.ego_s(case.ego.frames - 1) + EGO_CLEAR_AHEAD_M + VEHICLE_SIZE["truck"][0]
+        ego_index = n + drive.lane  # lanes numbered left to right over both directions
+        free_beyond = drive.end_s + EGO_CLEAR_AHEAD_M + VEHICLE_SIZE["truck"][0]
         lanes = []
         for offset in self.LANE_ORDER:
             j = ego_index + offset
@@ -466,7 +464,7 @@ class Vehicle(TrafficIllusion):
         yaw = 0.0 if lane_t < 0 else np.pi
         t = lane_t + rng.uniform(-0.25, 0.25)
         if changing:
-            t_ego = ctx.network.lane_center_t(ctx.case.ego.lane)
+            t_ego = ctx.network.lane_center_t(ctx.drive.lane)
             inner = [float(b) for b in ctx.network.main.boundaries_t[1:-1]
                      if abs(abs(b - lane_t) - ctx.network.lane_width / 2) < 1e-6
                      and abs(abs(b - t_ego) - ctx.network.lane_width / 2) > 1e-6]

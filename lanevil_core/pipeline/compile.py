@@ -10,7 +10,7 @@ import numpy as np
 
 from ..camera import ego_path
 from ..case import Case
-from ..illusions import CompileContext, MeshFileError
+from ..illusions import CompileContext, EgoDrive, MeshFileError
 from ..illusions.traffic import mesh_path
 from ..world.environment import environment_for, is_night
 from ..world.paint import road_paint
@@ -52,6 +52,12 @@ def check_mesh_files(case: Case, meshes_dir: Path | None) -> None:
             raise MeshFileError(field, str(error)) from None
 
 
+def ego_drive(case: Case) -> EgoDrive:
+    """What the illusions read of the case's ego: its lane and its drive along the main road."""
+    return EgoDrive(lane=case.ego.lane, start_s=case.ego.start_s, end_s=case.ego_s(case.ego.frames - 1),
+                    road_length=case.road.length)
+
+
 def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir: Path | None = None) -> CompiledScene:
     """Build the network, the roadside props and every illusion's scene elements.
 
@@ -62,7 +68,8 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     as they are and only the environment and illusions are compiled anew; the result equals a full compile.
     """
     network, roadside = _roadside(case, reuse)
-    ctx = CompileContext(case=case, network=network, env=environment_for(case), meshes_dir=meshes_dir)
+    ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
+                         meshes_dir=meshes_dir)
     ctx.meshes.extend(roadside)
     for index, illusion in enumerate(case.illusions):
         ctx.source = index

@@ -28,7 +28,7 @@ from lanevil_core.drive import (
 )
 from lanevil_core.drive.lane_estimate import LanePath
 from lanevil_core.labels.lanes import h_samples_for, lane_labels, tusimple_columns
-from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.pipeline.compile import compile_scene, ego_drive
 from lanevil_core.world.road_layout import build_network
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -184,7 +184,7 @@ def test_illusion_span_covers_the_illusion():
 
     case = load_case(SCENES / "10_road_damage" / "tire_marks" / "00_straight_highway_noon" / "03_level3.json")
     s0, s1 = illusion_span(compile_scene(case))
-    start = case.illusions[0].start_s(case)
+    start = case.illusions[0].start_s(ego_drive(case))
     assert s0 == pytest.approx(start, abs=2.0) and s1 > s0 + 10
     assert illusion_span(compile_scene(load_case(SCENES / "00_clean" / "00_straight_urban.json"))) is None
 

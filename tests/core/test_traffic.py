@@ -15,6 +15,7 @@ from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, case_meshes_dir, parse_case
 from lanevil_core.illusions import REGISTRY, CompileContext, MeshFileError
 from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
+from lanevil_core.pipeline.compile import ego_drive
 from lanevil_core.world.environment import environment_for
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
@@ -26,7 +27,8 @@ def compiled(spec: dict, meshes_dir: Path | None = None, **case: object) -> tupl
     """Compile one illusion on its own (no roadside) into a fresh context."""
     model = Case.model_validate({"illusions": [spec], **case})
     network = build_network(model.road, model.scene.kind)
-    ctx = CompileContext(case=model, network=network, env=environment_for(model), source=0, meshes_dir=meshes_dir)
+    ctx = CompileContext(seed=model.seed, drive=ego_drive(model), network=network, env=environment_for(model),
+                         source=0, meshes_dir=meshes_dir)
     model.illusions[0].compile(ctx)
     return model, ctx
 
@@ -262,7 +264,7 @@ def test_the_cli_reads_meshes_beside_the_case_file(tmp_path: Path) -> None:
 
 def test_someone_on_an_edge_line_stands_just_inside_the_paved_edge() -> None:
     case = Case()
-    free = Footprints(case, t_ego=-1.75)
+    free = Footprints(ego_drive(case), t_ego=-1.75)
     placed = free.place(Slot(40.0, -7.0, 0.0), 0.3, 0.4, reach=7.2)
     assert placed is not None and placed.t == pytest.approx(-6.8)  # squeezed in, still on the edge line
     assert free.place(Slot(60.0, -7.5, 0.0), 0.3, 0.4, reach=7.2) is None  # standing off the road: dropped
