@@ -110,7 +110,7 @@ def test_stock_library_matches_its_source() -> None:
 
     lib = library()
     on_disk = {str(p.relative_to(ROOT / "scenes")): p.read_text() for p in _scene_files()}
-    assert set(on_disk) == set(lib), "run `lanevil library --out scenes` after changing lanevil_core/stock.py"
+    assert set(on_disk) == set(lib), "run `lanevil library --out scenes` after changing lanevil_core/library/stock.py"
     for relative, case in lib.items():
         assert on_disk[relative] == case_json(case), relative
 
