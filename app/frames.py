@@ -320,6 +320,28 @@ class FrameService:
         self._release(key)
         return cached
 
+    def draft(self, case: Case, index: int, size: tuple[int, int], overlay: bool = False) -> RenderedFrame:
+        """A quick look at frame ``index`` of ``case`` at ``size``: the same compiled scene, lens and bonnet, but
+        without the camera's sensor stage (auto-exposure, motion blur, noise, sharpening), so colours differ from
+        ``frame``'s where the case has a sensor. For the editor's draft quality while a slider moves; cached apart
+        from exact frames (its key ends in ``:draft``)."""
+        key = f"{self.frame_key(case, index, size, overlay)}:draft"
+        cached = self.frames.get(key)
+        if cached is not None:
+            return cached
+        with self.slots.hold():
+            scene = self.scene(case)
+            # The same scene (and its renderer cache: packed triangles, shadow maps) seen by a camera without sensor.
+            ego = replace(scene.ego, mount=scene.ego.mount.model_copy(update={"sensor": None}))
+            frame = render_frame(replace(scene, ego=ego), index, size, threads=self.threads)
+            self.renders += 1
+            record = tusimple_record(scene, index, frame, raw_file=frame_file(index))
+        rgb = draw_lanes(frame.rgb, record) if overlay else np.ascontiguousarray(frame.rgb)
+        rgb.setflags(write=False)
+        drafted = RenderedFrame(rgb, record, key)
+        self.frames.put(key, drafted)
+        return drafted
+
     def _render(self, case: Case, index: int, size: tuple[int, int], overlay: bool, detector: str | None,
                 key: str) -> RenderedFrame:
         if detector:  # detected lanes as bands on the plain frame, the labels' dots (if asked) on top of them

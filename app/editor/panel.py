@@ -1,6 +1,6 @@
 """The editor's control panel: every input, with short help, laid out in folders (no behaviour here).
 
-``build_panel`` creates the inputs in the shared (all-tabs) GUI and returns their handles; ``editor.Editor`` wires
+``build_panel`` creates the inputs in one browser tab's GUI and returns their handles; ``tab.EditorTab`` wires
 their callbacks. Inputs start at sensible defaults and carry hover hints.
 """
 
@@ -17,7 +17,7 @@ from lanevil_core.typed import ROAD_TYPES, SCENE_KINDS
 
 from .detection import DETECTOR_CHOICES, NO_DETECTOR
 from .params import ParamInputs
-from .preview import PREVIEW_SIZE
+from .preview import PREVIEW_SIZE, QUALITIES
 
 MESH_TYPES = ".glb,.gltf,.obj"  # what the upload dialog offers
 PLACE_OFF = "(pick a type, then click the road)"
@@ -73,6 +73,7 @@ class Panel:
     play: viser.GuiCheckboxHandle
     overlay: viser.GuiCheckboxHandle
     detector: viser.GuiDropdownHandle
+    quality: viser.GuiDropdownHandle
     preview: viser.GuiImageHandle
     preview_info: viser.GuiMarkdownHandle
     detection: viser.GuiMarkdownHandle
@@ -99,6 +100,9 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         detector = gui.add_dropdown("Detector", list(DETECTOR_CHOICES), initial_value=NO_DETECTOR,
                                     hint="run a lane detector on the preview: its lanes in magenta, its TuSimple "
                                          "accuracy / FP / FN under the picture")
+        quality = gui.add_dropdown("Quality", list(QUALITIES), initial_value="draft",
+                                   hint="draft: while a slider moves, a quick half-size preview without the camera's "
+                                        "sensor stage, then the exact frame once it rests; full: only exact frames")
     with gui.add_folder("Case"):
         case_id = gui.add_dropdown("Open", case_ids or ["(no cases)"], hint="stored cases; choosing one opens it")
         title = gui.add_text("Title", "", hint="the case's title (saved with it)")
@@ -157,6 +161,6 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
                  camera_preset=camera_preset, camera_fov=camera_fov, camera_height=camera_height,
                  camera_pitch=camera_pitch, camera_roll=camera_roll, camera_k1=camera_k1, camera_bonnet=camera_bonnet,
                  camera_sensor=camera_sensor, camera_exposure=camera_exposure, camera_noise=camera_noise, frame=frame,
-                 play=play, overlay=overlay, detector=detector, preview=preview,
+                 play=play, overlay=overlay, detector=detector, quality=quality, preview=preview,
                  preview_info=preview_info, detection=detection,
                  export_case=export_case, export_frame=export_frame, export_sequence=export_sequence)

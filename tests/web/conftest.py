@@ -14,7 +14,7 @@ import uvicorn
 from fastapi import FastAPI
 from fastapi.testclient import TestClient
 
-from app.editor import Editor, launch_editor
+from app.editor import Editor, EditorTab, HeadlessTab, launch_editor
 from app.main import create_app
 from app.server import bind
 from app.settings import Settings
@@ -126,9 +126,16 @@ EDITOR_START_S = 120.0  # the first preview compiles the numba kernels on a cold
 
 
 @pytest.fixture
-def editor(state: AppState) -> Iterator[Editor]:
-    """The viser editor on the test store (a free port), its first preview rendered; stopped afterwards."""
+def editor_server(state: AppState) -> Iterator[Editor]:
+    """The viser editor on the test store (a free port), no tab open yet; stopped afterwards."""
     editor = launch_editor(state, host="127.0.0.1", port=0)
-    assert editor.preview.wait_idle(EDITOR_START_S)
     yield editor
     editor.stop()
+
+
+@pytest.fixture
+def tab(editor_server: Editor) -> Iterator[EditorTab]:
+    """One tab of the editor (a headless websocket client), its first preview rendered."""
+    with HeadlessTab(editor_server, timeout=EDITOR_START_S) as tab:
+        assert tab.preview.wait_idle(EDITOR_START_S)
+        yield tab
