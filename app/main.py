@@ -41,14 +41,14 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     api_openapi.install(app, STUDY_SCHEMAS)
     mount_static(app)
     app.state.editor_port = None  # set by the server once the viser editor listens
-    app.state.open_in_editor = None  # the editor's open_case(case_id), set with editor_port
+    app.state.open_in_editor = None  # the editor's open_case(case_id) for the next tab, set with editor_port
     app.add_api_route("/editor", _editor_redirect, methods=["GET"], include_in_schema=False)
     return app
 
 
 def _editor_redirect(request: Request, case: str | None = None) -> Response:
     """``/editor`` -> the viser editor on the same host name, so users need only the backend's address.
-    ``/editor?case=ID`` first opens stored case ``ID`` there (every editor tab shows the same case)."""
+    ``/editor?case=ID`` has the editor tab this redirect opens start on stored case ``ID``."""
     port = request.app.state.editor_port
     if port is None:
         raise HTTPException(503, detail="the editor is not running (start it with `lanevil serve`)")

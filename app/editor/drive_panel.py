@@ -114,7 +114,8 @@ class DrivePanel:
                                  seconds=float(self.seconds.value), size=DEFAULT_SIZE)
         self.fps = case.ego.fps
         self.job = drive_job(self.state.jobs, case, settings,
-                             {"case_id": case_id, "detector": settings.detector, "controller": settings.controller})
+                             {"case_id": case_id, "detector": settings.detector, "controller": settings.controller},
+                             meshes_dir=self.state.meshes_dir)
         self.status.content = f"driving {escape_markdown(case_id)} with **{escape_markdown(settings.detector)}** …"
         threading.Thread(target=self._follow, args=(self.job,), name="lanevil-editor-drive", daemon=True).start()
         return self.job
