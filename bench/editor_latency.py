@@ -1,6 +1,7 @@
 """Editor latency: from a GUI change (a panel handle set, as a browser message would) to the pushed preview image.
 
-Runs the editor in process on a temporary copy of a few stock cases and drives its handles: severity, sun
+Runs the editor in process on a temporary copy of a few stock cases, opens one tab (a headless websocket client,
+in full quality: exact frames only) and drives its handles: severity, sun
 altitude and frame changes, one at a time (each waits for its image) and in bursts (a dragged slider: the
 worker coalesces, and the latency of every change is measured to the first push that covers it). Prints median
 and p95 per kind of change, in milliseconds, and the compile/render split.
@@ -23,7 +24,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from app.editor import Editor, launch_editor  # noqa: E402
+from app.editor import EditorTab, HeadlessTab, launch_editor  # noqa: E402
 from app.settings import Settings  # noqa: E402
 from app.state import AppState  # noqa: E402
 
@@ -33,7 +34,7 @@ CASE_ID = "fence_shadow-03_level3"
 BURST_GAP_S = 0.02  # a slider dragged at 50 updates per second
 
 
-def push_latency_ms(editor: Editor, seq: int, changed_at: float) -> float:
+def push_latency_ms(editor: EditorTab, seq: int, changed_at: float) -> float:
     """Milliseconds from a change to the first pushed image rendered from it or a later state."""
     for pushed_seq, pushed_at in editor.push_log:
         if pushed_seq >= seq:
@@ -41,13 +42,13 @@ def push_latency_ms(editor: Editor, seq: int, changed_at: float) -> float:
     raise RuntimeError(f"request {seq} was never pushed")
 
 
-def change(editor: Editor, handle, value) -> tuple[int, float]:
+def change(editor: EditorTab, handle, value) -> tuple[int, float]:
     changed_at = time.perf_counter()
     handle.value = value
     return editor.preview.latest_seq, changed_at
 
 
-def single(editor: Editor, handle, values) -> list[float]:
+def single(editor: EditorTab, handle, values) -> list[float]:
     latencies = []
     for value in values:
         seq, at = change(editor, handle, value)
@@ -56,7 +57,7 @@ def single(editor: Editor, handle, values) -> list[float]:
     return latencies
 
 
-def burst(editor: Editor, handle, values) -> list[float]:
+def burst(editor: EditorTab, handle, values) -> list[float]:
     marks = []
     for value in values:
         marks.append(change(editor, handle, value))
@@ -81,29 +82,31 @@ def main() -> int:
             (scenes / relative).parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(REPO / "scenes" / relative, scenes / relative)
         state = AppState.open(Settings(data_dir=Path(tmp) / "data", scenes_dir=scenes, port=0, editor_port=0))
-        editor = launch_editor(state, host="127.0.0.1", port=0)
+        server = launch_editor(state, host="127.0.0.1", port=0)
         try:
-            p = editor.panel
-            p.case_id.value = CASE_ID
-            editor.preview.wait_idle(300)
-            p.selected.value = p.selected.options[1]
-            editor.preview.wait_idle(300)
-            n = args.repeats
-            frames = [(i * 7) % 90 + 1 for i in range(n)]
-            severities = [(i % 5) + 1 for i in range(n)]
-            altitudes = [10.0 + 5 * (i % 12) for i in range(n)]
-            single(editor, p.frame, [0, 1])  # warm the kernels and caches
-            results = {
-                "frame": stats(single(editor, p.frame, frames)),
-                "severity": stats(single(editor, p.severity, severities)),
-                "sun_altitude": stats(single(editor, p.sun_altitude, altitudes)),
-                "frame_drag": stats(burst(editor, p.frame, list(range(10, 10 + 2 * n)))),
-                "sun_drag": stats(burst(editor, p.sun_altitude, [20.0 + i for i in range(2 * n)])),
-                "renders_dropped_by_coalescing": editor.preview.dropped,
-                "compiles": {"full": state.frames.full_compiles, "partial": state.frames.partial_compiles},
-            }
+            with HeadlessTab(server, timeout=300) as editor:
+                p = editor.panel
+                p.quality.value = "full"
+                p.case_id.value = CASE_ID
+                editor.preview.wait_idle(300)
+                p.selected.value = p.selected.options[1]
+                editor.preview.wait_idle(300)
+                n = args.repeats
+                frames = [(i * 7) % 90 + 1 for i in range(n)]
+                severities = [(i % 5) + 1 for i in range(n)]
+                altitudes = [10.0 + 5 * (i % 12) for i in range(n)]
+                single(editor, p.frame, [0, 1])  # warm the kernels and caches
+                results = {
+                    "frame": stats(single(editor, p.frame, frames)),
+                    "severity": stats(single(editor, p.severity, severities)),
+                    "sun_altitude": stats(single(editor, p.sun_altitude, altitudes)),
+                    "frame_drag": stats(burst(editor, p.frame, list(range(10, 10 + 2 * n)))),
+                    "sun_drag": stats(burst(editor, p.sun_altitude, [20.0 + i for i in range(2 * n)])),
+                    "renders_dropped_by_coalescing": editor.preview.dropped,
+                    "compiles": {"full": state.frames.full_compiles, "partial": state.frames.partial_compiles},
+                }
         finally:
-            editor.stop()
+            server.stop()
     if args.json:
         print(json.dumps(results, indent=2))
     else:

@@ -589,7 +589,8 @@ class EditorTab:
         return detection_text(found)
 
     def _publish(self, result: PreviewResult) -> None:
-        """Push the preview image first (latency), then bring the 3D view up to the same state."""
+        """Push the preview image first (latency), then bring the 3D view up to the same state (after the exact
+        frame only: a draft's state is about to be replaced by the next one or refined)."""
         self.panel.preview.image = result.rgb
         self.push_log.append((result.request.seq, time.perf_counter()))
         self.last_result = result
@@ -598,8 +599,9 @@ class EditorTab:
         kind = "draft " if result.request.draft else ""
         self.panel.preview_info.content = (f"Frame {result.request.frame} · {kind}{result.rgb.shape[1]}×"
                                            f"{result.rgb.shape[0]} · {timing}")
-        if not result.request.draft:  # a draft runs no detector: the score line waits for the exact frame
-            self.panel.detection.content = self._detection_text(result.request)
+        if result.request.draft:  # no detector, no 3D view: both wait for the exact frame
+            return
+        self.panel.detection.content = self._detection_text(result.request)
         selected = self.selected if self.selected is not None and self.selected < len(case.illusions) else None
         road_key = roadside_key(case)
         # An illusion's meshes may depend on those placed before it (traffic keeps clear of earlier footprints).

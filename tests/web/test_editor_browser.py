@@ -40,37 +40,31 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, stat
     page.set_default_timeout(SHOT_MS)
     page.goto(f"http://127.0.0.1:{editor.port}/")
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
-    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    tab = editor.tab(timeout=WAIT_S)
+    wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
     time.sleep(8)  # meshes fade in
     page.screenshot(path=str(screenshot_dir / "editor_1_opened.png"), timeout=SHOT_MS)
 
-    case_id = editor.session.case_id
+    case_id = tab.session.case_id
     combos = page.locator("input[role=combobox]")
     place = combos.nth(combos.evaluate_all("(inputs) => inputs.findIndex((i) => i.value.startsWith('(pick a type'))"))
     place.click()
     page.get_by_role("option", name="vehicle", exact=True).click()
-    wait_for(lambda: editor.panel.place.value == "vehicle", "the Place dropdown")
+    wait_for(lambda: tab.panel.place.value == "vehicle", "the Place dropdown")
     page.mouse.click(*ROAD_CLICK)
-    wait_for(lambda: any(ill.type == "vehicle" for ill in editor.case.illusions), "the placed vehicle")
-    assert editor.preview.wait_idle(WAIT_S)
+    wait_for(lambda: any(ill.type == "vehicle" for ill in tab.case.illusions), "the placed vehicle")
+    assert tab.preview.wait_idle(WAIT_S)
     time.sleep(3)
     page.screenshot(path=str(screenshot_dir / "editor_2_placed.png"), timeout=SHOT_MS)
     before = preview.screenshot(timeout=SHOT_MS)
-    placed = editor.case.illusions[-1]
-    assert editor.selected == len(editor.case.illusions) - 1 and 10.0 < placed.s < 80.0
+    placed = tab.case.illusions[-1]
+    assert tab.selected == len(tab.case.illusions) - 1 and 10.0 < placed.s < 80.0
 
-    # Drag the thumb to the right end (arrow keys would also steer viser's camera).
-    thumb = page.locator("[role=slider][aria-valuemax='5']")
-    thumb.scroll_into_view_if_needed()
-    box = thumb.bounding_box()
-    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
-    page.mouse.down()
-    page.mouse.move(box["x"] + 300, box["y"] + box["height"] / 2, steps=8)
-    page.mouse.up()
-    wait_for(lambda: editor.case.illusions[-1].severity == 5, "severity 5")
-    assert editor.preview.wait_idle(WAIT_S)
+    drag_thumb(page, page.locator("[role=slider][aria-valuemax='5']"), 300)  # to the right end
+    wait_for(lambda: tab.case.illusions[-1].severity == 5, "severity 5")
+    assert tab.preview.wait_idle(WAIT_S)
     time.sleep(2)
     after = preview.screenshot(timeout=SHOT_MS)
     assert after != before, "the preview did not change with the severity"
@@ -97,17 +91,18 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SHOT_MS)
     page.goto(f"http://127.0.0.1:{editor.port}/")
-    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    tab = editor.tab(timeout=WAIT_S)
+    wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
-    assert editor.preview.wait_idle(WAIT_S)
+    assert tab.preview.wait_idle(WAIT_S)
     time.sleep(2)
     before = preview.screenshot(timeout=SHOT_MS)
     seen = [before]
     for current, name in (("none", "hough"), ("hough", "ufld")):
         pick(page, current, name)
-        wait_for(lambda name=name: editor.panel.detector.value == name, f"the Detector dropdown at {name}")
-        assert editor.preview.wait_idle(WAIT_S)
+        wait_for(lambda name=name: tab.panel.detector.value == name, f"the Detector dropdown at {name}")
+        assert tab.preview.wait_idle(WAIT_S)
         score = page.get_by_text(f"{name} (magenta):").first
         score.wait_for(timeout=WAIT_S * 1000)
         time.sleep(2)
@@ -125,16 +120,17 @@ def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, scree
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SHOT_MS)
     page.goto(f"http://127.0.0.1:{editor.port}/")
-    wait_for(lambda: editor.server.get_clients() and editor.view.surface is not None, "the scene")
+    tab = editor.tab(timeout=WAIT_S)
+    wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
-    assert editor.preview.wait_idle(WAIT_S)
+    assert tab.preview.wait_idle(WAIT_S)
     time.sleep(2)
     before = preview.screenshot(timeout=SHOT_MS)
     page.get_by_text("Camera", exact=True).first.click()  # open the folder
     pick(page, "(the case's camera)", "dashcam")
-    wait_for(lambda: editor.case.camera.bonnet is not None, "the dash cam's bonnet in the case")
-    assert editor.preview.wait_idle(WAIT_S)
+    wait_for(lambda: tab.case.camera.bonnet is not None, "the dash cam's bonnet in the case")
+    assert tab.preview.wait_idle(WAIT_S)
     time.sleep(2)
     after = preview.screenshot(timeout=SHOT_MS)
     assert after != before, "the preview did not change with the camera preset"
@@ -149,24 +145,24 @@ INJECTION = '<iframe srcdoc="<script>alert(1)</script>"></iframe><img src=x oner
 
 
 def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, state: AppState, monkeypatch) -> None:
-    record = state.store.create(state.store.get(editor.session.case_id).case.model_copy(
+    record = state.store.create(state.store.list()[0].case.model_copy(
         update={"title": INJECTION, "description": INJECTION}), case_id="injected")
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     dialogs: list[str] = []
     page.on("dialog", lambda dialog: (dialogs.append(dialog.message), dialog.dismiss()))
     page.goto(f"http://127.0.0.1:{editor.port}/")
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
-    wait_for(lambda: bool(editor.server.get_clients()), "the browser to connect")
+    tab = editor.tab(timeout=WAIT_S)
     scripts_before = page.locator("script").count()
-    editor.panel.case_id.value = record.id
-    assert editor.preview.wait_idle(WAIT_S)
+    tab.panel.case_id.value = record.id
+    assert tab.preview.wait_idle(WAIT_S)
 
     def fail(*args: object, **kwargs: object) -> None:
         raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
 
     monkeypatch.setattr(state.frames, "frame", fail)
-    editor.panel.frame.value = 2
-    assert editor.preview.wait_idle(WAIT_S)
+    tab.panel.frame.value = 2
+    assert tab.preview.wait_idle(WAIT_S)
     page.get_by_text("obstacle model not found", exact=False).first.wait_for(timeout=WAIT_S * 1000)
     time.sleep(2)
     assert dialogs == []
@@ -175,3 +171,46 @@ def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, state:
     assert page.locator("a[href^='javascript']").count() == 0
     assert page.locator("script").count() == scripts_before
     assert "<iframe srcdoc=" in page.get_by_text("obstacle model not found", exact=False).first.inner_text()
+
+
+def drag_thumb(page, thumb, dx: float) -> None:
+    """Drag a slider's thumb ``dx`` pixels sideways (arrow keys would also steer viser's camera)."""
+    thumb.scroll_into_view_if_needed()
+    box = thumb.bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] / 2 + dx, box["y"] + box["height"] / 2, steps=8)
+    page.mouse.up()
+
+
+def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Editor, screenshot_dir: Path) -> None:
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(SHOT_MS)
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    tab = editor.tab(timeout=WAIT_S)
+    page.locator("img[src^='blob:']").first.wait_for(timeout=WAIT_S * 1000)
+    assert tab.preview.wait_idle(WAIT_S) and tab.panel.quality.value == "draft"
+    shown: list[bool] = []  # whether each pushed preview was a draft
+    publish = tab.preview._publish
+    tab.preview._publish = lambda result: (shown.append(result.request.draft), publish(result))
+    altitude = page.locator("[role=slider][aria-valuemax='90']")  # Sun altitude, -10 to 90 degrees
+    drag_thumb(page, altitude, -120)
+    wait_for(lambda: tab.case.sun.altitude != 45.0, "the sun to move")
+    assert tab.preview.wait_idle(WAIT_S)
+    assert shown[0] and not shown[-1], shown  # drafts first, then the exact frame
+    assert tab.last_result.rgb.shape == (360, 640, 3)
+
+    pick(page, "draft", "full")
+    wait_for(lambda: tab.panel.quality.value == "full", "the Quality dropdown at full")
+    assert tab.preview.wait_idle(WAIT_S)
+    shown.clear()
+    drag_thumb(page, altitude, 80)
+    assert tab.preview.wait_idle(WAIT_S)
+    time.sleep(1)
+    assert tab.preview.wait_idle(WAIT_S)
+    assert shown and not any(shown), shown
+    page.get_by_text("Frame 0 · 640×360").first.wait_for(timeout=WAIT_S * 1000)
+    page.mouse.move(400, 450)
+    time.sleep(1)
+    page.screenshot(path=str(screenshot_dir / "editor_6_quality.png"), timeout=SHOT_MS)
+    page.close()

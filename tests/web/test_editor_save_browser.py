@@ -1,5 +1,7 @@
-"""Two browser tabs on the editor: Save in one tab shows no "stored elsewhere" warning in either, and a real write
-from elsewhere (REST) over unsaved edits still does. Screenshot: tests/web/_screenshots/editor_two_tabs_*.png."""
+"""Browser tabs on the editor: each has its own edits and view settings (a Quality or Detector chosen in one shows
+in no other); Save in one tab shows no "stored elsewhere" warning in either (the other, clean, takes the version),
+and a real write from elsewhere (REST) over a tab's unsaved edits still warns that tab. Screenshots:
+tests/web/_screenshots/editor_two_tabs_*.png, editor_tabs_own_settings.png."""
 
 from __future__ import annotations
 
@@ -34,32 +36,71 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
         time.sleep(0.1)
 
 
-def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: AppState, screenshot_dir: Path) -> None:
-    tabs = [browser.new_page(viewport={"width": 1280, "height": 900}) for _ in range(2)]
-    for tab in tabs:
-        tab.set_default_timeout(WAIT_S * 1000)
-        tab.goto(f"http://127.0.0.1:{editor.port}/")
-        tab.get_by_role("button", name="Save", exact=True).wait_for()
-    wait_for(lambda: len(editor.server.get_clients()) == 2, "both tabs to connect")
-    case_id = editor.session.case_id
+def pick(page, current: str, option: str) -> None:
+    """Choose ``option`` in the viser dropdown that now shows ``current``."""
+    combos = page.locator("input[role=combobox]")
+    index = combos.evaluate_all(f"(inputs) => inputs.findIndex((i) => i.value === {current!r})")
+    assert index >= 0, f"no dropdown shows {current!r}"
+    combos.nth(index).click()
+    page.get_by_role("option", name=option, exact=True).click()
 
-    editor.panel.title.value = "Edited in a tab"  # an unsaved edit, shared by both tabs
-    tabs[0].get_by_role("button", name="Save", exact=True).click()
+
+def dropdowns(page) -> list[str]:
+    return page.locator("input[role=combobox]").evaluate_all("(inputs) => inputs.map((i) => i.value)")
+
+
+def open_tab(browser, editor: Editor):
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(WAIT_S * 1000)
+    newest = max(editor.tabs, default=-1)
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.get_by_role("button", name="Save", exact=True).wait_for()
+    return page, editor.tab(timeout=WAIT_S, after=newest)
+
+
+def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: AppState, screenshot_dir: Path) -> None:
+    (page0, tab0), (page1, tab1) = open_tab(browser, editor), open_tab(browser, editor)
+    assert tab0 is not tab1 and tab0.session.case_id == tab1.session.case_id
+    case_id = tab0.session.case_id
+
+    tab0.panel.title.value = "Edited in a tab"  # an unsaved edit of the first tab only
+    assert tab1.case.title != "Edited in a tab"
+    page0.get_by_role("button", name="Save", exact=True).click()
     wait_for(lambda: state.store.get(case_id).version == 2, "the save")
     time.sleep(2.0)  # a notification would be on screen by now
-    for index, tab in enumerate(tabs):
-        assert tab.get_by_text(FOREIGN).count() == 0, f"tab {index} warns about its own save"
-        assert "saved version 2" in tab.get_by_text("saved version 2").first.inner_text()
-    assert state.store.get(case_id).case.title == "Edited in a tab"
-    tabs[1].screenshot(path=str(screenshot_dir / "editor_two_tabs_saved.png"))
+    for index, page in enumerate((page0, page1)):
+        assert page.get_by_text(FOREIGN).count() == 0, f"tab {index} warns about a save it should take"
+    page0.get_by_text("saved version 2").first.wait_for()
+    page1.get_by_text("version 2 arrived from the store").first.wait_for()  # the clean tab took it
+    assert state.store.get(case_id).case.title == tab1.case.title == "Edited in a tab"
+    page1.screenshot(path=str(screenshot_dir / "editor_two_tabs_saved.png"))
 
-    editor.panel.title.value = "Edited again, not saved"
+    tab1.panel.title.value = "Edited again, not saved"  # the second tab's own unsaved edit
     theirs = state.store.get(case_id).case.model_copy(update={"title": "changed over REST"})
     state.store.update(case_id, theirs, expected_version=2)
-    for tab in tabs:  # a real foreign write is still reported, in every tab (the toast closes after 8 s)
-        tab.locator(TOAST, has_text=FOREIGN).wait_for()
-    tabs[0].screenshot(path=str(screenshot_dir / "editor_two_tabs_foreign.png"))
-    for tab in tabs:
-        assert tab.get_by_text("Version 3 was stored elsewhere").count() >= 1
-    for tab in tabs:
-        tab.close()
+    page1.locator(TOAST, has_text=FOREIGN).wait_for()  # a foreign write over unsaved edits is reported
+    page1.screenshot(path=str(screenshot_dir / "editor_two_tabs_foreign.png"))
+    assert page1.get_by_text("Version 3 was stored elsewhere").count() >= 1
+    page0.get_by_text("version 3 arrived from the store").first.wait_for()  # the clean tab takes it
+    assert page0.get_by_text(FOREIGN).count() == 0 and tab0.case.title == "changed over REST"
+    for page in (page0, page1):
+        page.close()
+
+
+def test_view_settings_stay_in_their_tab(browser, editor: Editor, screenshot_dir: Path) -> None:
+    """Quality and Detector chosen in one tab show in no other tab, open or opened later."""
+    page0, tab0 = open_tab(browser, editor)
+    defaults = dropdowns(page0)
+    assert "draft" in defaults and "none" in defaults
+    page1, tab1 = open_tab(browser, editor)
+    pick(page0, "draft", "full")
+    pick(page0, "none", "hough")
+    wait_for(lambda: (tab0.panel.quality.value, tab0.panel.detector.value) == ("full", "hough"), "the first tab")
+    page2, tab2 = open_tab(browser, editor)
+    for page, tab in ((page1, tab1), (page2, tab2)):
+        assert (tab.panel.quality.value, tab.panel.detector.value) == ("draft", "none")
+        assert dropdowns(page) == defaults
+    assert "full" in dropdowns(page0) and "hough" in dropdowns(page0)
+    page2.screenshot(path=str(screenshot_dir / "editor_tabs_own_settings.png"))
+    for page in (page0, page1, page2):
+        page.close()
