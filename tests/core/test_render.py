@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from lanevil_core.case import Case, load_case
+from lanevil_core.case import Camera, Case, load_case
 from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import Frame, render_frame
 from lanevil_core.world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_SKY
 
@@ -25,6 +26,10 @@ UPDATE = os.environ.get("LANEVIL_UPDATE_GOLDEN") == "1"  # set to write the actu
 GOLDEN_CASES = ["00_clean/00_straight_urban.json", "00_clean/01_bend_suburban.json",
                 "30_shadow/rail_shadow/00_straight_urban_noon/05_level5.json",
                 "40_reflection/streetlight_reflection/00_t_junction_suburban_night/05_level5.json"]
+# One case through every camera preset: a painted urban street, buildings on both sides, the sun high.
+PRESET_GOLDEN_CASE = "00_clean/00_straight_urban.json"
+PRESET_GOLDEN_FRAME = 10
+PRESET_GOLDEN_WIDTH = 192
 
 
 def _small(case: Case, size: tuple[int, int] = (320, 180)) -> Case:
@@ -74,22 +79,38 @@ def _mean_abs(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a.astype(np.int16) - b.astype(np.int16)).mean())
 
 
-@pytest.mark.parametrize("relative", GOLDEN_CASES)
-def test_golden_images(relative: str, tmp_path: Path) -> None:
-    rgb = render_frame(compile_scene(_small(load_case(ROOT / "scenes" / relative))), 0).rgb
-    golden = GOLDEN / (relative.replace("/", "__").removesuffix(".json") + ".png")
+def _check_golden(rgb: np.ndarray, golden: Path, label: str) -> None:
+    """``rgb`` against the golden PNG within ``GOLDEN_TOLERANCE`` (with LANEVIL_UPDATE_GOLDEN=1: written as it)."""
     if UPDATE:
         golden.parent.mkdir(exist_ok=True)
         Image.fromarray(rgb).save(golden)
         pytest.skip(f"wrote {golden.name}")
     assert golden.exists(), f"missing {golden}; LANEVIL_UPDATE_GOLDEN=1 writes it"
     expected = np.asarray(Image.open(golden).convert("RGB"))
+    assert rgb.shape == expected.shape, f"{label}: shape {rgb.shape} != the golden's {expected.shape}"
     difference = _mean_abs(rgb, expected)
     if difference > GOLDEN_TOLERANCE:
         actual = golden.parent / "_actual" / golden.name
         actual.parent.mkdir(exist_ok=True)
         Image.fromarray(rgb).save(actual)
-        pytest.fail(f"{relative}: mean difference {difference:.2f} > {GOLDEN_TOLERANCE} (actual in {actual})")
+        pytest.fail(f"{label}: mean difference {difference:.2f} > {GOLDEN_TOLERANCE} (actual in {actual})")
+
+
+@pytest.mark.parametrize("relative", GOLDEN_CASES)
+def test_golden_images(relative: str) -> None:
+    rgb = render_frame(compile_scene(_small(load_case(ROOT / "scenes" / relative))), 0).rgb
+    _check_golden(rgb, GOLDEN / (relative.replace("/", "__").removesuffix(".json") + ".png"), relative)
+
+
+@pytest.mark.parametrize("preset", CAMERA_PRESET_NAMES)
+def test_golden_image_per_camera_preset(preset: str) -> None:
+    """The golden case seen through each camera preset (lens, bonnet, sensor and its seeded noise), 192 px wide
+    with the preset's aspect ratio."""
+    case = load_case(ROOT / "scenes" / PRESET_GOLDEN_CASE)
+    camera = Camera.model_validate({"preset": preset})
+    size = (PRESET_GOLDEN_WIDTH, round(PRESET_GOLDEN_WIDTH * camera.height / camera.width))
+    rgb = render_frame(compile_scene(_small(case.model_copy(update={"camera": camera}), size)), PRESET_GOLDEN_FRAME).rgb
+    _check_golden(rgb, GOLDEN / f"camera_preset__{preset}.png", f"camera preset {preset}")
 
 
 def _scene_files() -> list[Path]:
