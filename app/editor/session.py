@@ -1,4 +1,4 @@
-"""Editing state of one stored case, shared by every browser tab that has it open: undo/redo, dirty, version.
+"""Editing state of one stored case in one browser tab: undo/redo, dirty, version.
 
 The session holds the case being edited and the store version it is based on. ``save`` goes through the same
 version check as the REST API, so a save over someone else's newer version raises ``VersionConflict`` and the
@@ -124,7 +124,7 @@ class CaseSession:
 
 
 class SessionRegistry:
-    """One ``CaseSession`` per open case id, so every tab editing a case shares its state and history."""
+    """A tab's ``CaseSession``s, one per case id it opened (switching back to a case finds its unsaved edits)."""
 
     def __init__(self, store: CaseStore) -> None:
         self.store = store

@@ -3,7 +3,7 @@
 Each viser client (a browser tab) gets an ``EditorTab`` built in its client-scoped GUI and scene: its open case,
 unsaved edits and undo history, selection, frame, overlay, detector, quality and camera pose are its own, so what
 one tab changes never shows in another tab, nor in one opened later. Tabs meet in the store: a save goes through
-its version check, and a change stored elsewhere reaches every tab (``Editor`` hands store events to each).
+its version check, and each tab follows the store's changes of its open case (``CaseStore.subscribe``).
 
 Methods named after user actions (``open_case``, ``place``, ``set_severity`` …) are what the panel's callbacks
 call; tests and the latency benchmark call the same methods or set the panel's handles directly.
