@@ -1,7 +1,7 @@
-"""Browser tabs on the editor: each has its own edits and view settings (a Quality or Detector chosen in one shows
-in no other); Save in one tab shows no "stored elsewhere" warning in either (the other, clean, takes the version),
-and a real write from elsewhere (REST) over a tab's unsaved edits still warns that tab. Screenshots:
-tests/web/_screenshots/editor_two_tabs_*.png, editor_tabs_own_settings.png."""
+"""Browser tabs on the editor: each has its own edits and view settings (a Quality or Detector chosen in one does
+not show in a tab opened after); Save in one tab shows no "stored elsewhere" warning in either (the other, clean,
+takes the version), and a real write from elsewhere (REST) over a tab's unsaved edits still warns that tab.
+Screenshots: tests/web/_screenshots/editor_two_tabs_*.png, editor_tabs_own_settings.png."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 WAIT_S = 90.0
 FOREIGN = "was stored elsewhere"
+SLOW_MS = 180_000  # a click waits for the page, which SwiftShader draws slowly on a busy machine
 TOAST = ".mantine-Notification-root"  # viser's notifications (the status line in the panel says it too)
 
 
@@ -88,19 +89,18 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: Ap
 
 
 def test_view_settings_stay_in_their_tab(browser, editor: Editor, screenshot_dir: Path) -> None:
-    """Quality and Detector chosen in one tab show in no other tab, open or opened later."""
+    """Quality and Detector chosen in one tab do not show in a tab opened after (open tabs: test_editor_tabs.py)."""
     page0, tab0 = open_tab(browser, editor)
+    page0.set_default_timeout(SLOW_MS)
     defaults = dropdowns(page0)
     assert "draft" in defaults and "none" in defaults
-    page1, tab1 = open_tab(browser, editor)
     pick(page0, "draft", "full")
     pick(page0, "none", "hough")
     wait_for(lambda: (tab0.panel.quality.value, tab0.panel.detector.value) == ("full", "hough"), "the first tab")
-    page2, tab2 = open_tab(browser, editor)
-    for page, tab in ((page1, tab1), (page2, tab2)):
-        assert (tab.panel.quality.value, tab.panel.detector.value) == ("draft", "none")
-        assert dropdowns(page) == defaults
+    page1, tab1 = open_tab(browser, editor)
+    assert tab1 is not tab0 and (tab1.panel.quality.value, tab1.panel.detector.value) == ("draft", "none")
+    assert dropdowns(page1) == defaults
     assert "full" in dropdowns(page0) and "hough" in dropdowns(page0)
-    page2.screenshot(path=str(screenshot_dir / "editor_tabs_own_settings.png"))
-    for page in (page0, page1, page2):
+    page1.screenshot(path=str(screenshot_dir / "editor_tabs_own_settings.png"), timeout=SLOW_MS)
+    for page in (page0, page1):
         page.close()
