@@ -1,6 +1,7 @@
 """A browser tab without a browser: a websocket client that connects to the editor as viser's page does.
 
-It sends the page's first camera pose, then reads and drops whatever the server sends until it is closed. The
+It sends the page's first camera pose (viser counts a client as connected, and builds its tab, only once it has
+reported its camera), then reads and drops whatever the server sends until it is closed. The
 editor builds a full ``EditorTab`` for it, which tests and benchmarks then drive through its panel handles.
 """
 

@@ -52,7 +52,7 @@ def dropdowns(page) -> list[str]:
 
 def open_tab(browser, editor: Editor):
     page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.set_default_timeout(WAIT_S * 1000)
+    page.set_default_timeout(SLOW_MS)
     newest = max(editor.tabs, default=-1)
     page.goto(f"http://127.0.0.1:{editor.port}/")
     page.get_by_role("button", name="Save", exact=True).wait_for()
@@ -91,7 +91,6 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: Ap
 def test_view_settings_stay_in_their_tab(browser, editor: Editor, screenshot_dir: Path) -> None:
     """Quality and Detector chosen in one tab do not show in a tab opened after (open tabs: test_editor_tabs.py)."""
     page0, tab0 = open_tab(browser, editor)
-    page0.set_default_timeout(SLOW_MS)
     defaults = dropdowns(page0)
     assert "draft" in defaults and "none" in defaults
     pick(page0, "draft", "full")
