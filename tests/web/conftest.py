@@ -5,7 +5,7 @@ from __future__ import annotations
 import shutil
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -120,6 +120,21 @@ def screenshot_dir() -> Path:
     """Where browser tests save what they saw (ignored by git; open the PNGs to look at them)."""
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     return SCREENSHOTS
+
+
+def _pick(page, current: str, option: str) -> None:
+    combos = page.locator("input[role=combobox]")
+    index = combos.evaluate_all(f"(inputs) => inputs.findIndex((i) => i.value === {current!r})")
+    assert index >= 0, f"no dropdown shows {current!r}"
+    combos.nth(index).click()
+    page.get_by_role("option", name=option, exact=True).click()
+
+
+@pytest.fixture
+def pick() -> Callable[..., None]:
+    """``pick(page, current, option)``: choose ``option`` in the viser dropdown of ``page`` that now shows
+    ``current`` (browser tests)."""
+    return _pick
 
 
 EDITOR_START_S = 120.0  # the first preview compiles the numba kernels on a cold cache

@@ -26,6 +26,14 @@ def editor(state: AppState) -> Iterator[Editor]:
     editor.stop()
 
 
+def open_page(browser, editor: Editor):
+    """A new page on the editor, and the tab the editor built for it."""
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.set_default_timeout(SHOT_MS)
+    page.goto(f"http://127.0.0.1:{editor.port}/")
+    return page, editor.tab(timeout=WAIT_S)
+
+
 def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) -> None:
     deadline = time.monotonic() + timeout
     while not condition():
@@ -77,21 +85,9 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, stat
     page.close()
 
 
-def pick(page, current: str, option: str) -> None:
-    """Choose ``option`` in the viser dropdown that now shows ``current``."""
-    combos = page.locator("input[role=combobox]")
-    index = combos.evaluate_all(f"(inputs) => inputs.findIndex((i) => i.value === {current!r})")
-    assert index >= 0, f"no dropdown shows {current!r}"
-    combos.nth(index).click()
-    page.get_by_role("option", name=option, exact=True).click()
-
-
-def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: Editor,
+def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: Editor, pick,
                                                                screenshot_dir: Path) -> None:
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.set_default_timeout(SHOT_MS)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
-    tab = editor.tab(timeout=WAIT_S)
+    page, tab = open_page(browser, editor)
     wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
@@ -116,11 +112,8 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     page.close()
 
 
-def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, screenshot_dir: Path) -> None:
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.set_default_timeout(SHOT_MS)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
-    tab = editor.tab(timeout=WAIT_S)
+def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, pick, screenshot_dir: Path) -> None:
+    page, tab = open_page(browser, editor)
     wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
@@ -183,11 +176,9 @@ def drag_thumb(page, thumb, dx: float) -> None:
     page.mouse.up()
 
 
-def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Editor, screenshot_dir: Path) -> None:
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.set_default_timeout(SHOT_MS)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
-    tab = editor.tab(timeout=WAIT_S)
+def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Editor, pick,
+                                                             screenshot_dir: Path) -> None:
+    page, tab = open_page(browser, editor)
     page.locator("img[src^='blob:']").first.wait_for(timeout=WAIT_S * 1000)
     assert tab.preview.wait_idle(WAIT_S) and tab.panel.quality.value == "draft"
     shown: list[bool] = []  # whether each pushed preview was a draft

@@ -37,15 +37,6 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
         time.sleep(0.1)
 
 
-def pick(page, current: str, option: str) -> None:
-    """Choose ``option`` in the viser dropdown that now shows ``current``."""
-    combos = page.locator("input[role=combobox]")
-    index = combos.evaluate_all(f"(inputs) => inputs.findIndex((i) => i.value === {current!r})")
-    assert index >= 0, f"no dropdown shows {current!r}"
-    combos.nth(index).click()
-    page.get_by_role("option", name=option, exact=True).click()
-
-
 def dropdowns(page) -> list[str]:
     return page.locator("input[role=combobox]").evaluate_all("(inputs) => inputs.map((i) => i.value)")
 
@@ -88,7 +79,7 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: Ap
         page.close()
 
 
-def test_view_settings_stay_in_their_tab(browser, editor: Editor, screenshot_dir: Path) -> None:
+def test_view_settings_stay_in_their_tab(browser, editor: Editor, pick, screenshot_dir: Path) -> None:
     """Quality and Detector chosen in one tab do not show in a tab opened after (open tabs: test_editor_tabs.py)."""
     page0, tab0 = open_tab(browser, editor)
     defaults = dropdowns(page0)
