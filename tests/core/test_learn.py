@@ -140,6 +140,21 @@ def test_same_seed_same_weights_and_resume_continues(tiny_dataset, tmp_path):
     assert [h["epoch"] for h in history] == [1, 2]
 
 
+def test_init_copies_a_trained_model_heads_included_or_a_backbone(tmp_path):
+    from lanevil_core.learn.backbone import load_init
+    from lanevil_core.learn.models import build_model
+
+    spec = ModelSpec(family="ganet", **TINY_SPEC)
+    trained, fresh = build_model(spec), build_model(spec)
+    torch.save({k: v.half() for k, v in trained.state_dict().items()}, tmp_path / "weights.pt")
+    copied, skipped = load_init(fresh, tmp_path / "weights.pt")
+    assert (copied, skipped) == (len(trained.state_dict()), 0)
+    assert torch.allclose(fresh.keypoints.classify.weight, trained.keypoints.classify.weight.half().float())
+    # a bare backbone's names (ImageNet layout) land under ``backbone.``
+    torch.save(trained.backbone.state_dict(), tmp_path / "backbone.pt")
+    assert load_init(build_model(spec), tmp_path / "backbone.pt") == (len(trained.backbone.state_dict()), 0)
+
+
 def test_train_and_detect_errors_exit_2(tmp_path, capsys):
     assert main(["train", "--data", str(tmp_path / "missing"), "--out", str(tmp_path / "m")]) == 2
     assert "--data" in capsys.readouterr().err
