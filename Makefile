@@ -44,10 +44,11 @@ test-browser: $(STAMP)
 	scripts/install-chromium
 	$(PY) -m pytest -q -m browser || test $$? -eq 5
 
-# The shipped learned detectors (lanevil_core/detect/models/<family>). ufld and seg in two stages: trained at
-# 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then fine-tuned 6
-# epochs from those backbones on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames). The
-# four newer families train on the first split (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
+# The shipped learned detectors (lanevil_core/detect/models/<family>). ufld, seg, ganet and laneatt in two stages:
+# trained at 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then
+# fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
+# and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate). scnn
+# and bezier train on the first split only (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
 # training ufld and seg on 2 idle cores; MODELS_DATA and MODELS_DATA_VARIED keep the renders for reruns.
 MODELS_DATA ?= out/models-data
 MODELS_DATA_VARIED ?= out/models-data-v
@@ -63,9 +64,13 @@ models: $(STAMP)
 	  $(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/$$family --model $$family --epochs 6 \
 	    --threads 1 --init out/models/$$family-base/weights.pt || exit 1; done
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/scnn --model scnn --epochs 8
-	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt --model laneatt --epochs 6
-	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet --model ganet --epochs 10
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt-base --model laneatt --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet-base --model ganet --epochs 10
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
+	  --threads 1 --init out/models/ganet-base/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 5 --lr 1e-3 \
+	  --threads 1 --init out/models/laneatt-base/weights.pt
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done

@@ -37,7 +37,8 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",
                         help="share of the train split's case folders held out for validation (default 0.1)")
     parser.add_argument("--init", type=Path, default=None,
-                        help="state dict to initialise the backbone from (e.g. ImageNet ResNet weights)")
+                        help="state dict to initialise from: a trained model's weights.pt (fine-tuning, heads "
+                             "included) or a backbone's (e.g. ImageNet ResNet weights)")
     parser.add_argument("--threads", type=count(0), default=0,
                         help="CPU threads (default 0 = every core; use 1 when other work shares the cores: "
                              "oversubscribed threads make training many times slower)")

@@ -28,7 +28,10 @@ POSITIVE_DISTANCE = 0.05  # normalised mean horizontal distance below which an a
 NEGATIVE_DISTANCE = 0.08  # ... above which it is background (between: ignored by the classifier)
 UNCOVERED_DISTANCE = 0.5  # distance counted at a lane row below the anchor's start
 NMS_DISTANCE = 0.03
-SCORE_THRESHOLD = 0.2  # LaneATT's TuSimple setting (focal-loss scores stay low)
+# LaneATT's TuSimple setting is 0.2 (focal-loss scores stay low); with the score loss weighted 10x as in LaneATT,
+# the anchors guessed from the road's layout still reach 0.2-0.4, and 0.5 is where accuracy on held-out
+# drawn-camera training frames peaks (65.2 % against 33.7 % at 0.2).
+SCORE_THRESHOLD = 0.5
 IGNORE = -1
 
 

@@ -68,18 +68,21 @@ class ResNet(nn.Module):
         return c2, c3, self.layer4(c3)
 
 
-def load_init(backbone: ResNet, path: str | Path) -> tuple[int, int]:
-    """Copy the tensors of a state dict file whose names and shapes match (e.g. ImageNet ResNet weights);
-    returns (copied, skipped). A ``fc.*`` classifier or a ``backbone.`` prefix is ignored."""
+def load_init(model: nn.Module, path: str | Path) -> tuple[int, int]:
+    """Copy into ``model`` (a detector) the tensors of a state dict file whose names and shapes match: a trained
+    detector's ``weights.pt`` (its heads too, for fine-tuning) or a backbone's (e.g. ImageNet ResNet weights,
+    matched under ``backbone.``); returns (copied, skipped). A ``fc.*`` classifier matches nothing."""
     state = torch.load(Path(path), map_location="cpu", weights_only=True)
     if isinstance(state, dict) and "state_dict" in state:
         state = state["state_dict"]
-    own = backbone.state_dict()
+    own = model.state_dict()
     copied = 0
     for name, tensor in state.items():
-        name = name.removeprefix("module.").removeprefix("backbone.")
-        if name in own and own[name].shape == tensor.shape:
-            own[name] = tensor
-            copied += 1
-    backbone.load_state_dict(own)
+        name = name.removeprefix("module.")
+        for candidate in (name, "backbone." + name.removeprefix("backbone.")):
+            if candidate in own and own[candidate].shape == tensor.shape:
+                own[candidate] = tensor.to(own[candidate].dtype)
+                copied += 1
+                break
+    model.load_state_dict(own)
     return copied, len(state) - copied

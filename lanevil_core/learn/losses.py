@@ -1,15 +1,15 @@
 """Training losses of the detector families.
 
-``ufld`` (as in Ultra Fast Lane Detection): cross-entropy over the ``grid + 1`` classes of every (slot, anchor);
-a similarity loss (L1 between the cell distributions of adjacent anchors: lanes are continuous); a shape loss
-(L1 of the second difference of the expected column along three adjacent anchors: lanes are smooth); and the
-auxiliary lane-mask cross-entropy. ``seg`` and ``scnn``: lane-mask cross-entropy (background down-weighted, as in
-SCNN) and binary cross-entropy of slot existence. ``laneatt``: focal loss of the anchor scores, smooth L1 of the
-positive anchors' x offsets, bottom row and length. ``bezier``: query slots matched to the lanes by the Hungarian
-method on sampled curve points (``scipy.optimize.linear_sum_assignment``), L1 of the matched curves' sampled points
-and existence cross-entropy (matched queries weighted as the unmatched together). ``ganet``: CenterNet's focal
-loss on the keypoint heatmap and L1 of the offsets at the keypoints. The last three add the auxiliary lane-mask
-cross-entropy.
+``ufld`` (as in Ultra Fast Lane Detection): cross-entropy over the ``grid + 1`` classes of every (slot, anchor); a
+similarity loss (L1 between the cell distributions of adjacent anchors: lanes are continuous); a shape loss (L1 of
+the second difference of the expected column along three adjacent anchors: lanes are smooth); and the auxiliary
+lane-mask cross-entropy. ``seg`` and ``scnn``: lane-mask cross-entropy (background down-weighted, as in SCNN) and
+binary cross-entropy of slot existence. ``laneatt``: focal loss of the anchor scores (weighted 10x, as LaneATT
+does), smooth L1 of the positive anchors' x offsets, bottom row and length. ``bezier``: query slots matched to the
+lanes by the Hungarian method on sampled curve points (``scipy.optimize.linear_sum_assignment``), L1 of the matched
+curves' sampled points and existence cross-entropy (matched queries weighted as the unmatched together). ``ganet``:
+CenterNet's focal loss on the keypoint heatmap and L1 of the offsets at the keypoints. The last three add the
+auxiliary lane-mask cross-entropy.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ class LossWeights:
     shape: float = 0.1
     aux_mask: float = 1.0
     existence: float = 0.1
+    anchor_score: float = 10.0  # laneatt's focal loss of the anchor scores (LaneATT's cls_loss_weight)
     regression: float = 10.0  # laneatt's smooth L1 of normalised x offsets, bottom row and length
     curve: float = 5.0  # bezier's L1 of normalised sampled curve points
     keypoint_offset: float = 1.0  # ganet's L1 of sub-cell column and start offsets
@@ -155,7 +156,7 @@ def _seg_loss(out: dict[str, torch.Tensor], batch: dict[str, torch.Tensor],
 def _laneatt_loss(out: dict[str, torch.Tensor], batch: dict[str, torch.Tensor],
                   weights: LossWeights) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
     terms = anchor_losses(out, batch)
-    return terms["cls"] + weights.regression * terms["reg"], terms
+    return weights.anchor_score * terms["cls"] + weights.regression * terms["reg"], terms
 
 
 def _bezier_loss(out: dict[str, torch.Tensor], batch: dict[str, torch.Tensor],

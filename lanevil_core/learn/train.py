@@ -197,9 +197,9 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     data_sha = file_sha256(label_file)
     model = build_model(spec).to(device)
     if settings.init is not None:
-        copied, skipped = load_init(model.backbone, settings.init)
+        copied, skipped = load_init(model, settings.init)
         if copied == 0:
-            raise TrainError(f"--init {settings.init}: no tensor matches the {spec.backbone} backbone")
+            raise TrainError(f"--init {settings.init}: no tensor matches the {spec.family} network")
     optimizer = torch.optim.AdamW(model.parameters(), lr=settings.lr, weight_decay=settings.weight_decay)
     steps_per_epoch = math.ceil(len(train_set) / settings.batch)
     if settings.max_steps is not None:
