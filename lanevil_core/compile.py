@@ -10,7 +10,7 @@ import numpy as np
 
 from .camera import ego_path
 from .case import Case
-from .environment import environment_for, is_night
+from .environment import environment_for, in_proportion, is_night
 from .illusions import CompileContext, MeshFileError
 from .illusions.traffic import mesh_path
 from .paint import road_paint
@@ -67,5 +67,7 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
         illusion.compile(ctx)
+    if case.camera.sensor is not None:  # a photograph: sun and sky in daylight's proportion for the final sun
+        in_proportion(ctx.env)
     return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),
                          ego=ego_path(case, network), meshes=ctx.meshes, layers=ctx.layers, lights=ctx.lights)

@@ -28,7 +28,8 @@ DEFAULT_AHEAD_M = 22.0
 
 @dataclass
 class CompileContext:
-    """What an illusion may read (case, road) and add to (meshes, layers, lights, environment)."""
+    """What an illusion may read (case, road) and add to (meshes, layers, lights, environment); the shadow of a
+    low sun may also leave out roadside buildings that would swallow it."""
 
     case: Case
     network: RoadNetwork
