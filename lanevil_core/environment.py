@@ -85,10 +85,10 @@ def in_proportion(env: Environment) -> None:
     cloudiness (the photographed path; the ideal render keeps its own numbers).
 
     ``env.sun_intensity`` stays the sun's clearness (1 = a clear sky's beam; ``environment_for`` thins it by the
-    case's clouds as the daylight model does; illusions raise it for a harder sun); the beam now also falls with the air mass at low altitude, and the sky's
-    diffuse light on the ground is the daylight model's for that altitude and cloud cover. The circumsolar part of
-    that diffuse light comes from around the sun and is shaded with it (Hay & Davies): it joins the sun's beam, and
-    only the rest lights the shadows from the open sky."""
+    case's clouds as the daylight model does; illusions raise it for a harder sun); the beam now also falls with
+    the air mass at low altitude, and the sky's diffuse light on the ground is the daylight model's for that
+    altitude and cloud cover. The circumsolar part of that diffuse light comes from around the sun and is shaded
+    with it (Hay & Davies): it joins the sun's beam, and only the rest lights the shadows from the open sky."""
     if env.night or env.sun_intensity <= 0.0:
         return
     altitude = float(np.degrees(np.arcsin(np.clip(env.sun_dir_world[2], -1.0, 1.0))))
