@@ -64,10 +64,11 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     network, roadside = _roadside(case, reuse)
     ctx = CompileContext(case=case, network=network, env=environment_for(case), meshes_dir=meshes_dir)
     ctx.meshes.extend(roadside)
+    case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
         illusion.compile(ctx)
     if case.camera.sensor is not None:  # a photograph: sun and sky in daylight's proportion for the final sun
-        in_proportion(ctx.env)
+        in_proportion(ctx.env, air_mass=ctx.env.sun_intensity == case_sun)
     return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),
                          ego=ego_path(case, network), meshes=ctx.meshes, layers=ctx.layers, lights=ctx.lights)

@@ -80,7 +80,7 @@ def _beam_through_clouds(altitude_deg: float, cloud: float) -> float:
     return daylight(altitude, cloud)[0] / clear_sky(altitude)[0]
 
 
-def in_proportion(env: Environment) -> None:
+def in_proportion(env: Environment, air_mass: bool = True) -> None:
     """Set ``env``'s sun and sky irradiance in the physical proportion of daylight at its sun's altitude and its
     cloudiness (the photographed path; the ideal render keeps its own numbers).
 
@@ -88,7 +88,9 @@ def in_proportion(env: Environment) -> None:
     case's clouds as the daylight model does; illusions raise it for a harder sun); the beam now also falls with
     the air mass at low altitude, and the sky's diffuse light on the ground is the daylight model's for that
     altitude and cloud cover. The circumsolar part of that diffuse light comes from around the sun and is shaded
-    with it (Hay & Davies): it joins the sun's beam, and only the rest lights the shadows from the open sky."""
+    with it (Hay & Davies): it joins the sun's beam, and only the rest lights the shadows from the open sky.
+    ``air_mass`` False: the sun was set by an illusion whose table gives its light as seen (1 = a clear noon sun),
+    so its beam keeps that; the sky's light still follows its altitude."""
     if env.night or env.sun_intensity <= 0.0:
         return
     altitude = float(np.degrees(np.arcsin(np.clip(env.sun_dir_world[2], -1.0, 1.0))))
@@ -98,8 +100,9 @@ def in_proportion(env: Environment) -> None:
     _, diffuse = daylight(model_altitude, env.cloudiness)
     day = float(np.clip((altitude - NIGHT_SUN_ALTITUDE_DEG) / 12.0, 0.0, 1.0))
     sky = 0.5 * np.asarray(env.sky_zenith, np.float64) + 0.5 * np.asarray(env.sky_horizon, np.float64)
-    beam_now = env.sun_intensity * beam
-    circumsolar = min(beam_now / SOLAR_CONSTANT_W_M2, 1.0)  # Hay & Davies' anisotropy index
+    beam_now = env.sun_intensity * (beam if air_mass else zenith_beam)
+    # Hay & Davies' anisotropy index, of a beam no brighter than a clear sky's (illusions push the sun beyond it)
+    circumsolar = min(env.sun_intensity, 1.0) * beam / SOLAR_CONSTANT_W_M2
     sin_alt = float(np.sin(np.radians(model_altitude)))
     env.sun_intensity = float((beam_now + circumsolar * day * diffuse / sin_alt) / zenith_beam)
     isotropic = (1.0 - circumsolar) * day * diffuse

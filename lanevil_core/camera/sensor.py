@@ -3,11 +3,9 @@
 The renderer hands over scene-referred linear radiance (the old ideal pipeline maps 1.0 to a bright grey); this
 module works out, per frame, the numbers of the sensor kernel (``render.develop``):
 
-- **Auto-exposure** meters the road as a driving camera does: where the frame shows road, its sunlit asphalt (the
-  ``ROAD_PERCENTILE`` of the road's log luminance: above the shadows, below the paint) is brought to
-  ``ROAD_KEY``, so a shadow on the road falls as dark as the light in it, however much of the road it covers.
-  A frame with too little road meters its middle 90 % (the mean log luminance, trimmed so neither the sun's glint
-  nor black tyres rule it) to middle grey (``KEY``). Both within the sensor's gain limits.
+- **Auto-exposure** meters the frame as a camera does: the mean log luminance of the frame's middle 90 %
+  (trimmed, so neither the sun's glint nor black tyres rule it) is brought to middle grey (``KEY``), within the
+  sensor's gain limits. The sky is in the metered frame, so shadowed asphalt falls dark and highlights clip.
 - **Gain and noise**: beyond ``BASE_GAIN`` the camera raises its analogue gain (ISO) instead of the exposure
   time; shot noise (Poisson, ~ sqrt(signal / full well)) and read noise (Gaussian) grow with it (EMVA 1288).
 - **White balance**: von Kries gains from the scene's daylight to the camera's set colour temperature.
@@ -28,9 +26,6 @@ from ..typed import FloatArray, UInt8Array
 
 KEY = 0.18  # middle grey the metered mean log luminance is brought to
 TRIM = (5.0, 95.0)  # percentiles of log luminance kept by the meter
-ROAD_PERCENTILE = 75.0  # the road's sunlit asphalt: above the share a long shadow covers, below the paint
-ROAD_KEY = 0.09  # sensor value of sunlit asphalt (sRGB 85 after the filmic curve)
-ROAD_MIN_SHARE = 0.02  # the road meter needs this share of the frame
 METER_STEP = 8  # the meter reads every 8th pixel of every 8th row
 BASE_GAIN = 2.0  # exposure gain reached at base ISO (longest shutter); above it the analogue gain rises
 FULL_WELL_E = 5000.0  # electrons at clip of a small automotive sensor pixel
@@ -62,24 +57,18 @@ class Development:
     lut: UInt8Array
 
 
-def metered_gain(hdr: np.ndarray, sensor: Sensor, road: np.ndarray | None = None) -> float:
-    """Exposure gain for a (H, W, 3) float32 linear frame (times the bias), clamped to the sensor's limits;
-    ``sensor.gain`` in fixed mode. ``road`` (H, W) bool marks the road's pixels: where enough of the frame is road,
-    its sunlit asphalt is brought to ``ROAD_KEY``; otherwise the trimmed mean log luminance to ``KEY``."""
+def metered_gain(hdr: np.ndarray, sensor: Sensor) -> float:
+    """Exposure gain for a (H, W, 3) float32 linear frame: trimmed mean log luminance to ``KEY`` (times the bias),
+    clamped to the sensor's limits; ``sensor.gain`` in fixed mode."""
     if sensor.exposure == "fixed":
         return float(sensor.gain)
-    grid = (slice(METER_STEP // 2, None, METER_STEP), slice(METER_STEP // 2, None, METER_STEP))
-    sample = np.asarray(hdr[grid], np.float64)
-    log_l = np.log2(np.maximum(sample @ LUMA, 1e-5))
-    on_road = road[grid] if road is not None else np.zeros(log_l.shape, bool)
-    if on_road.mean() >= ROAD_MIN_SHARE:
-        level = float(np.percentile(log_l[on_road], ROAD_PERCENTILE))
-        gain = ROAD_KEY * 2.0 ** (sensor.bias - level)
-    else:
-        lo, hi = np.percentile(log_l, TRIM)
-        kept = log_l[(log_l >= lo) & (log_l <= hi)]
-        mean_log = float(kept.mean()) if kept.size else float(log_l.mean())
-        gain = KEY * 2.0 ** (sensor.bias - mean_log)
+    sample = np.asarray(hdr[METER_STEP // 2::METER_STEP, METER_STEP // 2::METER_STEP], np.float64)
+    luminance = np.maximum(sample @ LUMA, 1e-5).ravel()
+    log_l = np.log2(luminance)
+    lo, hi = np.percentile(log_l, TRIM)
+    kept = log_l[(log_l >= lo) & (log_l <= hi)]
+    mean_log = float(kept.mean()) if kept.size else float(log_l.mean())
+    gain = KEY * 2.0 ** (sensor.bias - mean_log)
     return float(np.clip(gain, sensor.min_gain, sensor.max_gain))
 
 
@@ -123,9 +112,9 @@ def tone_lut(contrast: float) -> UInt8Array:
     return lut
 
 
-def development(hdr: np.ndarray, sensor: Sensor, road: np.ndarray | None = None) -> Development:
-    """The sensor kernel's numbers for a (H, W, 3) float32 linear frame (``road``: see ``metered_gain``)."""
-    gain = metered_gain(hdr, sensor, road)
+def development(hdr: np.ndarray, sensor: Sensor) -> Development:
+    """The sensor kernel's numbers for a (H, W, 3) float32 linear frame."""
+    gain = metered_gain(hdr, sensor)
     iso_gain = max(1.0, gain / BASE_GAIN)
     shot = sensor.noise**2 * iso_gain / FULL_WELL_E
     read = sensor.noise * READ_NOISE_E * iso_gain / FULL_WELL_E

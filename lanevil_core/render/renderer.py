@@ -15,7 +15,7 @@ from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
 from ..paint import MATERIAL_ALBEDO
-from ..scene import ID_EGO, ID_ROAD, ID_SKY, CompiledScene, Environment
+from ..scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from ..typed import Float32Array, IntArray, UInt8Array
 from .bands import run_bands
 from .develop import develop, motion_blur
@@ -276,7 +276,7 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
         finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
     else:
         hdr = blend_edges(hdr, object_id, threads)
-        dev = development(hdr, sensor, object_id == ID_ROAD)
+        dev = development(hdr, sensor)
         develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
                 sensor.saturation, _noise_seed(scene.case.seed, frame), dev.lut, rgb, threads)
         if sensor.sharpen > 0.0:

@@ -13,15 +13,7 @@ from hypothesis import strategies as st
 from lanevil_core.camera import intrinsics_for, mounted_camera
 from lanevil_core.camera.cover import cover_camera
 from lanevil_core.camera.lens import distort, undistort
-from lanevil_core.camera.sensor import (
-    KEY,
-    LUMA,
-    ROAD_KEY,
-    development,
-    filmic,
-    metered_gain,
-    white_balance_gains,
-)
+from lanevil_core.camera.sensor import KEY, LUMA, development, filmic, metered_gain, white_balance_gains
 from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
 from lanevil_core.compile import compile_scene
 from lanevil_core.environment import SKY_AMBIENT_GAIN, SUN_SCALE, clear_sky, daylight
@@ -96,19 +88,6 @@ def test_metering_brings_the_frame_to_middle_grey_within_limits() -> None:
     dark = development(flat * 0.01, Sensor())
     bright = development(flat, Sensor())
     assert dark.iso_gain > bright.iso_gain and dark.shot > bright.shot  # noise rises with gain in low light
-
-
-def test_the_road_meter_exposes_for_the_sunlit_asphalt_however_much_shadow_covers() -> None:
-    sky = np.full((40, 64, 3), 2.0, np.float32)
-    for shaded in (0, 8, 16):  # of 24 road rows: none, a third, two thirds in shadow
-        road = np.full((24, 64, 3), 0.12, np.float32)
-        road[:shaded] *= 0.1
-        frame = np.concatenate([sky, road])
-        mask = np.zeros(frame.shape[:2], bool)
-        mask[40:] = True
-        gain = metered_gain(frame, Sensor(), mask)
-        assert gain * float(LUMA @ road[-1, 0]) == pytest.approx(ROAD_KEY, rel=1e-3)
-    assert metered_gain(frame, Sensor(), np.zeros(frame.shape[:2], bool)) == metered_gain(frame, Sensor())
 
 
 def _shadow_share(case: Case) -> float:
