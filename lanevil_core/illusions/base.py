@@ -38,7 +38,8 @@ class EgoDrive:
 @dataclass
 class CompileContext:
     """What an illusion may read (the case's seed, the ego's drive, the road) and add to (meshes, layers, lights,
-    environment). Built by ``compile_scene`` from the case, so the illusions need not know the case model."""
+    environment); the shadow of a low sun may also leave out roadside buildings that would swallow it. Built by
+    ``compile_scene`` from the case, so the illusions need not know the case model."""
 
     seed: int  # the case's seed
     drive: EgoDrive

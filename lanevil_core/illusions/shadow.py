@@ -152,6 +152,20 @@ def _road_frame(line: ReferenceLine, p_world: np.ndarray) -> tuple[np.ndarray, n
     return s_road, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
 
 
+SUNWARD_KINDS = ("building",)  # roadside props tall enough to shade the whole road at a low sun
+SUNWARD_SHADOW_M = 120.0  # how far ahead of a stretch a building's low-sun shadow can fall back onto it
+
+
+def clear_sunward(ctx: CompileContext, piece: RoadPiece, s0: float, s1: float, sign: float) -> None:
+    """Leave out the buildings on side ``sign`` of the road beside [s0, s1 + SUNWARD_SHADOW_M]: with the sun on
+    that side and ahead, their shadows would fall back over the stretch."""
+    def shades(mesh_vertices: np.ndarray) -> bool:
+        s_road, t_road, _ = _road_frame(piece.line, mesh_vertices)
+        return bool(np.sign(t_road.mean()) == sign and s_road.max() > s0 and s_road.min() < s1 + SUNWARD_SHADOW_M)
+
+    ctx.meshes[:] = [mesh for mesh in ctx.meshes if mesh.kind not in SUNWARD_KINDS or not shades(mesh.vertices)]
+
+
 @dataclass(frozen=True)
 class StreetlightShadowLevel(SunAheadLevel):
     """What one severity level of ``StreetlightShadow`` sets."""
@@ -167,23 +181,24 @@ class StreetlightShadow(SunShadowIllusion):
     """Rows of street lamps whose shadows, poles and arms, stripe the lanes."""
 
     # A low sun from the lamps' side and ahead (``sun_ahead`` from square-on), so each pole throws a long shadow
-    # back along the road at a shallow angle to the lanes: neighbouring poles' shadows run parallel, about a lane
-    # width apart across the road (spacing * tan(90 - sun_ahead)), dark lines that look like lane lines. The sun
-    # sinks only a little between levels (an original with a low sun of its own changes about as much at every
-    # level); the level hardens it and makes the lamps taller and closer, so the shadows grow longer (pole height
-    # / tan(altitude): 16 m to 30 m), reach over more lanes and stripe more of the road.
+    # back along the road at a shallow angle (20 deg) to the lanes: neighbouring poles' shadows run parallel, a
+    # lane-like spacing * tan(90 - sun_ahead) apart across the road (11 m to 4 m over the levels), dark lines that
+    # cross the lanes and run along them. The sun sinks with the level (26 to 14 deg), the lamps grow taller and
+    # closer, so the shadows grow longer (pole height / tan(altitude): 14 m to 44 m), reach over more lanes and
+    # stripe more of the road. Buildings on the lamps' side along the stretch are left out (``clear_sunward``):
+    # their own shadows at so low a sun would cover the road and swallow the poles'.
     SEVERITY: ClassVar[tuple[StreetlightShadowLevel, ...]] = (
-        StreetlightShadowLevel(sun_altitude=24.0, sun_ahead=68.0, sun_intensity=1.1, penumbra=0.010, spacing=30.0,
+        StreetlightShadowLevel(sun_altitude=26.0, sun_ahead=70.0, sun_intensity=1.1, penumbra=0.010, spacing=30.0,
                                pole_height=7.0, pole_radius=0.12, arm=1.2),  # sparse lamps, shadows into one lane
-        StreetlightShadowLevel(sun_altitude=23.0, sun_ahead=68.0, sun_intensity=1.2, penumbra=0.008, spacing=24.0,
+        StreetlightShadowLevel(sun_altitude=22.0, sun_ahead=70.0, sun_intensity=1.2, penumbra=0.008, spacing=24.0,
                                pole_height=8.0, pole_radius=0.14, arm=1.5),
-        StreetlightShadowLevel(sun_altitude=22.0, sun_ahead=68.0, sun_intensity=1.3, penumbra=0.007, spacing=19.0,
+        StreetlightShadowLevel(sun_altitude=19.0, sun_ahead=70.0, sun_intensity=1.3, penumbra=0.007, spacing=18.0,
                                pole_height=9.0, pole_radius=0.16, arm=1.8),
-        StreetlightShadowLevel(sun_altitude=21.0, sun_ahead=68.0, sun_intensity=1.4, penumbra=0.006, spacing=15.0,
+        StreetlightShadowLevel(sun_altitude=16.0, sun_ahead=70.0, sun_intensity=1.4, penumbra=0.006, spacing=14.0,
                                pole_height=10.0, pole_radius=0.18, arm=2.0),
-        StreetlightShadowLevel(sun_altitude=20.0, sun_ahead=68.0, sun_intensity=1.5, penumbra=0.005, spacing=12.0,
+        StreetlightShadowLevel(sun_altitude=14.0, sun_ahead=70.0, sun_intensity=1.5, penumbra=0.005, spacing=11.0,
                                pole_height=11.0, pole_radius=0.20,
-                               arm=2.2),  # tall dense lamps: lane-like stripes over every lane
+                               arm=2.2),  # tall dense lamps, long shadows: lane-like stripes over every lane
     )
 
     type: Literal["streetlight_shadow"] = "streetlight_shadow"
@@ -207,6 +222,7 @@ class StreetlightShadow(SunShadowIllusion):
         spacing = self.spacing if self.spacing is not None else level.spacing
         signs = (-1.0, 1.0) if self.side == "both" else (side_sign(self.side),)
         self.apply_sun(ctx, s0, signs[0])
+        clear_sunward(ctx, piece, s0, s1, signs[0])
         gaps = blocked(ctx, piece)
         for k, sign in enumerate(signs):
             s_poles = np.arange(s0 + 0.5 * spacing * k, s1, spacing)

@@ -12,7 +12,7 @@ from ..camera import ego_path
 from ..case import Case
 from ..illusions import CompileContext, EgoDrive, MeshFileError
 from ..illusions.traffic import mesh_path
-from ..world.environment import environment_for, is_night
+from ..world.environment import environment_for, in_proportion, is_night
 from ..world.paint import road_paint
 from ..world.road_layout import RoadNetwork, build_network
 from ..world.scene import CompiledScene, Mesh
@@ -71,8 +71,11 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
                          meshes_dir=meshes_dir)
     ctx.meshes.extend(roadside)
+    case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
         illusion.compile(ctx)
+    if case.camera.sensor is not None:  # a photograph: sun and sky in daylight's proportion for the final sun
+        in_proportion(ctx.env, air_mass=ctx.env.sun_intensity == case_sun)
     return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),
                          ego=ego_path(case, network), meshes=ctx.meshes, layers=ctx.layers, lights=ctx.lights)

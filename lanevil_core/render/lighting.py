@@ -12,6 +12,7 @@ NORMAL_OFFSET_M = 0.03
 LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
+FOOTPRINT_TAPS = 4  # most shadow lookups along each side of a pixel's footprint (photographed frames)
 # Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
 NEAR_AROUND, FAR_AROUND = range(2)
 
@@ -165,6 +166,45 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
             lit = taps / 9.0
     # Every path ends on a use of the three arrays, so numba releases them in one place (see ``_jit``).
     return lit if maps.shape[0] == cells.shape[0] == params.shape[0] else lit
+
+
+@kernel(inline="always")
+def _texels_per_metre(px: float, py: float, pz: float, params: np.ndarray, R_light: np.ndarray, size: int) -> float:
+    """Texels per metre of the first cascade that holds world point p (the last one's when none does)."""
+    u = R_light[0, 0] * px + R_light[0, 1] * py + R_light[0, 2] * pz
+    v = R_light[1, 0] * px + R_light[1, 1] * py + R_light[1, 2] * pz
+    scale = params[params.shape[0] - 1, 2]
+    for c in range(params.shape[0]):
+        x = (u - params[c, 0]) * params[c, 2]
+        y = (v - params[c, 1]) * params[c, 2]
+        if x >= 2 and y >= 2 and x <= size - 2 and y <= size - 2:
+            scale = params[c, 2]
+            break
+    return scale if params.shape[1] == R_light.shape[1] else scale  # one release of both arrays (see ``_jit``)
+
+
+@kernel(inline="always")
+def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
+                        bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray,
+                        R_light: np.ndarray, penumbra: float, du: tuple[float, float, float],
+                        dv: tuple[float, float, float]) -> float:
+    """The mean of ``sun_visibility`` over a pixel's footprint, the parallelogram p + a du + b dv (|a|, |b| <=
+    1/2; du, dv are the world steps of one pixel across and down on the surface): a lookup every shadow-map texel
+    or so along each side, at most FOOTPRINT_TAPS. Shadows finer than a pixel (a slatted fence's far off) then
+    average to their share of shade instead of beating with the pixel grid (moire)."""
+    scale = _texels_per_metre(px, py, pz, params, R_light, maps.shape[1])
+    n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
+    n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
+    total = 0.0
+    for j in range(n_v):
+        b = (j + 0.5) / n_v - 0.5
+        for i in range(n_u):
+            a = (i + 0.5) / n_u - 0.5
+            total += sun_visibility(px + a * du[0] + b * dv[0], py + a * du[1] + b * dv[1],
+                                    pz + a * du[2] + b * dv[2], nx, ny, nz, offset, bias_texels, maps, cells, params,
+                                    R_light, penumbra)
+    mean = total / (n_u * n_v)
+    return mean if maps.shape[0] == cells.shape[0] == params.shape[0] else mean  # see ``sun_visibility``
 
 
 @kernel(inline="always")

@@ -34,6 +34,7 @@ from .lighting import (
     sky_openness,
     sky_radiance,
     sun_visibility,
+    sun_visibility_over,
 )
 from .surface import paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
@@ -222,6 +223,22 @@ def road_footprint(R_world_camera: np.ndarray, fx: float, fy: float,
     fs = coordinate_step(grad_cam[0], grad_cam[1], grad_cam[2], x_cam, y_cam, k_u, k_v, su, sv)
     ft = coordinate_step(grad_cam[3], grad_cam[4], grad_cam[5], x_cam, y_cam, k_u, k_v, su, sv)
     return fs, ft
+
+
+@kernel(inline="always")
+def pixel_steps(R_world_camera: np.ndarray, fx: float, fy: float, depth: float, norm: float, dx: float, dy: float,
+                dz: float, nx: float, ny: float, nz: float,
+                n_dot_v: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """(du, dv): the world steps on the face's plane (normal n, facing the viewer) between the pixel and its
+    neighbours across and down, by ray differentials (see ``road_footprint``)."""
+    R = R_world_camera
+    n_dot_r = -max(n_dot_v, 1e-4) * norm
+    k_u = (nx * R[0, 0] + ny * R[1, 0] + nz * R[2, 0]) / n_dot_r
+    k_v = (nx * R[0, 1] + ny * R[1, 1] + nz * R[2, 1]) / n_dot_r
+    su, sv = depth / fx, depth / fy
+    rx, ry, rz = dx * norm, dy * norm, dz * norm  # the pixel's ray (camera z = 1) in world axes
+    return ((su * (R[0, 0] - k_u * rx), su * (R[1, 0] - k_u * ry), su * (R[2, 0] - k_u * rz)),
+            (sv * (R[0, 1] - k_v * rx), sv * (R[1, 1] - k_v * ry), sv * (R[2, 1] - k_v * rz)))
 
 
 @kernel(inline="always")
@@ -484,7 +501,12 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         fresnel = fresnel_schlick(n_dot_v, max(surface[kind, F0], gloss * 0.08))
         n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        if sun_i > 0.0 and n_dot_l > 0.0:
+        if sun_i > 0.0 and n_dot_l > 0.0 and detail > 0.0:  # a photograph: shadows filtered over the pixel
+            du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
+            vis = sun_visibility_over(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS],
+                                      maps, cells, shadow_params, R_light, penumbra, du, dv)
+            direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
+        elif sun_i > 0.0 and n_dot_l > 0.0:
             vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
                                  cells, shadow_params, R_light, penumbra)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)

@@ -18,6 +18,24 @@ NIGHT_EXPOSURE = 2.2
 PHOTO_DETAIL = 1.5  # surface texture of a case seen through a real camera's sensor (0 in the ideal render)
 HEADLIGHT_INTENSITY = 35.0  # radiance scale at 1 m of each of the ego's two headlights (on at night)
 
+# Daylight of a photographed case (docs/realism.md, "Sun and sky in proportion"). Clear-sky beam and diffuse by the
+# ASHRAE clear-sky model (ASHRAE Handbook of Fundamentals; Threlkeld & Jordan 1958), its 21 April row:
+# beam normal E_DN = A exp(-B / sin(altitude)) W/m2, diffuse on the ground E_d = C E_DN.
+ASHRAE_A_W_M2, ASHRAE_B, ASHRAE_C = 1136.0, 0.180, 0.097
+# Clouds (Kasten & Czeplak 1980, N = cloud cover 0..1): global G(N) = G_clear (1 - 0.75 N**3.4), the diffuse part
+# of it D/G rising from its clear-sky value to 1 as N**2 (their 0.3 + 0.7 N**2 with 0.3 the clear share).
+KC_GLOBAL, KC_GLOBAL_POWER = 0.75, 3.4
+# Anisotropic sky (Hay & Davies 1980): the share beam / extraterrestrial irradiance of the diffuse light is
+# circumsolar, seen from the sun's direction, so a shadow loses it with the beam.
+SOLAR_CONSTANT_W_M2 = 1361.0
+# The renderer's irradiance unit: sun_intensity 1 = the clear-sky beam of a sun at the zenith, SUN_SCALE on a face
+# square to it (render.lighting); the sky's ambient is in units of its colour's luminance (render.shading).
+SKY_AMBIENT_GAIN = 2.2
+SUN_SCALE = 3.2
+LUMA = np.array([0.2126, 0.7152, 0.0722])
+MODEL_MIN_ALTITUDE_DEG = 5.0
+NIGHT_AMBIENT = 0.01
+
 
 def sun_direction(azimuth_deg: float, altitude_deg: float) -> FloatArray:
     """(3,) unit vector from the ground towards the sun (azimuth CCW from +X, altitude above the horizon)."""
@@ -37,6 +55,61 @@ def is_night(sun_altitude_deg: float) -> bool:
     return sun_altitude_deg <= NIGHT_SUN_ALTITUDE_DEG
 
 
+def clear_sky(altitude_deg: float) -> tuple[float, float]:
+    """(beam normal, diffuse on the ground) W/m2 of a clear sky for a sun ``altitude_deg`` above the horizon."""
+    sin_alt = max(np.sin(np.radians(altitude_deg)), 0.02)
+    beam = ASHRAE_A_W_M2 * float(np.exp(-ASHRAE_B / sin_alt))
+    return beam, ASHRAE_C * beam
+
+
+def daylight(altitude_deg: float, cloud: float) -> tuple[float, float]:
+    """(beam normal, diffuse on the ground) W/m2 under ``cloud`` cover (0..1): the clear sky's thinned by the
+    clouds (Kasten & Czeplak)."""
+    beam, diffuse = clear_sky(altitude_deg)
+    sin_alt = max(np.sin(np.radians(altitude_deg)), 0.02)
+    global_clear = beam * sin_alt + diffuse
+    global_cloudy = global_clear * (1.0 - KC_GLOBAL * cloud**KC_GLOBAL_POWER)
+    share = diffuse / global_clear
+    diffuse_share = share + (1.0 - share) * cloud**2
+    return global_cloudy * (1.0 - diffuse_share) / sin_alt, global_cloudy * diffuse_share
+
+
+def _beam_through_clouds(altitude_deg: float, cloud: float) -> float:
+    """The share of a clear sky's beam that ``cloud`` cover lets through (Kasten & Czeplak)."""
+    altitude = max(altitude_deg, MODEL_MIN_ALTITUDE_DEG)
+    return daylight(altitude, cloud)[0] / clear_sky(altitude)[0]
+
+
+def in_proportion(env: Environment, air_mass: bool = True) -> None:
+    """Set ``env``'s sun and sky irradiance in the physical proportion of daylight at its sun's altitude and its
+    cloudiness (the photographed path; the ideal render keeps its own numbers).
+
+    ``env.sun_intensity`` stays the sun's clearness (1 = a clear sky's beam; ``environment_for`` thins it by the
+    case's clouds as the daylight model does; illusions raise it for a harder sun); the beam now also falls with
+    the air mass at low altitude, and the sky's diffuse light on the ground is the daylight model's for that
+    altitude and cloud cover. The circumsolar part of that diffuse light comes from around the sun and is shaded
+    with it (Hay & Davies): it joins the sun's beam, and only the rest lights the shadows from the open sky.
+    ``air_mass`` False: the sun was set by an illusion whose table gives its light as seen (1 = a clear noon sun),
+    so its beam keeps that; the sky's light still follows its altitude."""
+    if env.night or env.sun_intensity <= 0.0:
+        return
+    altitude = float(np.degrees(np.arcsin(np.clip(env.sun_dir_world[2], -1.0, 1.0))))
+    model_altitude = max(altitude, MODEL_MIN_ALTITUDE_DEG)  # the clear-sky fits hold above a few degrees
+    zenith_beam, _ = clear_sky(90.0)
+    beam, _ = clear_sky(model_altitude)
+    _, diffuse = daylight(model_altitude, env.cloudiness)
+    day = float(np.clip((altitude - NIGHT_SUN_ALTITUDE_DEG) / 12.0, 0.0, 1.0))
+    sky = 0.5 * np.asarray(env.sky_zenith, np.float64) + 0.5 * np.asarray(env.sky_horizon, np.float64)
+    beam_now = env.sun_intensity * (beam if air_mass else zenith_beam)
+    # Hay & Davies' anisotropy index, of a beam no brighter than a clear sky's (illusions push the sun beyond it)
+    circumsolar = min(env.sun_intensity, 1.0) * beam / SOLAR_CONSTANT_W_M2
+    sin_alt = float(np.sin(np.radians(model_altitude)))
+    env.sun_intensity = float((beam_now + circumsolar * day * diffuse / sin_alt) / zenith_beam)
+    isotropic = (1.0 - circumsolar) * day * diffuse
+    env.ambient = float(max(SUN_SCALE * isotropic / zenith_beam / (SKY_AMBIENT_GAIN * float(LUMA @ sky)),
+                            NIGHT_AMBIENT))
+
+
 def environment_for(case: Case) -> Environment:
     """Sun, sky, wetness and fog of a case (before illusions change them)."""
     weather, sun = case.weather, case.sun
@@ -51,14 +124,15 @@ def environment_for(case: Case) -> Environment:
     zenith = _mix(clear_zenith, grey * 0.8, cloud) * day + np.array([0.004, 0.006, 0.015]) * (1 - day)
     horizon = _mix(_mix(clear_horizon, [0.95, 0.7, 0.5], low * 0.6 * (1 - cloud)), grey, cloud)
     horizon = horizon * day + np.array([0.01, 0.012, 0.02]) * (1 - day)
-    direct = sun.intensity * day * (1.0 - 0.85 * cloud)
+    photographed = case.camera.sensor is not None
+    direct = sun.intensity * day * (_beam_through_clouds(altitude, cloud) if photographed else 1.0 - 0.85 * cloud)
     return Environment(
         sun_dir_world=sun_direction(sun.azimuth, max(altitude, 0.5)),
         sun_intensity=float(direct),
         sun_color=sun_color,
         sky_zenith=zenith.astype(np.float32),
         sky_horizon=horizon.astype(np.float32),
-        ambient=float(0.25 + 0.35 * cloud) * day + 0.01 * (1 - day),
+        ambient=float(0.25 + 0.35 * cloud) * day + NIGHT_AMBIENT * (1 - day),
         wetness=float(np.clip(max(weather.wetness, weather.precipitation) / 100.0, 0.0, 1.0)),
         puddles=weather.precipitation_deposits / 100.0,
         fog_density=0.0004 + weather.fog_density / 100.0 * 0.03,
@@ -68,5 +142,5 @@ def environment_for(case: Case) -> Environment:
         exposure=1.0 if not night else NIGHT_EXPOSURE,
         night=night,
         headlights=HEADLIGHT_INTENSITY if night else 0.0,
-        detail=PHOTO_DETAIL if case.camera.sensor is not None else 0.0,
+        detail=PHOTO_DETAIL if photographed else 0.0,
     )

@@ -13,9 +13,10 @@ from hypothesis import strategies as st
 from lanevil_core.camera import intrinsics_for, mounted_camera
 from lanevil_core.camera.cover import cover_camera
 from lanevil_core.camera.lens import distort, undistort
-from lanevil_core.camera.sensor import KEY, development, filmic, metered_gain, white_balance_gains
+from lanevil_core.camera.sensor import KEY, LUMA, development, filmic, metered_gain, white_balance_gains
 from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
 from lanevil_core.pipeline.compile import compile_scene
+from lanevil_core.world.environment import SKY_AMBIENT_GAIN, SUN_SCALE, clear_sky, daylight
 from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import render_frame
 
@@ -87,6 +88,44 @@ def test_metering_brings_the_frame_to_middle_grey_within_limits() -> None:
     dark = development(flat * 0.01, Sensor())
     bright = development(flat, Sensor())
     assert dark.iso_gain > bright.iso_gain and dark.shot > bright.shot  # noise rises with gain in low light
+
+
+def _shadow_share(case: Case) -> float:
+    """Light on flat ground in shadow over light in the sun (luminance), as the renderer gets them."""
+    env = compile_scene(case).env
+    sky = 0.5 * env.sky_zenith.astype(np.float64) + 0.5 * env.sky_horizon.astype(np.float64)
+    shade = env.ambient * SKY_AMBIENT_GAIN * float(LUMA @ sky)
+    sun = SUN_SCALE * env.sun_intensity * env.sun_dir_world[2] * float(LUMA @ env.sun_color)
+    return shade / (shade + sun)
+
+
+def test_daylight_models_give_the_published_proportions() -> None:
+    beam, diffuse = clear_sky(45.0)
+    assert 850 < beam < 900 and diffuse / (beam * np.sin(np.radians(45.0)) + diffuse) == pytest.approx(0.12, abs=0.01)
+    assert daylight(45.0, 0.0) == pytest.approx(clear_sky(45.0))
+    overcast_beam, overcast_diffuse = daylight(45.0, 1.0)
+    assert overcast_beam == pytest.approx(0.0, abs=1e-9)  # Kasten & Czeplak: all light diffuse at 8 oktas
+    assert overcast_diffuse == pytest.approx(0.25 * (beam * np.sin(np.radians(45.0)) + diffuse))
+
+
+def test_photographed_shadows_darken_with_a_higher_sun_and_fade_under_clouds() -> None:
+    def share(altitude: float, cloudiness: float, camera: dict | None = None) -> float:
+        camera = {"preset": "carla"} if camera is None else camera
+        return _shadow_share(Case(sun={"altitude": altitude, "azimuth": 0.0, "intensity": 1.0},
+                                  weather={"cloudiness": cloudiness}, camera=camera))
+
+    clear = [share(altitude, 0.0) for altitude in (15.0, 20.0, 30.0, 45.0, 60.0)]
+    assert all(a > b for a, b in zip(clear, clear[1:]))
+    assert 0.03 < clear[-1] < clear[1] < 0.2
+    assert share(45.0, 30.0) < share(45.0, 60.0) < share(45.0, 90.0)
+    assert share(45.0, 90.0) > 0.6  # overcast: faint shadows
+    assert share(45.0, 0.0, {}) == pytest.approx(0.12, abs=0.01)  # the ideal render keeps its own numbers
+
+
+def test_the_sun_unit_is_the_renderers() -> None:
+    from lanevil_core.render.lighting import SUN_SCALE as RENDER_SUN_SCALE
+
+    assert SUN_SCALE == RENDER_SUN_SCALE
 
 
 def test_filmic_curve_is_monotone_from_black_to_white_and_white_balance_is_neutral_at_daylight() -> None:

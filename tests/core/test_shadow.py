@@ -44,10 +44,14 @@ def road_coords(line: ReferenceLine, p_world: np.ndarray) -> np.ndarray:
     return np.stack([s, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]], axis=1)
 
 
-def shadow_points(scene: CompiledScene) -> np.ndarray:
-    """(n, 2) x, y where the sun ray through each raised vertex of the illusion meets the flat road z = 0."""
+def shadow_points(scene: CompiledScene, upright: bool = False) -> np.ndarray:
+    """(n, 2) x, y where the sun ray through each raised vertex of the illusion meets the flat road z = 0.
+    ``upright``: the structure is solid below its vertices (poles), so the shadow of the whole upright under each
+    vertex counts, sampled every tenth of its length."""
     p_world = own_vertices(scene)
     p_world = p_world[p_world[:, 2] > 0.3]
+    if upright:
+        p_world = np.concatenate([p_world * [1.0, 1.0, k] for k in np.linspace(0.1, 1.0, 10)])
     sun = scene.env.sun_dir_world
     return (p_world - sun * (p_world[:, 2:3] / sun[2]))[:, :2]
 
@@ -124,7 +128,8 @@ def test_default_sun_stands_on_the_structure_side_and_ahead(name: str, side: str
 @pytest.mark.parametrize("severity", [3, 5])
 def test_shadows_fall_on_the_ego_lane_in_view(name: str, severity: int) -> None:
     case = Case(illusions=[{"type": name, "severity": severity}])
-    x, y = shadow_points(compiled(case.illusions[0].model_dump())).T  # straight road along +X: x = s, y = t
+    # straight road along +X: x = s, y = t
+    x, y = shadow_points(compiled(case.illusions[0].model_dump()), upright=name == "streetlight_shadow").T
     ego_lane = (y > -case.road.lane_width) & (y < 0.0)
     in_view = (x > case.ego.start_s + 5.0) & (x < case.ego_s(case.ego.frames - 1) + 30.0)
     assert (ego_lane & in_view).sum() > 20
