@@ -16,9 +16,9 @@ from lanevil_core.camera.lens import distort, undistort
 from lanevil_core.camera.sensor import KEY, LUMA, development, filmic, metered_gain, white_balance_gains
 from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
 from lanevil_core.pipeline.compile import compile_scene
-from lanevil_core.world.environment import SKY_AMBIENT_GAIN, SUN_SCALE, clear_sky, daylight
 from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import render_frame
+from lanevil_core.world.environment import SKY_AMBIENT_GAIN, SUN_SCALE, clear_sky, daylight
 
 
 @pytest.mark.parametrize("name", CAMERA_PRESET_NAMES)
