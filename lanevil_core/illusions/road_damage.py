@@ -401,8 +401,8 @@ class GuardRail(Illusion):
     # sinking with the level would shade a street canyon's whole road and lower the change there.)
     SEVERITY: ClassVar[tuple[GuardRailLevel, ...]] = (
         GuardRailLevel(offset=2.4, far_side=False, median=False, albedo=0.30, shadow_m=0.0),  # one rail, set back
-        GuardRailLevel(offset=1.6, far_side=False, median=False, albedo=0.44, shadow_m=2.5),
-        GuardRailLevel(offset=1.0, far_side=True, median=False, albedo=0.58, shadow_m=2.5),  # both edges
+        GuardRailLevel(offset=1.8, far_side=False, median=False, albedo=0.38, shadow_m=2.5),
+        GuardRailLevel(offset=0.9, far_side=True, median=False, albedo=0.62, shadow_m=2.5),  # both edges
         GuardRailLevel(offset=0.5, far_side=True, median=False, albedo=0.72, shadow_m=2.5),
         GuardRailLevel(offset=0.1, far_side=True, median=True, albedo=0.85, shadow_m=2.5),  # and the median
     )

@@ -190,10 +190,10 @@ class StreetlightShadow(SunShadowIllusion):
     SEVERITY: ClassVar[tuple[StreetlightShadowLevel, ...]] = (
         StreetlightShadowLevel(sun_altitude=26.0, sun_ahead=70.0, sun_intensity=1.1, penumbra=0.010, spacing=30.0,
                                pole_height=7.0, pole_radius=0.12, arm=1.2),  # sparse lamps, shadows into one lane
-        StreetlightShadowLevel(sun_altitude=22.0, sun_ahead=70.0, sun_intensity=1.2, penumbra=0.008, spacing=24.0,
-                               pole_height=8.0, pole_radius=0.14, arm=1.5),
-        StreetlightShadowLevel(sun_altitude=19.0, sun_ahead=70.0, sun_intensity=1.3, penumbra=0.007, spacing=18.0,
-                               pole_height=9.0, pole_radius=0.16, arm=1.8),
+        StreetlightShadowLevel(sun_altitude=22.0, sun_ahead=70.0, sun_intensity=1.25, penumbra=0.008, spacing=22.0,
+                               pole_height=8.0, pole_radius=0.15, arm=1.5),
+        StreetlightShadowLevel(sun_altitude=19.0, sun_ahead=70.0, sun_intensity=1.35, penumbra=0.007, spacing=17.0,
+                               pole_height=9.0, pole_radius=0.17, arm=1.8),
         StreetlightShadowLevel(sun_altitude=16.0, sun_ahead=70.0, sun_intensity=1.4, penumbra=0.006, spacing=14.0,
                                pole_height=10.0, pole_radius=0.18, arm=2.0),
         StreetlightShadowLevel(sun_altitude=14.0, sun_ahead=70.0, sun_intensity=1.5, penumbra=0.005, spacing=11.0,
