@@ -92,9 +92,10 @@ def test_a_draft_is_the_frame_without_the_sensor_stage(make_case) -> None:
     assert frames.draft(case, 2, (160, 90)) is draft  # cached
     without_sensor = FrameService(threads=1).frame(ideal, 2, (160, 90)).rgb
     photographed = frames.frame(case, 2, (160, 90)).rgb
-    # Close to the case rendered without a sensor (the sensor's surface texture detail is compiled into the scene),
-    # far from the photographed frame (auto-exposure, filmic curve, noise, sharpening).
-    assert mean_difference(draft.rgb, without_sensor) < 2.0
-    assert mean_difference(draft.rgb, photographed) > 10.0
+    # Close to the case rendered without a sensor (the sensor's surface texture detail is compiled into the scene;
+    # its daylight in proportion darkens the shaded road a little), far from the photographed frame (auto-exposure,
+    # filmic curve, noise, sharpening).
+    to_ideal, to_photograph = mean_difference(draft.rgb, without_sensor), mean_difference(draft.rgb, photographed)
+    assert to_ideal < 5.0 and to_photograph > 10.0 and to_photograph > 3 * to_ideal
     overlaid = frames.draft(case, 2, (160, 90), overlay=True)
     assert overlaid.rgb.shape == (90, 160, 3) and not np.array_equal(overlaid.rgb, draft.rgb)
