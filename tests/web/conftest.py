@@ -137,6 +137,14 @@ def pick() -> Callable[..., None]:
     return _pick
 
 
+@pytest.fixture
+def editor_url(editor: Editor) -> str:
+    """The editor's page for a browser test. Software WebGL (SwiftShader) spends about two CPU seconds on each
+    full-resolution frame of a road scene, and viser draws one a second even when idle, so a test page draws the
+    3D view at a quarter of the resolution (viser's ``fixedDpr``): two open tabs no longer starve the server."""
+    return f"http://127.0.0.1:{editor.port}/?fixedDpr=0.25"
+
+
 EDITOR_START_S = 120.0  # the first preview compiles the numba kernels on a cold cache
 
 

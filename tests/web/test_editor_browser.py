@@ -26,11 +26,11 @@ def editor(state: AppState) -> Iterator[Editor]:
     editor.stop()
 
 
-def open_page(browser, editor: Editor):
+def open_page(browser, editor: Editor, url: str):
     """A new page on the editor, and the tab the editor built for it."""
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SHOT_MS)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.goto(url)
     return page, editor.tab(timeout=WAIT_S)
 
 
@@ -42,11 +42,11 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
         time.sleep(0.1)
 
 
-def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, state: AppState,
+def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, editor_url: str, state: AppState,
                                                     screenshot_dir: Path) -> None:
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SHOT_MS)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.goto(editor_url)
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
     tab = editor.tab(timeout=WAIT_S)
     wait_for(lambda: tab.view.surface is not None, "the scene")
@@ -85,9 +85,9 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, stat
     page.close()
 
 
-def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: Editor, pick,
+def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: Editor, editor_url: str, pick,
                                                                screenshot_dir: Path) -> None:
-    page, tab = open_page(browser, editor)
+    page, tab = open_page(browser, editor, editor_url)
     wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
@@ -112,8 +112,9 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     page.close()
 
 
-def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, pick, screenshot_dir: Path) -> None:
-    page, tab = open_page(browser, editor)
+def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, editor_url: str,
+                                                  pick, screenshot_dir: Path) -> None:
+    page, tab = open_page(browser, editor, editor_url)
     wait_for(lambda: tab.view.surface is not None, "the scene")
     preview = page.locator("img[src^='blob:']").first
     preview.wait_for(timeout=WAIT_S * 1000)
@@ -137,13 +138,14 @@ def test_camera_preset_and_sliders_in_the_browser(browser, editor: Editor, pick,
 INJECTION = '<iframe srcdoc="<script>alert(1)</script>"></iframe><img src=x onerror=alert(2)> [x](javascript:alert(3))'
 
 
-def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, state: AppState, monkeypatch) -> None:
+def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, editor_url: str,
+                                                 state: AppState, monkeypatch) -> None:
     record = state.store.create(state.store.list()[0].case.model_copy(
         update={"title": INJECTION, "description": INJECTION}), case_id="injected")
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     dialogs: list[str] = []
     page.on("dialog", lambda dialog: (dialogs.append(dialog.message), dialog.dismiss()))
-    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.goto(editor_url)
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
     tab = editor.tab(timeout=WAIT_S)
     scripts_before = page.locator("script").count()
@@ -176,9 +178,9 @@ def drag_thumb(page, thumb, dx: float) -> None:
     page.mouse.up()
 
 
-def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Editor, pick,
+def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Editor, editor_url: str, pick,
                                                              screenshot_dir: Path) -> None:
-    page, tab = open_page(browser, editor)
+    page, tab = open_page(browser, editor, editor_url)
     page.locator("img[src^='blob:']").first.wait_for(timeout=WAIT_S * 1000)
     assert tab.preview.wait_idle(WAIT_S) and tab.panel.quality.value == "draft"
     shown: list[bool] = []  # whether each pushed preview was a draft

@@ -41,17 +41,18 @@ def dropdowns(page) -> list[str]:
     return page.locator("input[role=combobox]").evaluate_all("(inputs) => inputs.map((i) => i.value)")
 
 
-def open_tab(browser, editor: Editor):
+def open_tab(browser, editor: Editor, url: str):
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     page.set_default_timeout(SLOW_MS)
     newest = max(editor.tabs, default=-1)
-    page.goto(f"http://127.0.0.1:{editor.port}/")
+    page.goto(url)
     page.get_by_role("button", name="Save", exact=True).wait_for()
     return page, editor.tab(timeout=WAIT_S, after=newest)
 
 
-def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: AppState, screenshot_dir: Path) -> None:
-    (page0, tab0), (page1, tab1) = open_tab(browser, editor), open_tab(browser, editor)
+def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, editor_url: str,
+                                              state: AppState, screenshot_dir: Path) -> None:
+    (page0, tab0), (page1, tab1) = open_tab(browser, editor, editor_url), open_tab(browser, editor, editor_url)
     assert tab0 is not tab1 and tab0.session.case_id == tab1.session.case_id
     case_id = tab0.session.case_id
 
@@ -79,15 +80,15 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, state: Ap
         page.close()
 
 
-def test_view_settings_stay_in_their_tab(browser, editor: Editor, pick, screenshot_dir: Path) -> None:
+def test_view_settings_stay_in_their_tab(browser, editor: Editor, editor_url: str, pick, screenshot_dir: Path) -> None:
     """Quality and Detector chosen in one tab do not show in a tab opened after (open tabs: test_editor_tabs.py)."""
-    page0, tab0 = open_tab(browser, editor)
+    page0, tab0 = open_tab(browser, editor, editor_url)
     defaults = dropdowns(page0)
     assert "draft" in defaults and "none" in defaults
     pick(page0, "draft", "full")
     pick(page0, "none", "hough")
     wait_for(lambda: (tab0.panel.quality.value, tab0.panel.detector.value) == ("full", "hough"), "the first tab")
-    page1, tab1 = open_tab(browser, editor)
+    page1, tab1 = open_tab(browser, editor, editor_url)
     assert tab1 is not tab0 and (tab1.panel.quality.value, tab1.panel.detector.value) == ("draft", "none")
     assert dropdowns(page1) == defaults
     assert "full" in dropdowns(page0) and "hough" in dropdowns(page0)
