@@ -15,7 +15,7 @@ from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from ..world.paint import MATERIAL_ALBEDO, stripe_index
 from ..world.road_layout import RoadNetwork
 from ..world.road_mesh import RoadSurface, road_surface
-from ..world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene
+from ..world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene, Mesh
 from .raster import depth_orthographic
 
 
@@ -195,12 +195,6 @@ def _road_surface(network: RoadNetwork) -> RoadSurface:
     return _reuse(("road", id(network)), network, lambda: road_surface(network))
 
 
-def _casters_digest(packed: PackedScene) -> str:
-    """Digest of the shadow casters' triangles (world coordinates, in order)."""
-    corners = packed.vertices[packed.faces[packed.shadow_faces]]
-    return hashlib.blake2b(np.ascontiguousarray(corners).tobytes(), digest_size=16).hexdigest()
-
-
 # How strongly the photographic surface texture (weathering, grime, leaf clumps, tufts) marks each kind of mesh
 # and each road material when the case's camera has a sensor (``Environment.detail``); 0 = flat colour.
 TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.55, "tunnel": 0.6,
@@ -211,59 +205,119 @@ DEFAULT_TEXTURE = 0.3
 MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8], np.float32)
 
 
+FACE_FIELDS = ("mat", "obj", "color", "emission", "gloss", "texture", "shadow", "visible", "mirror")
+
+
+def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:
+    """The road surface's per-vertex and per-face arrays, each the first entry of a list that meshes extend."""
+    m = len(road.faces)
+    return {"verts": [road.vertices], "faces": [road.faces], "st": [road.st], "piece": [road.piece],
+            "mat": [road.material], "obj": [np.where(road.carriageway, ID_ROAD, ID_ROADSIDE).astype(np.int32)],
+            "color": [MATERIAL_ALBEDO[road.material]], "emission": [np.zeros((m, 3), np.float32)],
+            "gloss": [np.zeros(m, np.float32)], "texture": [MATERIAL_TEXTURE[road.material]],
+            "shadow": [np.zeros(m, bool)], "visible": [np.ones(m, bool)], "mirror": [np.zeros(m, bool)]}
+
+
+def _append_meshes(arrays: dict[str, list[np.ndarray]], meshes: list[Mesh], first_index: int, offset: int) -> int:
+    """Append ``meshes`` (object ids from ``first_index``, vertex numbers from ``offset``); return the new offset."""
+    for index, mesh in enumerate(meshes, start=first_index):
+        m = len(mesh.faces)
+        arrays["verts"].append(mesh.vertices)
+        arrays["faces"].append(mesh.faces + offset)
+        arrays["st"].append(np.zeros((len(mesh.vertices), 2)))
+        arrays["piece"].append(np.full(len(mesh.vertices), -1, np.int32))
+        arrays["mat"].append(np.full(m, -1, np.int32))
+        arrays["obj"].append(np.full(m, FIRST_OBJECT_ID + index, np.int32))
+        arrays["color"].append(mesh.colors)
+        arrays["emission"].append(mesh.emission if mesh.emission is not None else np.zeros((m, 3), np.float32))
+        arrays["gloss"].append(np.full(m, mesh.gloss, np.float32))
+        arrays["texture"].append(np.full(m, TEXTURE_BY_KIND.get(mesh.kind, DEFAULT_TEXTURE), np.float32))
+        arrays["shadow"].append(np.full(m, mesh.casts_shadow, bool))
+        arrays["visible"].append(np.full(m, mesh.visible, bool))
+        arrays["mirror"].append(np.full(m, mesh.visible and mesh.kind not in ("building", "terrain"), bool))
+        offset += len(mesh.vertices)
+    return offset
+
+
+@dataclass
+class _Roadside:
+    """The road surface and the roadside meshes that lead ``scene.meshes``, packed (what an edit of the case's
+    illusions, sun or camera leaves as it was), with the per-face work on them done."""
+
+    meshes: tuple[Mesh, ...]
+    arrays: dict[str, np.ndarray]  # each key of _road_arrays, concatenated
+    normals: Float32Array
+    road_grad_st: Float32Array  # (road faces, 6)
+    casters: Any  # blake2b over the shadow casters' corners so far (copied, then fed the rest)
+
+
+def _pack_roadside(road: RoadSurface, meshes: tuple[Mesh, ...]) -> _Roadside:
+    arrays = _road_arrays(road)
+    _append_meshes(arrays, list(meshes), 0, len(road.vertices))
+    joined = {key: np.concatenate(parts) for key, parts in arrays.items()}
+    vertices, faces = joined["verts"], joined["faces"].astype(np.int32)
+    casters = hashlib.blake2b(digest_size=16)
+    casters.update(np.ascontiguousarray(vertices[faces[np.flatnonzero(joined["shadow"])]]).tobytes())
+    road_faces = len(road.faces)
+    road_grad_st = _st_gradients(vertices, faces[:road_faces], joined["st"], road_faces)
+    return _Roadside(meshes, joined, _face_normals(vertices, faces), road_grad_st, casters)
+
+
+def _roadside(scene: CompiledScene, road: RoadSurface) -> _Roadside:
+    """The packed roadside of ``scene``, reused from a scene compiled around the same network and meshes."""
+    leading = 0
+    while leading < len(scene.meshes) and scene.meshes[leading].source < 0:
+        leading += 1
+    meshes = tuple(scene.meshes[:leading])
+    found = _reuse(("roadside", (id(scene.network), leading)), scene.network, lambda: _pack_roadside(road, meshes))
+    if all(a is b for a, b in zip(found.meshes, meshes, strict=True)):
+        return found
+    fresh = _pack_roadside(road, meshes)
+    with _reused_lock:
+        _reused[("roadside", (id(scene.network), leading))] = (scene.network, fresh)
+    return fresh
+
+
 def pack_scene(scene: CompiledScene) -> PackedScene:
-    """Concatenate the road surface and every mesh into flat arrays (cached on the scene)."""
+    """Concatenate the road surface and every mesh into flat arrays (cached on the scene).
+
+    The road and the roadside meshes come first and are packed once per road (``_roadside``); the illusions'
+    meshes follow. The arrays are those of packing everything in one go."""
     cached = scene.cache.get("packed")
     if cached is not None:
         return cached
     road = _road_surface(scene.network)
-    verts, faces, st, piece = [road.vertices], [road.faces], [road.st], [road.piece]
-    mat = [road.material]
-    obj = [np.where(road.carriageway, ID_ROAD, ID_ROADSIDE).astype(np.int32)]
-    color = [MATERIAL_ALBEDO[road.material]]
-    emission = [np.zeros((len(road.faces), 3), np.float32)]
-    gloss = [np.zeros(len(road.faces), np.float32)]
-    texture = [MATERIAL_TEXTURE[road.material]]
-    shadow, visible, mirror = [np.zeros(len(road.faces), bool)], [np.ones(len(road.faces), bool)], [
-        np.zeros(len(road.faces), bool)]
-    offset = len(road.vertices)
-    for index, mesh in enumerate(scene.meshes):
-        m = len(mesh.faces)
-        verts.append(mesh.vertices)
-        faces.append(mesh.faces + offset)
-        st.append(np.zeros((len(mesh.vertices), 2)))
-        piece.append(np.full(len(mesh.vertices), -1, np.int32))
-        mat.append(np.full(m, -1, np.int32))
-        obj.append(np.full(m, FIRST_OBJECT_ID + index, np.int32))
-        color.append(mesh.colors)
-        emission.append(mesh.emission if mesh.emission is not None else np.zeros((m, 3), np.float32))
-        gloss.append(np.full(m, mesh.gloss, np.float32))
-        texture.append(np.full(m, TEXTURE_BY_KIND.get(mesh.kind, DEFAULT_TEXTURE), np.float32))
-        shadow.append(np.full(m, mesh.casts_shadow, bool))
-        visible.append(np.full(m, mesh.visible, bool))
-        mirror.append(np.full(m, mesh.visible and mesh.kind not in ("building", "terrain"), bool))
-        offset += len(mesh.vertices)
-    all_v = np.concatenate(verts)
-    all_f = np.concatenate(faces).astype(np.int32)
+    roadside = _roadside(scene, road)
+    arrays = {key: [value] for key, value in roadside.arrays.items()}
+    leading = len(roadside.meshes)
+    _append_meshes(arrays, scene.meshes[leading:], leading, len(roadside.arrays["verts"]))
+    joined = {key: np.concatenate(parts) for key, parts in arrays.items()}  # fresh arrays for every scene
+    all_v, all_f = joined["verts"], joined["faces"].astype(np.int32)
+    rest = all_f[len(roadside.normals):]
+    grad_st = np.zeros((len(all_f), 6), np.float32)
+    grad_st[:len(road.faces)] = roadside.road_grad_st
+    shadow_faces = np.flatnonzero(joined["shadow"]).astype(np.int32)
+    casters = roadside.casters.copy()
+    casters.update(np.ascontiguousarray(all_v[all_f[shadow_faces[shadow_faces >= len(roadside.normals)]]]).tobytes())
     stripes = scene.paint.stripes(scene.network)
     lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
                       np.float64).reshape(-1, 7)
     packed = PackedScene(
-        vertices=all_v, faces=all_f, vertex_st=np.concatenate(st).astype(np.float32),
-        vertex_piece=np.concatenate(piece), face_material=np.concatenate(mat),
-        face_object=np.concatenate(obj), face_color=np.concatenate(color).astype(np.float32),
-        face_emission=np.concatenate(emission).astype(np.float32), face_gloss=np.concatenate(gloss),
-        face_texture=np.concatenate(texture),
-        face_normal=_face_normals(all_v, all_f),
-        face_grad_st=_st_gradients(all_v, all_f, np.concatenate(st), len(road.faces)),
-        camera_faces=np.flatnonzero(np.concatenate(visible)).astype(np.int32),
-        shadow_faces=np.flatnonzero(np.concatenate(shadow)).astype(np.int32),
-        mirror_faces=np.flatnonzero(np.concatenate(mirror)).astype(np.int32),
+        vertices=all_v, faces=all_f, vertex_st=joined["st"].astype(np.float32),
+        vertex_piece=joined["piece"], face_material=joined["mat"],
+        face_object=joined["obj"], face_color=joined["color"].astype(np.float32),
+        face_emission=joined["emission"].astype(np.float32), face_gloss=joined["gloss"],
+        face_texture=joined["texture"],
+        face_normal=np.concatenate([roadside.normals, _face_normals(all_v, rest)]),
+        face_grad_st=grad_st,
+        camera_faces=np.flatnonzero(joined["visible"]).astype(np.int32),
+        shadow_faces=shadow_faces,
+        mirror_faces=np.flatnonzero(joined["mirror"]).astype(np.int32),
         stripes=stripes, stripe_index=stripe_index(stripes, len(scene.network.pieces), len(scene.paint.markings)),
         layers=layer_atlas(scene), lights=lights,
         overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )
-    packed.overhead, packed.overhead_params = _reuse(("overhead", (id(scene.network), _casters_digest(packed))),
+    packed.overhead, packed.overhead_params = _reuse(("overhead", (id(scene.network), casters.hexdigest())),
                                                      scene.network, lambda: overhead_map(packed, road))
     scene.cache["packed"] = packed
     return packed
