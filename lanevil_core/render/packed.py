@@ -205,9 +205,6 @@ DEFAULT_TEXTURE = 0.3
 MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8], np.float32)
 
 
-FACE_FIELDS = ("mat", "obj", "color", "emission", "gloss", "texture", "shadow", "visible", "mirror")
-
-
 def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:
     """The road surface's per-vertex and per-face arrays, each the first entry of a list that meshes extend."""
     m = len(road.faces)
@@ -218,8 +215,8 @@ def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:
             "shadow": [np.zeros(m, bool)], "visible": [np.ones(m, bool)], "mirror": [np.zeros(m, bool)]}
 
 
-def _append_meshes(arrays: dict[str, list[np.ndarray]], meshes: list[Mesh], first_index: int, offset: int) -> int:
-    """Append ``meshes`` (object ids from ``first_index``, vertex numbers from ``offset``); return the new offset."""
+def _append_meshes(arrays: dict[str, list[np.ndarray]], meshes: list[Mesh], first_index: int, offset: int) -> None:
+    """Append ``meshes`` (object ids from ``first_index``, vertex numbers from ``offset``)."""
     for index, mesh in enumerate(meshes, start=first_index):
         m = len(mesh.faces)
         arrays["verts"].append(mesh.vertices)
@@ -236,7 +233,6 @@ def _append_meshes(arrays: dict[str, list[np.ndarray]], meshes: list[Mesh], firs
         arrays["visible"].append(np.full(m, mesh.visible, bool))
         arrays["mirror"].append(np.full(m, mesh.visible and mesh.kind not in ("building", "terrain"), bool))
         offset += len(mesh.vertices)
-    return offset
 
 
 @dataclass
@@ -264,18 +260,14 @@ def _pack_roadside(road: RoadSurface, meshes: tuple[Mesh, ...]) -> _Roadside:
 
 
 def _roadside(scene: CompiledScene, road: RoadSurface) -> _Roadside:
-    """The packed roadside of ``scene``, reused from a scene compiled around the same network and meshes."""
+    """The packed roadside of ``scene``, reused from a scene compiled around the same network and meshes (the
+    cached value holds its meshes, so equal ids in the key are the same objects)."""
     leading = 0
     while leading < len(scene.meshes) and scene.meshes[leading].source < 0:
         leading += 1
     meshes = tuple(scene.meshes[:leading])
-    found = _reuse(("roadside", (id(scene.network), leading)), scene.network, lambda: _pack_roadside(road, meshes))
-    if all(a is b for a, b in zip(found.meshes, meshes, strict=True)):
-        return found
-    fresh = _pack_roadside(road, meshes)
-    with _reused_lock:
-        _reused[("roadside", (id(scene.network), leading))] = (scene.network, fresh)
-    return fresh
+    return _reuse(("roadside", (id(scene.network), tuple(map(id, meshes)))), scene.network,
+                  lambda: _pack_roadside(road, meshes))
 
 
 def pack_scene(scene: CompiledScene) -> PackedScene:
