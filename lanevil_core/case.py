@@ -17,7 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, Stri
 from .files import write_atomic
 from .illusions import IllusionSpec
 from .presets import camera_preset_values, preset_values
-from .typed import LineType, RoadType, SceneKind, Turn
+from .typed import LineType, Pavement, RoadType, SceneKind, Turn
 
 SCHEMA_VERSION: Literal[1] = 1
 
@@ -73,6 +73,11 @@ class Road(_Model):
         default_factory=list,
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults)",
+    )
+    pavement: Pavement = Field(
+        "asphalt",
+        description="what the carriageway is paved with: asphalt, or concrete slabs (jointed plain concrete "
+        "pavement: 4.5 m slabs, one per lane, with sealed joints, as on concrete highways and bridge decks)",
     )
     paint: StrictBool = Field(
         True,

@@ -46,6 +46,11 @@ SCENE_KINDS: tuple[SceneKind, ...] = ("urban", "suburban", "highway", "rural", "
 
 Turn = Literal["left", "right"]
 
-# Surface materials of the road cross-section (index = material id in the renderer).
-Material = Literal["asphalt", "concrete", "grass", "gravel", "kerb", "dirt"]
-MATERIALS: tuple[Material, ...] = ("asphalt", "concrete", "grass", "gravel", "kerb", "dirt")
+# Surface materials of the road cross-section (index = material id in the renderer). ``slab`` is a carriageway of
+# jointed concrete slabs (a concrete road or bridge deck); ``concrete`` is a sidewalk's or verge's.
+Material = Literal["asphalt", "concrete", "grass", "gravel", "kerb", "dirt", "slab"]
+MATERIALS: tuple[Material, ...] = ("asphalt", "concrete", "grass", "gravel", "kerb", "dirt", "slab")
+
+# What the carriageway is paved with.
+Pavement = Literal["asphalt", "concrete"]
+PAVEMENTS: tuple[Pavement, ...] = ("asphalt", "concrete")

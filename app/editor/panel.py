@@ -13,7 +13,7 @@ import viser
 
 from lanevil_core.illusions import ILLUSION_TYPES
 from lanevil_core.presets import CAMERA_PRESET_NAMES, PRESET_NAMES
-from lanevil_core.typed import ROAD_TYPES, SCENE_KINDS
+from lanevil_core.typed import PAVEMENTS, ROAD_TYPES, SCENE_KINDS
 
 from .detection import DETECTOR_CHOICES, NO_DETECTOR
 from .params import ParamInputs
@@ -59,6 +59,7 @@ class Panel:
     sun_altitude: viser.GuiSliderHandle
     sun_intensity: viser.GuiSliderHandle
     weather: viser.GuiDropdownHandle
+    pavement: viser.GuiDropdownHandle
     camera_preset: viser.GuiDropdownHandle
     camera_fov: viser.GuiSliderHandle
     camera_height: viser.GuiSliderHandle
@@ -133,6 +134,8 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         sun_intensity = gui.add_slider("Sun intensity", 0.0, 3.0, 0.05, 1.0, hint="1 = clear noon")
         weather = gui.add_dropdown("Weather preset", [CUSTOM_WEATHER, *PRESET_NAMES],
                                    hint="fills cloud, rain, puddles, fog and the sun's height")
+        pavement = gui.add_dropdown("Pavement", list(PAVEMENTS), initial_value="asphalt",
+                                    hint="asphalt, or jointed concrete slabs with sealed joints")
     with gui.add_folder("Camera", expand_by_default=False):
         camera_preset = gui.add_dropdown("Camera preset", [CUSTOM_CAMERA, *CAMERA_PRESET_NAMES],
                                          hint="the paper's CARLA camera, a TuSimple- or CULane-like front camera or "
@@ -158,6 +161,7 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
                  selected=selected, severity=severity, delete=delete, upload_mesh=upload_mesh,
                  params=ParamInputs(gui, params_folder, lambda name, value: None),
                  sun_azimuth=sun_azimuth, sun_altitude=sun_altitude, sun_intensity=sun_intensity, weather=weather,
+                 pavement=pavement,
                  camera_preset=camera_preset, camera_fov=camera_fov, camera_height=camera_height,
                  camera_pitch=camera_pitch, camera_roll=camera_roll, camera_k1=camera_k1, camera_bonnet=camera_bonnet,
                  camera_sensor=camera_sensor, camera_exposure=camera_exposure, camera_noise=camera_noise, frame=frame,

@@ -25,6 +25,7 @@ from lanevil_core.illusions import REGISTRY, Illusion, MeshFileError
 from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.pipeline.compile import check_mesh_files, roadside_key
 from lanevil_core.presets import camera_preset_values, preset_values
+from lanevil_core.typed import PAVEMENTS
 from lanevil_core.world.road_layout import RoadNetwork
 from lanevil_core.world.scene import CompiledScene
 
@@ -132,6 +133,7 @@ class EditorTab:
                  "sun_altitude": lambda e: self.set_sun(altitude=float(e.target.value)),
                  "sun_intensity": lambda e: self.set_sun(intensity=float(e.target.value)),
                  "weather": lambda e: self.set_weather_preset(str(e.target.value)),
+                 "pavement": lambda e: self.set_pavement(str(e.target.value)),
                  "camera_preset": lambda e: self.set_camera_preset(str(e.target.value)),
                  "camera_fov": lambda e: self.set_camera(fov=float(e.target.value)),
                  "camera_height": lambda e: self.set_camera(z=float(e.target.value)),
@@ -363,6 +365,14 @@ class EditorTab:
         data["sun"].update({k: v for k, v in values["sun"].items() if k != "azimuth"})
         self._edit(data, f"weather {name}")
 
+    def set_pavement(self, pavement: str) -> None:
+        """Pave the carriageway with ``pavement`` (asphalt or concrete slabs)."""
+        if pavement not in PAVEMENTS:
+            raise EditError(f"road.pavement: {pavement!r} is not one of {', '.join(PAVEMENTS)}")
+        data = self._data()
+        data["road"]["pavement"] = pavement
+        self._edit(data, f"pavement {pavement}")
+
     def set_camera_preset(self, name: str) -> None:
         """See the case through a named camera (its mount, field of view, lens, bonnet and sensor)."""
         if name == CUSTOM_CAMERA:
@@ -545,6 +555,7 @@ class EditorTab:
             p.sun_azimuth.value = _wrap_degrees(case.sun.azimuth)
             p.sun_altitude.value = float(np.clip(case.sun.altitude, p.sun_altitude.min, p.sun_altitude.max))
             p.sun_intensity.value = case.sun.intensity
+            p.pavement.value = case.road.pavement
             camera = case.camera
             for handle, value in ((p.camera_fov, camera.hfov), (p.camera_height, camera.z),
                                   (p.camera_pitch, camera.pitch), (p.camera_roll, camera.roll),

@@ -57,6 +57,7 @@ SUN_ALTITUDE_JITTER_DEG = 10.0
 # edge line, the lane lines of a variation, or (rarely) every line. An unpainted boundary has no label.
 CAMERA_JITTER_SHARE = 0.5
 VARIED_CAMERA_SHARE = 0.75  # --vary-camera: share of train variations seen through a drawn camera
+CONCRETE_SHARE = 0.3  # --vary-camera: share of train variations on a concrete road (drawn after the camera)
 CAMERA_Y_RANGE_M = (-0.7, 0.7)
 CAMERA_Z_RANGE_M = (1.4, 3.2)
 CAMERA_PITCH_RANGE_DEG = (0.0, 4.0)
@@ -325,7 +326,8 @@ def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
 def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False) -> tuple[Case, dict[str, Any]]:
     """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``; with
     ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same), and
-    used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's)."""
+    used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's), and last
+    its pavement (concrete slabs for ``CONCRETE_SHARE`` of them)."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -345,18 +347,19 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     drawn = random_camera(rng, (base.camera.width, base.camera.height)) if vary_camera else None
     if drawn is not None and rng.uniform() < VARIED_CAMERA_SHARE:
         camera = drawn
+    pavement = "concrete" if vary_camera and rng.uniform() < CONCRETE_SHARE else base.road.pavement
     data = base.model_dump()
     data["camera"] = camera
     data["weather"] = values["weather"]
     data["sun"] = {**values["sun"], "azimuth": azimuth, "altitude": round(altitude, 1)}
     data["road"].update(lanes_per_direction=lanes_per_direction, lane_width=lane_width,
-                        markings=markings)
+                        markings=markings, pavement=pavement)
     data["ego"].update(lane=lane, start_s=start_s)
     data["seed"] = case_seed
     data["title"] = f"{base.title} ({preset}, variation {index})"
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
                   "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
-                  "lane_width": lane_width,
+                  "lane_width": lane_width, "pavement": pavement,
                   "camera": {k: camera[k] for k in ("fov", "x", "y", "z", "pitch", "yaw", "roll") if k in camera},
                   "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
+from ..typed import MATERIALS
 from ..world import surface_textures as tex
 from ..world.environment import sun_direction
 from ..world.paint import MATERIAL_ALBEDO
@@ -187,7 +188,8 @@ class RoadCrack(_SurfaceDamage):
         wear = _setting(self, "paint_wear")
         if wear > 0:
             rgba, _ = tex.worn_paint(np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape, area.texel,
-                                     [area.local_t(t) for t in lines], wear, MATERIAL_ALBEDO[0])
+                                     [area.local_t(t) for t in lines], wear,
+                                     MATERIAL_ALBEDO[MATERIALS.index(ctx.network.main.carriageway)])
             self._emit(ctx, area, rgba, None, over_paint=True, name="worn paint")
 
     def _shares(self, alligator_share: float) -> dict[tex.CrackKind, float]:

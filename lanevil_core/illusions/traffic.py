@@ -234,10 +234,10 @@ def half_extents(mesh: Mesh) -> tuple[float, float]:
 
 
 def paved_reach(piece: RoadPiece) -> float:
-    """|t| up to which the road is flat asphalt: the carriageway plus any level asphalt strip at its edge."""
+    """|t| up to which the road is flat pavement: the carriageway plus any level strip at its edge paved like it."""
     reach = piece.half_width
     for strip in piece.strips:
-        if strip.material != "asphalt" or strip.height != 0.0:
+        if strip.material != piece.carriageway or strip.height != 0.0:
             break
         reach += strip.width
     return reach

@@ -46,6 +46,8 @@ MAIN_ROAD_ID = 1
 JUNCTION_ID = 100
 THROUGH_ROAD_ID = JUNCTION_ID + 1  # the first connecting road: the main road through the junction
 REPEAT_MIN_LENGTH_M = 12.0  # objects longer than this along the road are written as repeated objects
+# The carriageway material as an OpenDRIVE lane <material>: surface name and dry friction coefficient.
+SURFACES: dict[str, tuple[str, float]] = {"asphalt": ("asphalt", 0.9), "slab": ("concrete", 0.85)}
 CORNER_RADIUS_M = 4.0  # radius of the innermost lane edge of a junction turn (a tight urban kerb)
 BASE_HEIGHT_M = 1.0  # an upright object's footprint is that of its parts reaching this close to the road
 CLEARANCE_M = 4.0  # a part over the carriageway this high above the road is written as an overhead object
@@ -91,18 +93,22 @@ def road_mark(marking: Marking) -> xodr.RoadMark:
 
 
 def lanes(network: RoadNetwork, markings: list[Marking]) -> xodr.Lanes:
-    """One lane section: the centre lane and ``n`` lanes each side, each with its outer boundary's mark."""
+    """One lane section: the centre lane and ``n`` lanes each side, each with its outer boundary's mark and the
+    carriageway's surface material."""
     xodr = _xodr()
     n = network.lanes_per_direction
+    surface, friction = SURFACES[network.main.carriageway]
     centre = xodr.Lane(a=0.0)
     centre.add_roadmark(road_mark(markings[n]))
     section = xodr.LaneSection(0.0, centre)
     for k in range(1, n + 1):
         left = xodr.Lane(a=network.lane_width)
         left.add_roadmark(road_mark(markings[n - k]))
+        left.add_lane_material(friction, surface=surface)
         section.add_left_lane(left)
         right = xodr.Lane(a=network.lane_width)
         right.add_roadmark(road_mark(markings[n + k]))
+        right.add_lane_material(friction, surface=surface)
         section.add_right_lane(right)
     result = xodr.Lanes()
     result.add_lanesection(section)

@@ -201,8 +201,8 @@ TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "
                                      "bridge": 0.5, "barrier": 0.3, "guard_rail": 0.2, "fence": 0.2, "pole": 0.3,
                                      "streetlight": 0.15, "vehicle": 0.08, "pedestrian": 0.15, "bicycle": 0.1}
 DEFAULT_TEXTURE = 0.3
-# Per road material (index = typed.MATERIALS): asphalt, concrete, grass, gravel, kerb, dirt.
-MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8], np.float32)
+# Per road material (index = typed.MATERIALS): asphalt, concrete, grass, gravel, kerb, dirt, slab.
+MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8, 0.15], np.float32)
 
 
 def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:

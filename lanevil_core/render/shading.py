@@ -36,13 +36,14 @@ from .lighting import (
     sun_visibility,
     sun_visibility_over,
 )
-from .surface import paint, sample_layers, sample_noise
+from .surface import dash_coverage, paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA, DETAIL = range(9)
 ASPHALT = MATERIALS.index("asphalt")
-PAVED = ("asphalt", "concrete", "kerb")  # hold a water film; grass, gravel and dirt soak it up
+SLAB = MATERIALS.index("slab")
+PAVED = ("asphalt", "concrete", "kerb", "slab")  # hold a water film; grass, gravel and dirt soak it up
 # surface_table columns; its rows are the road MATERIALS, then one for every object
 ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0 = range(7)
 OBJECT_ROW = len(MATERIALS)
@@ -57,6 +58,17 @@ MID_TEXEL_M = 0.03  # ... and of its grain (m)
 CLUMP_SHARPNESS = 4.0  # the clump noise is scaled and clipped to +-1: sharp-edged patches
 CLUMP_DEPTH = 0.6
 GRAIN_DEPTH = 0.35
+# Jointed plain concrete pavement (FHWA TA 5040.30: transverse joints at most about 15 ft apart; longitudinal
+# joints along the lane lines): sawn joints filled with dark sealant, a wider band of sealant smeared over them
+# (the "tar seams" of concrete roads and bridge decks), slabs whose concrete weathered slightly differently.
+JOINT_SPACING_M = 4.5
+JOINT_WIDTH_M = 0.012
+SEAM_WIDTH_M = 0.07
+SEAM_OPACITY = 0.6
+SEALANT_ALBEDO = 0.03
+SLAB_TONE = 0.08  # each slab's albedo differs from the pavement's by up to this share
+DRIP_HALF_WIDTH_M = 0.35  # the oil-drip stain down the middle of every lane (engines and gearboxes leak there)
+DRIP_DARKENING = 0.22
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
@@ -143,6 +155,7 @@ def surface_table(albedo: np.ndarray = MATERIAL_ALBEDO) -> FloatArray:
     table[:OBJECT_ROW, ALBEDO_R:ALBEDO_B + 1] = albedo
     table[:, ROUGHNESS], table[:, F0], table[:, MIRROR_F0] = 0.35, 0.04, 0.02
     table[ASPHALT, ROUGHNESS], table[ASPHALT, F0] = 0.55, 0.02
+    table[SLAB, ROUGHNESS], table[SLAB, F0] = 0.6, 0.03
     table[[MATERIALS.index(name) for name in PAVED], HOLDS_WATER] = 1.0
     table[OBJECT_ROW, ROUGHNESS], table[OBJECT_ROW, MIRROR_F0] = 0.25, 0.05  # glossy paint
     return table
@@ -261,6 +274,31 @@ def albedo(surface: np.ndarray, material: int, grain: float, blotch: float,
     (0 = the ideal render) deepens both as a photograph shows them."""
     tone = (1.0 + 0.35 * (1.0 + detail) * grain) * (1.0 + 0.18 * (1.0 + 1.5 * detail) * blotch)
     return surface[material, ALBEDO_R] * tone, surface[material, ALBEDO_G] * tone, surface[material, ALBEDO_B] * tone
+
+
+@kernel(inline="always")
+def slab_joints(s: float, t: float, fs: float, ft: float, lane_width: float, stain: float, r: float, g: float,
+                b: float) -> tuple[float, float, float]:
+    """(r, g, b) of concrete slabs: each slab's own tone and the oil-drip stain down its lane's middle, then the
+    sealed joints (transverse every ``JOINT_SPACING_M``, longitudinal on the lane boundaries) and their sealant
+    bands, box-filtered over the pixel's footprint (fs, ft); ``stain`` (noise in [-1, 1]) varies the smeared
+    sealant and the drip."""
+    i, j = np.floor(s / JOINT_SPACING_M), np.floor(t / lane_width)
+    hashed = np.sin(i * 12.9898 + j * 78.233) * 43758.5453
+    fade = max(1.0 - 2.0 * max(fs, ft) / JOINT_SPACING_M, 0.0)  # far away a pixel spans many slabs
+    tone = 1.0 + SLAB_TONE * fade * (2.0 * (hashed - np.floor(hashed)) - 1.0)
+    across = (t / lane_width - j - 0.5) * lane_width / DRIP_HALF_WIDTH_M
+    spread = min(ft / lane_width, 1.0)  # a footprint across the lane sees the drip's lane-wide mean
+    drip = np.exp(-across * across) * (1.0 - spread) + np.sqrt(np.pi) * DRIP_HALF_WIDTH_M / lane_width * spread
+    tone *= 1.0 - DRIP_DARKENING * (0.6 + 0.4 * stain) * drip
+    joint = max(dash_coverage(s + 0.5 * JOINT_WIDTH_M, fs, JOINT_WIDTH_M, JOINT_SPACING_M),
+                dash_coverage(t + 0.5 * JOINT_WIDTH_M, ft, JOINT_WIDTH_M, lane_width))
+    seam = max(dash_coverage(s + 0.5 * SEAM_WIDTH_M, fs, SEAM_WIDTH_M, JOINT_SPACING_M),
+               dash_coverage(t + 0.5 * SEAM_WIDTH_M, ft, SEAM_WIDTH_M, lane_width))
+    cover = max(joint, SEAM_OPACITY * (0.5 + 0.5 * stain) * seam)
+    keep = tone * (1.0 - cover)
+    sealant = SEALANT_ALBEDO * cover
+    return r * keep + sealant, g * keep + sealant, b * keep + sealant
 
 
 @kernel(inline="always")
@@ -471,7 +509,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),
                               sample_noise(fine, MID_TEXEL_M, s, t + 5.0, footprint))
                 r, g, b = r * tone, g * tone, b * tone
-            if material == ASPHALT:  # only asphalt carries paint and surface layers
+            if material == SLAB:
+                r, g, b = slab_joints(s, t, fs, ft, lane_width,
+                                      sample_noise(coarse, COARSE_TEXEL_M, s * 2.0 + 53.0, t, footprint), r, g, b)
+            if material == ASPHALT or material == SLAB:  # only the carriageway carries paint and surface layers
                 piece = vertex_piece[faces[f, 0]]
                 r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
                 k0, k1 = boundaries_near(lanes, lane_width, last, t, ft)

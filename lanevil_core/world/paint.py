@@ -32,6 +32,7 @@ MATERIAL_ALBEDO = np.array([
     [0.16, 0.145, 0.13],  # gravel
     [0.38, 0.37, 0.35],  # kerb
     [0.13, 0.10, 0.07],  # dirt
+    [0.21, 0.205, 0.19],  # slab: weathered concrete pavement (new 0.35-0.40, aged 0.20-0.30)
 ], np.float32)
 
 WHITE_PAINT = (0.70, 0.70, 0.67)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..typed import FloatArray, Material, SceneKind
+from ..typed import FloatArray, Material, Pavement, SceneKind
 from .road_geometry import GradeChange, Piece, ReferenceLine
 
 if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
@@ -54,6 +54,7 @@ class RoadPiece:
     strips: tuple[Strip, ...]
     boundaries_t: FloatArray  # (k,) t of every lane boundary, left to right
     s_start: float = 0.0  # arms start at the main road's edge
+    carriageway: Material = "asphalt"  # the carriageway's material (``slab``: concrete slabs)
     # (s0, s1, side): where the roadside of one side (+1 left, -1 right) gives way to a junction arm
     gaps: list[tuple[float, float, int]] = field(default_factory=list)
 
@@ -98,13 +99,25 @@ def reference_pieces(road: Road) -> tuple[list[Piece], tuple[GradeChange, ...]]:
     return [Piece(road.length)], ()
 
 
+def paved(strips: tuple[Strip, ...], pavement: Pavement) -> tuple[tuple[Strip, ...], Material]:
+    """The cross-section and the carriageway's material for ``pavement``: a concrete road is slabs out to its
+    paved shoulder (the first strip, when it is flush asphalt)."""
+    if pavement == "asphalt":
+        return strips, "asphalt"
+    first = strips[0]
+    if first.material == "asphalt" and first.height == 0.0:
+        strips = (Strip(first.width, "slab", 0.0), *strips[1:])
+    return strips, "slab"
+
+
 def build_network(road: Road, scene_kind: SceneKind) -> RoadNetwork:
     """Compile the road description into reference lines and cross-sections."""
     pieces, grades = reference_pieces(road)
     n, w = road.lanes_per_direction, road.lane_width
     boundaries = np.array([(n - k) * w for k in range(2 * n + 1)], dtype=np.float64)
-    strips = CROSS_SECTIONS[scene_kind]
-    main = RoadPiece(ReferenceLine(pieces, grade_changes=grades), n * w, strips, boundaries)
+    strips, carriageway = paved(CROSS_SECTIONS[scene_kind], road.pavement)
+    main = RoadPiece(ReferenceLine(pieces, grade_changes=grades), n * w, strips, boundaries,
+                     carriageway=carriageway)
     network = RoadNetwork([main], w, n)
     if road.type in ("t_junction", "crossroad"):
         sides = (-1,) if road.type == "t_junction" else (-1, 1)
@@ -120,7 +133,8 @@ def _arm(main: RoadPiece, s_junction: float, side: int, strips: tuple[Strip, ...
     origin = p_world[:2]
     arm_line = ReferenceLine([Piece(ARM_LENGTH_M + main.half_width)], origin_xy=(origin[0], origin[1]),
                              origin_heading=heading, origin_z=float(p_world[2]))
-    arm = RoadPiece(arm_line, main.half_width, strips, boundaries, s_start=main.half_width)
+    arm = RoadPiece(arm_line, main.half_width, strips, boundaries, s_start=main.half_width,
+                    carriageway=main.carriageway)
     # The main road's roadside gives way over the arm's carriageway and its first roadside band.
     mouth = main.half_width + strips[0].width + (strips[1].width if len(strips) > 1 else 0.0)
     main.gaps.append((s_junction - mouth, s_junction + mouth, side))

@@ -64,7 +64,7 @@ def _profile(piece: RoadPiece, far_m: float) -> tuple[list[tuple[float, float]],
     left_pts, left_mats = walk(+1)
     right_pts, right_mats = walk(-1)
     points = left_pts[::-1] + right_pts
-    mats = left_mats[::-1] + [MATERIALS.index("asphalt")] + right_mats
+    mats = left_mats[::-1] + [MATERIALS.index(piece.carriageway)] + right_mats
     sides = [1] * len(left_mats) + [0] + [-1] * len(right_mats)
     return points, mats, sides
 

@@ -113,6 +113,14 @@ def test_junction_cases_have_arms_and_a_junction(exported):
     assert len(connecting) >= 6
 
 
+@pytest.mark.parametrize(("pavement", "surface"), [("asphalt", "asphalt"), ("concrete", "concrete")])
+def test_every_lane_carries_the_pavement_as_its_material(make_case, pavement, surface):
+    root = ET.fromstring(xodr_text(opendrive(make_case(road={"pavement": pavement}))))
+    lanes = [lane for lane in root.iter("lane") if lane.get("id") != "0"]
+    assert lanes and all(lane.find("material").get("surface") == surface for lane in lanes)
+    assert all(0.5 < float(lane.find("material").get("friction")) <= 1.0 for lane in lanes)
+
+
 def test_roadside_objects_are_written(tmp_path):
     case = load_case(SCENES / "10_road_damage" / "guard_rail" / "00_bend_highway_noon" / "05_level5.json")
     xodr, = write_interchange(case, tmp_path)

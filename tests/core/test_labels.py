@@ -254,7 +254,8 @@ def _paint_errors(case, frame_index, size=(640, 360)):
     return np.array(errors)
 
 
-@pytest.mark.parametrize("road", [{"type": "straight"}, {"type": "bend", "radius": 80.0, "turn": "left"}])
+@pytest.mark.parametrize("road", [{"type": "straight"}, {"type": "bend", "radius": 80.0, "turn": "left"},
+                                  {"type": "straight", "pavement": "concrete"}])
 def test_labels_sit_on_the_rendered_paint(make_case, road):
     case = make_case(road=road, ego={"start_s": 20.0})
     for frame_index in (0, 40):

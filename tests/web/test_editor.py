@@ -196,6 +196,18 @@ def test_sun_sliders_and_weather_preset(tab: EditorTab) -> None:
     assert tab.case.sun.intensity == 0.5
 
 
+def test_pavement_dropdown_paves_the_road_with_concrete_and_undo_takes_it_back(tab: EditorTab) -> None:
+    before = settle(tab)
+    assert tab.panel.pavement.value == tab.case.road.pavement == "asphalt"
+    tab.panel.pavement.value = "concrete"
+    after = settle(tab)
+    assert tab.case.road.pavement == "concrete"
+    assert after.astype(float).mean() > before.astype(float).mean() + 5  # pale slabs fill the lower frame
+    tab.undo()
+    settle(tab)
+    assert tab.case.road.pavement == "asphalt" and tab.panel.pavement.value == "asphalt"
+
+
 def test_sun_sliders_override_a_shadow_illusions_own_sun(tab: EditorTab) -> None:
     open_shadow(tab)
     tab.panel.sun_altitude.value = 20.0
