@@ -38,6 +38,11 @@ class Marking(_Model):
     width: StrictFloat = Field(PAINT_WIDTH_M, gt=0.02, le=0.6, description="paint width of one line (m)")
     dash: StrictFloat = Field(DASH_M, gt=0.1, le=50, description="dash length (m)")
     gap: StrictFloat = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
+    wear: StrictFloat = Field(
+        0.0, ge=0.0, le=1.0,
+        description="how worn the paint is (0 = fresh): it flakes off in chips along the line, the rest is dirtier, "
+        "and far away the line fades evenly; the label stays (annotators label worn lines)",
+    )
 
     @model_validator(mode="before")
     @classmethod

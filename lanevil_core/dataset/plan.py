@@ -58,6 +58,8 @@ SUN_ALTITUDE_JITTER_DEG = 10.0
 CAMERA_JITTER_SHARE = 0.5
 VARIED_CAMERA_SHARE = 0.75  # --vary-camera: share of train variations seen through a drawn camera
 CONCRETE_SHARE = 0.3  # --vary-camera: share of train variations on a concrete road (drawn after the camera)
+WORN_PAINT_SHARE = 0.5  # --vary-camera: share of train variations whose paint is worn, and by how much at most
+PAINT_WEAR_RANGE = (0.1, 0.7)
 CAMERA_Y_RANGE_M = (-0.7, 0.7)
 CAMERA_Z_RANGE_M = (1.4, 3.2)
 CAMERA_PITCH_RANGE_DEG = (0.0, 4.0)
@@ -327,7 +329,7 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``; with
     ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same), and
     used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's), and last
-    its pavement (concrete slabs for ``CONCRETE_SHARE`` of them)."""
+    its pavement (concrete slabs for ``CONCRETE_SHARE`` of them) and its paint's wear (``WORN_PAINT_SHARE``)."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -348,6 +350,13 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     if drawn is not None and rng.uniform() < VARIED_CAMERA_SHARE:
         camera = drawn
     pavement = "concrete" if vary_camera and rng.uniform() < CONCRETE_SHARE else base.road.pavement
+    wear = 0.0
+    if vary_camera:  # always two draws
+        worn, amount = rng.uniform(0.0, 1.0, 2)
+        if worn < WORN_PAINT_SHARE:
+            wear = round(PAINT_WEAR_RANGE[0] + (PAINT_WEAR_RANGE[1] - PAINT_WEAR_RANGE[0]) * float(amount), 2)
+    for marking in markings:
+        marking["wear"] = wear
     data = base.model_dump()
     data["camera"] = camera
     data["weather"] = values["weather"]
@@ -359,7 +368,7 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     data["title"] = f"{base.title} ({preset}, variation {index})"
     parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
                   "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
-                  "lane_width": lane_width, "pavement": pavement,
+                  "lane_width": lane_width, "pavement": pavement, "paint_wear": wear,
                   "camera": {k: camera[k] for k in ("fov", "x", "y", "z", "pitch", "yaw", "roll") if k in camera},
                   "markings": [m["type"] for m in data["road"]["markings"]]}
     return parse_case(data, source=f"train variation {index}"), parameters

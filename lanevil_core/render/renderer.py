@@ -15,7 +15,7 @@ from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
 from ..typed import Float32Array, IntArray, UInt8Array
-from ..world.paint import MATERIAL_ALBEDO
+from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
 from .develop import develop, motion_blur
@@ -152,7 +152,8 @@ def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
     fine, coarse = noise_textures()
     return RoadLook(SURFACE_TABLE, packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
                     float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
-                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params)
+                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params,
+                    float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)))
 
 
 def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:

@@ -36,7 +36,7 @@ from .lighting import (
     sun_visibility,
     sun_visibility_over,
 )
-from .surface import dash_coverage, paint, sample_layers, sample_noise
+from .surface import CHIP_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
@@ -69,6 +69,8 @@ SEALANT_ALBEDO = 0.03
 SLAB_TONE = 0.08  # each slab's albedo differs from the pavement's by up to this share
 DRIP_HALF_WIDTH_M = 0.35  # the oil-drip stain down the middle of every lane (engines and gearboxes leak there)
 DRIP_DARKENING = 0.22
+CHIP_STRETCH = 0.4  # worn paint's chips run about 2.5 times longer along the line than across it
+CHIP_FLAKES = 0.55  # share of the chip noise that is flakes (the rest: longer worn and kept stretches)
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
@@ -114,6 +116,7 @@ class RoadLook(NamedTuple):
     noise_coarse: Float32Array
     overhead: Float32Array
     overhead_params: FloatArray
+    paint_wear: float  # the most worn stripe's wear (0: fresh paint everywhere, no chip noise is sampled)
 
 
 class Lighting(NamedTuple):
@@ -446,7 +449,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss, \
         face_texture = geometry
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
-        overhead_params = road
+        overhead_params, paint_wear = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
     maps, cells, shadow_params, R_light, sun_terms = shadow
     refl_rgb, refl_depth = reflection
@@ -516,11 +519,16 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 piece = vertex_piece[faces[f, 0]]
                 r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
                 k0, k1 = boundaries_near(lanes, lane_width, last, t, ft)
+                chips = 0.0
+                if paint_wear > 0.0:  # flakes (fine) in worn stretches (coarse), along the line, filtered
+                    chip_foot = max(fs * CHIP_STRETCH, ft)
+                    chips = CHIP_FLAKES * sample_noise(fine, CHIP_TEXEL_M, s * CHIP_STRETCH, t + 3.0, chip_foot) \
+                        + (1.0 - CHIP_FLAKES) * sample_noise(coarse, CHIP_TEXEL_M, s * CHIP_STRETCH, t, chip_foot)
                 for k in range(k0, k1 + 1):
                     r, g, b = paint(stripes, stripe_index[piece, k, 0], stripe_index[piece, k, 1], s, t, fs, ft, r,
-                                    g, b)
+                                    g, b, chips)
                 r, g, b = paint(stripes, stripe_index[piece, last, 0], stripe_index[piece, last, 1], s, t, fs, ft, r,
-                                g, b)
+                                g, b, chips)
                 r, g, b, wet_over = sample_layers(texels, table, first, piece, s, t, fs, ft, True, r, g, b)
                 wet = max(wet, wet_over)
                 if puddles > 0.0:

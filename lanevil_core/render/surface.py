@@ -8,9 +8,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..world.paint import PAINT_WEAR
 from ._jit import kernel
 
 MAX_ANISO = 6
+# Worn paint: the share left where the chip noise is n is 1 - wear (1 + CHIP_CONTRAST n), so chips come and go along
+# the line and a far pixel (noise filtered towards 0) sees the line faded to 1 - wear; what is left is dirtier.
+CHIP_CONTRAST = 2.0
+CHIP_TEXEL_M = 0.05
+DIRT_DIMMING = 0.35
 
 
 @kernel(inline="always")
@@ -63,8 +69,9 @@ def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprin
 
 @kernel(inline="always")
 def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
-          r: float, g: float, b: float) -> tuple[float, float, float]:
-    """(r, g, b) with the paint of stripes[lo:hi] blended over it."""
+          r: float, g: float, b: float, chips: float) -> tuple[float, float, float]:
+    """(r, g, b) with the paint of stripes[lo:hi] blended over it; ``chips`` (noise in [-1, 1], filtered over the
+    pixel) is where worn paint has flaked off."""
     for k in range(lo, hi):
         t_c, half = stripes[k, 1], stripes[k, 2]
         if abs(t - t_c) > half + ft:
@@ -76,9 +83,14 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
             continue
         if stripes[k, 5] > 0.5:
             cov *= dash_coverage(s - s0, fs, stripes[k, 6], stripes[k, 7])
-        r = r * (1.0 - cov) + stripes[k, 8] * cov
-        g = g * (1.0 - cov) + stripes[k, 9] * cov
-        b = b * (1.0 - cov) + stripes[k, 10] * cov
+        wear = stripes[k, PAINT_WEAR]
+        dirt = 1.0
+        if wear > 0.0:
+            cov *= min(max(1.0 - wear * (1.0 + CHIP_CONTRAST * chips), 0.0), 1.0)
+            dirt = 1.0 - DIRT_DIMMING * wear
+        r = r * (1.0 - cov) + stripes[k, 8] * dirt * cov
+        g = g * (1.0 - cov) + stripes[k, 9] * dirt * cov
+        b = b * (1.0 - cov) + stripes[k, 10] * dirt * cov
     return r, g, b
 
 

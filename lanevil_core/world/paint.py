@@ -40,8 +40,9 @@ YELLOW_PAINT = (0.72, 0.46, 0.04)
 STOP_LINE_M = 0.4
 
 # Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots), on, period, r, g, b,
-# boundary index (-1: not tied to a lane boundary)
-STRIPE_COLUMNS = 12
+# boundary index (-1: not tied to a lane boundary), wear (0 = fresh paint)
+STRIPE_COLUMNS = 13
+PAINT_WEAR = 12  # the wear column
 PAINT_LIFT_M = 0.01  # paint quads float this far above the asphalt in meshes (glTF scene, editor)
 PAINT_STEP_M = 1.0  # length of one paint quad along the road
 
@@ -116,11 +117,11 @@ def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool
                 if side and g_side == side:
                     spans = [(a, b) for a0, b0 in spans for a, b in ((a0, min(b0, g0)), (max(a0, g1), b0)) if b > a]
             for s0, s1 in spans:
-                rows += [[*row, k] for row in _stripes_of_boundary(index, float(t), marking, s0, s1)]
+                rows += [[*row, k, marking.wear] for row in _stripes_of_boundary(index, float(t), marking, s0, s1)]
         if index:  # a stop line across the arm's lanes that lead into the junction
             s0 = piece.s_start + 1.5
             rows.append([index, -piece.half_width / 2, piece.half_width / 2, s0, s0 + STOP_LINE_M, 0,
-                         1.0, 1.0, *WHITE_PAINT, -1])
+                         1.0, 1.0, *WHITE_PAINT, -1, 0.0])
     return np.array(rows, np.float64).reshape(-1, STRIPE_COLUMNS)
 
 
@@ -152,7 +153,7 @@ def paint_mesh(network: RoadNetwork, markings: Sequence[Marking],
     stripes = paint_stripes(network, markings, paint).reshape(-1, STRIPE_COLUMNS)
     vertices, faces, colors = [], [], []
     count = 0
-    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary in stripes:
+    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary, _wear in stripes:
         line = network.pieces[int(piece)].line
         for a, b_end in dash_spans(s0, s1, int(pattern), on, period):
             s_road = np.append(np.arange(a, b_end, PAINT_STEP_M), b_end)

@@ -206,13 +206,16 @@ def _paint_score(rgb: np.ndarray) -> np.ndarray:
 def _stripe_centre(score_row: np.ndarray, column: int, reach: int) -> float | None:
     """Centre (column coordinate) of the paint run within 2 px of ``column``, or None if no paint is there.
 
-    Paint must beat the asphalt ``reach`` px to either side by a clear margin; the run is where the score exceeds
-    the half-way level between the two.
+    Paint must beat the road surface ``reach`` px to either side (the darker side, each the median of 5 px there, so
+    a thin dark joint of a concrete road does not count) by a clear margin; the run is where the score exceeds the
+    half-way level between the two.
     """
     width = len(score_row)
     window = range(max(column - 2, 0), min(column + 3, width))
     peak = max(window, key=lambda i: score_row[i])
-    asphalt = min(score_row[max(column - reach, 0)], score_row[min(column + reach, width - 1)])
+    sides = [score_row[max(column - reach - 4, 0):max(column - reach + 1, 1)],
+             score_row[min(column + reach, width - 1):min(column + reach + 5, width)]]
+    asphalt = min(float(np.median(side)) for side in sides)
     if score_row[peak] < asphalt + 25.0:
         return None
     level = 0.5 * (score_row[peak] + asphalt)
@@ -254,10 +257,21 @@ def _paint_errors(case, frame_index, size=(640, 360)):
     return np.array(errors)
 
 
-@pytest.mark.parametrize("road", [{"type": "straight"}, {"type": "bend", "radius": 80.0, "turn": "left"},
-                                  {"type": "straight", "pavement": "concrete"}])
+@pytest.mark.parametrize("road", [{"type": "straight"}, {"type": "bend", "radius": 80.0, "turn": "left"}])
 def test_labels_sit_on_the_rendered_paint(make_case, road):
     case = make_case(road=road, ego={"start_s": 20.0})
+    for frame_index in (0, 40):
+        errors = _paint_errors(case, frame_index)
+        assert len(errors) > 60
+        assert errors.max() < 2.0 and errors.mean() < 0.6, (errors.max(), errors.mean())
+
+
+def test_labels_sit_on_the_paint_of_a_concrete_road(make_case):
+    # A highway: its wide slab shoulder keeps the shaded kerb face (as dark as asphalt) away from the edge lines, and
+    # white paint, since yellow on pale concrete is too faint for ``_paint_score``.
+    white = ["white_solid", "white_dashed", "white_double_solid", "white_dashed", "white_solid"]
+    case = make_case(road={"pavement": "concrete", "markings": white}, scene={"kind": "highway"},
+                     ego={"start_s": 20.0})
     for frame_index in (0, 40):
         errors = _paint_errors(case, frame_index)
         assert len(errors) > 60
