@@ -48,7 +48,7 @@ test-browser: $(STAMP)
 # trained at 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then
 # fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
 # and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate). scnn
-# and bezier train on the first split only (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
+# and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
 # training ufld and seg on 2 idle cores; MODELS_DATA and MODELS_DATA_VARIED keep the renders for reruns.
 MODELS_DATA ?= out/models-data
 MODELS_DATA_VARIED ?= out/models-data-v
@@ -66,7 +66,9 @@ models: $(STAMP)
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/scnn --model scnn --epochs 8
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt-base --model laneatt --epochs 6
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet-base --model ganet --epochs 10
-	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier-base --model bezier --epochs 6
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 10 --lr 1e-3 \
+	  --threads 1 --init out/models/bezier-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/ganet-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 5 --lr 1e-3 \
