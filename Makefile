@@ -47,8 +47,9 @@ test-browser: $(STAMP)
 # The shipped learned detectors (lanevil_core/detect/models/<family>). ufld, seg, ganet and laneatt in two stages:
 # trained at 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then
 # fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
-# and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate). scnn
-# and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
+# and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate, then
+# laneatt 8 more). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate
+# (docs/learning.md). About 3 + 3 min of rendering and 13 + 18 min of
 # training ufld and seg on 2 idle cores; MODELS_DATA and MODELS_DATA_VARIED keep the renders for reruns.
 MODELS_DATA ?= out/models-data
 MODELS_DATA_VARIED ?= out/models-data-v
@@ -71,8 +72,10 @@ models: $(STAMP)
 	  --threads 1 --init out/models/bezier-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/ganet-base/weights.pt
-	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 5 --lr 1e-3 \
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt-v --model laneatt --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/laneatt-base/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 8 --lr 1e-3 \
+	  --threads 1 --init out/models/laneatt-v/weights.pt
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
