@@ -48,8 +48,8 @@ test-browser: $(STAMP)
 # trained at 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then
 # fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
 # and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate, then
-# laneatt 8 more); seg then 6 more epochs at half the rate on a second randomised split (4,000 frames, seed 1: its
-# roads also concrete or with worn paint, its horizon anywhere). scnn and bezier train on the first split only,
+# laneatt 8 more); ufld and seg then 8 and 6 more epochs at half the rate on a second randomised split (4,000
+# frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere). scnn and bezier train on the first split only,
 # bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The three splits
 # render in about 3 + 3 + 13 min (the last measured with one worker beside two training runs); MODELS_DATA,
 # MODELS_DATA_VARIED and MODELS_DATA_VARIED2 keep the renders for reruns.
@@ -66,8 +66,10 @@ models: $(STAMP)
 	  --vary-camera --seed 1
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld-base --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg-base --model seg --epochs 10
-	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ufld --model ufld --epochs 6 \
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ufld-v --model ufld --epochs 6 \
 	  --threads 1 --init out/models/ufld-base/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED2) --out out/models/ufld --model ufld --epochs 8 --lr 1e-3 \
+	  --threads 1 --init out/models/ufld-v/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/seg-v --model seg --epochs 6 \
 	  --threads 1 --init out/models/seg-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED2) --out out/models/seg --model seg --epochs 6 --lr 1e-3 \
