@@ -41,7 +41,8 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
                         "own camera)")
     parser.add_argument("--vary-camera", action="store_true",
                         help="train variations draw their camera and sensor: HFOV 45-100, height 1.2-3.5 m, pitch "
-                        "-2..6, roll +-2, bonnet on/off, lens, exposure, noise, blur, colour, compression")
+                        "-2..6, roll +-2, principal point row, bonnet on/off, lens, exposure, noise, blur, colour, "
+                        "compression; and concrete roads (30 %%) and worn paint (half)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
