@@ -25,7 +25,6 @@ from lanevil_core.illusions import REGISTRY, Illusion, MeshFileError
 from lanevil_core.metrics.formats import LaneFileError
 from lanevil_core.pipeline.compile import check_mesh_files, roadside_key
 from lanevil_core.presets import camera_preset_values, preset_values
-from lanevil_core.typed import PAVEMENTS
 from lanevil_core.world.road_layout import RoadNetwork
 from lanevil_core.world.scene import CompiledScene
 
@@ -366,9 +365,7 @@ class EditorTab:
         self._edit(data, f"weather {name}")
 
     def set_pavement(self, pavement: str) -> None:
-        """Pave the carriageway with ``pavement`` (asphalt or concrete slabs)."""
-        if pavement not in PAVEMENTS:
-            raise EditError(f"road.pavement: {pavement!r} is not one of {', '.join(PAVEMENTS)}")
+        """Pave the carriageway with ``pavement`` (asphalt or concrete slabs; the case model refuses others)."""
         data = self._data()
         data["road"]["pavement"] = pavement
         self._edit(data, f"pavement {pavement}")

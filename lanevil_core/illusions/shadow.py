@@ -123,10 +123,7 @@ def side_sign(side: Side) -> float:
 
 def roadside_t(piece: RoadPiece, offset: float, sign: float) -> float:
     """t of a point ``offset`` metres beyond the paved edge (carriageway plus a shoulder paved like it)."""
-    paved = piece.half_width
-    if piece.strips and piece.strips[0].material == piece.carriageway:
-        paved += piece.strips[0].width
-    return sign * (paved + offset)
+    return sign * (piece.paved_reach + offset)
 
 
 def blocked(ctx: CompileContext, piece: RoadPiece) -> list[tuple[float, float, int]]:

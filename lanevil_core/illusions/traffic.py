@@ -32,7 +32,6 @@ from .base import Category, CompileContext, EgoDrive, Illusion, Level, MeshFileE
 
 if TYPE_CHECKING:
     from ..typed import FloatArray
-    from ..world.road_layout import RoadPiece
 
 EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
 EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position
@@ -208,7 +207,7 @@ class TrafficIllusion(Illusion):
         free = Footprints(ctx.drive, ctx.network.lane_center_t(ctx.drive.lane))
         for index, slot in enumerate(slots):
             mesh = make(index)
-            placed = free.place(slot, *half_extents(mesh), paved_reach(ctx.network.main))
+            placed = free.place(slot, *half_extents(mesh), ctx.network.main.paved_reach)
             if placed is not None:
                 self.add(ctx, mesh, placed, index, follow_grade=follow_grade)
 
@@ -231,16 +230,6 @@ def half_extents(mesh: Mesh) -> tuple[float, float]:
     """Half extents (m) along local X and Y of a local-frame mesh's footprint about its origin."""
     reach = np.abs(mesh.vertices[:, :2]).max(0)
     return float(reach[0]), float(reach[1])
-
-
-def paved_reach(piece: RoadPiece) -> float:
-    """|t| up to which the road is flat pavement: the carriageway plus any level strip at its edge paved like it."""
-    reach = piece.half_width
-    for strip in piece.strips:
-        if strip.material != piece.carriageway or strip.height != 0.0:
-            break
-        reach += strip.width
-    return reach
 
 
 def line_order(ctx: CompileContext) -> list[float]:
@@ -435,7 +424,7 @@ class Vehicle(TrafficIllusion):
                     return
                 kind = self._kind(rng, float(level.large))
                 length, width, height = VEHICLE_SIZE[kind]
-                s_vehicle, reach = s + rng.uniform(-2.0, 2.0), paved_reach(ctx.network.main)
+                s_vehicle, reach = s + rng.uniform(-2.0, 2.0), ctx.network.main.paved_reach
                 changing = on_line(index, lane_change)
                 placed = free.place(self._slot(ctx, rng, s_vehicle, lane_t, changing), length / 2, width / 2, reach)
                 if placed is None and changing:  # no room to change lanes: keep to the lane

@@ -55,6 +55,17 @@ class RoadPiece:
     boundaries_t: FloatArray  # (k,) t of every lane boundary, left to right
     s_start: float = 0.0  # arms start at the main road's edge
     carriageway: Material = "asphalt"  # the carriageway's material (``slab``: concrete slabs)
+
+    @property
+    def paved_reach(self) -> float:
+        """|t| up to which the road is flat pavement: the carriageway plus any level strips at its edge paved
+        like it."""
+        reach = self.half_width
+        for strip in self.strips:
+            if strip.material != self.carriageway or strip.height != 0.0:
+                break
+            reach += strip.width
+        return reach
     # (s0, s1, side): where the roadside of one side (+1 left, -1 right) gives way to a junction arm
     gaps: list[tuple[float, float, int]] = field(default_factory=list)
 

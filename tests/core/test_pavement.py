@@ -12,7 +12,6 @@ from hypothesis import strategies as st
 
 from lanevil_core.case import Case
 from lanevil_core.dataset.plan import train_variation
-from lanevil_core.illusions.traffic import paved_reach
 from lanevil_core.labels import lanes as L
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
@@ -30,7 +29,7 @@ def test_concrete_paves_the_carriageway_and_its_flush_shoulder(make_case: Callab
     asphalt = build_network(make_case(scene={"kind": kind}).road, kind)
     concrete = build_network(make_case(scene={"kind": kind}, road={"pavement": "concrete"}).road, kind)
     assert asphalt.main.carriageway == "asphalt" and concrete.main.carriageway == "slab"
-    assert paved_reach(concrete.main) == paved_reach(asphalt.main)  # illusions keep their room on the road
+    assert concrete.main.paved_reach == asphalt.main.paved_reach  # illusions keep their room on the road
     assert [s.material for s in concrete.main.strips[1:]] == [s.material for s in asphalt.main.strips[1:]]
     surface = road_surface(concrete)
     assert set(surface.material[surface.carriageway]) == {MATERIALS.index("slab")}
