@@ -32,7 +32,7 @@ FULL_WELL_E = 5000.0  # electrons at clip of a small automotive sensor pixel
 READ_NOISE_E = 4.0  # read noise (electrons, rms) at base ISO
 DAYLIGHT_K = 5600.0  # colour temperature of the renderer's sun and sky
 LUMA = np.array([0.2126, 0.7152, 0.0722])  # Rec. 709 luminance of linear RGB
-TONE_LUT_SIZE = 4096
+TONE_LUT_SIZE = 16384  # evenly spaced sensor values: within one level of the exact curve, no square root per read
 SHOULDER = 2.0  # the filmic curve's shoulder constant
 
 
@@ -46,7 +46,7 @@ class Development:
         channel_gain: (3,) float64 white-balance gains (green = 1).
         shot: shot-noise variance per unit of sensor value (already times ``iso_gain`` and the noise scale**2).
         read: read-noise standard deviation in sensor units.
-        lut: (TONE_LUT_SIZE,) uint8 sRGB byte of sqrt-spaced sensor values after the filmic curve.
+        lut: (TONE_LUT_SIZE,) uint8 sRGB byte of evenly spaced sensor values after the filmic curve.
     """
 
     gain: float
@@ -103,8 +103,8 @@ def filmic(x: FloatArray, contrast: float) -> FloatArray:
 
 @lru_cache(maxsize=16)
 def tone_lut(contrast: float) -> UInt8Array:
-    """(TONE_LUT_SIZE,) uint8: sRGB bytes of the filmic curve at sensor values ``(i / (n - 1)) ** 2``."""
-    x = np.linspace(0.0, 1.0, TONE_LUT_SIZE) ** 2
+    """(TONE_LUT_SIZE,) uint8: sRGB bytes of the filmic curve at sensor values ``i / (n - 1)``."""
+    x = np.linspace(0.0, 1.0, TONE_LUT_SIZE)
     display = filmic(x, contrast)  # display-referred linear light in [0, 1]
     srgb = np.where(display <= 0.0031308, 12.92 * display, 1.055 * np.power(display, 1 / 2.4) - 0.055)
     lut = np.clip(np.round(srgb * 255.0), 0, 255).astype(np.uint8)

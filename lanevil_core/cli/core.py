@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..case import Case, case_meshes_dir, load_case, write_atomic
+from ..presets import CAMERA_PRESET_NAMES
 from .base import (
     CLEAN_DIR,
     SCENES_DIR,
@@ -159,6 +160,10 @@ def _bench_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--threads", type=int, nargs="+", default=[1], metavar="N",
                         help="threads per frame (default 1); several counts (e.g. --threads 1 2) are timed frame by "
                              "frame side by side, with the speed-up over the first and a byte-identity check")
+    parser.add_argument("--camera", nargs="+", default=[], choices=CAMERA_PRESET_NAMES, metavar="PRESET",
+                        help="also time every frame through these camera presets (lens, mount and sensor), side by "
+                             "side with the case's own camera, with the ratio to it: "
+                             + ", ".join(CAMERA_PRESET_NAMES))
 
 
 def _run_bench(args: argparse.Namespace) -> int:
@@ -173,7 +178,7 @@ def _run_bench(args: argparse.Namespace) -> int:
         print(json.dumps(rows) if args.json else format_rows(rows))
         return 0
     result = run_benchmark(bench_cases(stock_scenes() if args.all else stock_scenes(CLEAN_DIR)),
-                           frames_per_case=args.frames_per_case, threads=args.threads)
+                           frames_per_case=args.frames_per_case, threads=args.threads, cameras=args.camera)
     print(json.dumps(result) if args.json else format_table(result))
     return 0
 

@@ -44,71 +44,96 @@ def _same_bytes(a: Frame, b: Frame) -> bool:
             and np.array_equal(a.object_id, b.object_id))
 
 
-def _row_key(size: tuple[int, int], threads: int, thread_counts: Sequence[int]) -> str:
+CASE_CAMERA = "case"  # the row name of each case's own camera when presets are timed beside it
+
+
+def _row_key(size: tuple[int, int], threads: int, thread_counts: Sequence[int], camera: str,
+             cameras: Sequence[str]) -> str:
     width, height = size
-    return f"{width}x{height}" if len(thread_counts) == 1 else f"{width}x{height} t{threads}"
+    key = f"{width}x{height}" if len(thread_counts) == 1 else f"{width}x{height} t{threads}"
+    return key if len(cameras) == 1 else f"{key} {camera}"
+
+
+def with_camera(case: Case, preset: str) -> Case:
+    """``case`` seen through camera preset ``preset`` (its lens, mount and sensor; ``CASE_CAMERA``: unchanged)."""
+    if preset == CASE_CAMERA:
+        return case
+    from ..presets import camera_preset_values
+
+    return case.model_copy(update={"camera": type(case.camera).model_validate(camera_preset_values(preset))})
 
 
 def run_benchmark(
     cases: Sequence[Case], sizes: Sequence[tuple[int, int]] = BENCH_SIZES, frames_per_case: int = 2,
-    threads: Sequence[int] = (1,),
+    threads: Sequence[int] = (1,), cameras: Sequence[str] = (),
 ) -> dict[str, dict[str, Any]]:
     """``{"WxH": {"median_ms": float, "stages": {stage: median ms}}}`` for every size.
 
     With several thread counts every frame is rendered with each count in turn (so load on the machine hits
     them alike), rows are keyed ``"WxH tN"`` and each row after the first count's also holds ``speedup`` (the
     first count's median over its own) and ``identical`` (every frame's bytes equal the first count's).
+    With camera presets (``presets.CAMERA_PRESETS`` names) every frame is also rendered through each of them,
+    in turn after the case's own camera, rows are keyed ``"WxH case"`` and ``"WxH <preset>"`` and a preset's
+    row holds ``ratio`` (its median over the case camera's at the same size and thread count).
     Cases are compiled one at a time (and dropped after timing) so memory stays that of one scene.
     """
     from ..render import render_frame
     from ..render.packed import pack_scene
     from .compile import compile_scene
 
-    warm = compile_scene(cases[0])
-    for size in sizes:  # warm-up: numba compilation
-        render_frame(warm, 0, size)
-    runs = [(size, n) for size in sizes for n in threads]
-    totals: dict[tuple[tuple[int, int], int], list[float]] = {run: [] for run in runs}
-    stages: dict[tuple[tuple[int, int], int], dict[str, list[float]]] = {run: {} for run in runs}
+    views = [CASE_CAMERA, *cameras]
+    for size in sizes:  # warm-up: numba compilation, of every camera's path
+        for view in views:
+            render_frame(compile_scene(with_camera(cases[0], view)), 0, size)
+    runs = [(size, n, view) for size in sizes for n in threads for view in views]
+    totals: dict[tuple[tuple[int, int], int, str], list[float]] = {run: [] for run in runs}
+    stages: dict[tuple[tuple[int, int], int, str], dict[str, list[float]]] = {run: {} for run in runs}
     identical = {run: True for run in runs}
     for case in cases:
-        scene = compile_scene(case)
-        pack_scene(scene)  # once per scene, cached on it: not a per-frame cost
+        scenes = {view: compile_scene(with_camera(case, view)) for view in views}
+        for scene in scenes.values():
+            pack_scene(scene)  # once per scene, cached on it: not a per-frame cost
         for size in sizes:
             for frame_index in frames_to_time(case, frames_per_case):
-                first: Frame | None = None
-                for n in threads:
-                    scene.cache.pop("shadow_cascades", None)  # frames spread over a drive share no cascade
-                    start = time.perf_counter()
-                    frame = render_frame(scene, frame_index, size, threads=n)
-                    totals[(size, n)].append((time.perf_counter() - start) * 1000.0)
-                    for stage, ms in frame.timings.items():
-                        stages[(size, n)].setdefault(stage, []).append(float(ms))
-                    if first is None:
-                        first = frame
-                    identical[(size, n)] &= _same_bytes(first, frame)
+                for view, scene in scenes.items():
+                    first: Frame | None = None
+                    for n in threads:
+                        scene.cache.pop("shadow_cascades", None)  # frames spread over a drive share no cascade
+                        start = time.perf_counter()
+                        frame = render_frame(scene, frame_index, size, threads=n)
+                        totals[(size, n, view)].append((time.perf_counter() - start) * 1000.0)
+                        for stage, ms in frame.timings.items():
+                            stages[(size, n, view)].setdefault(stage, []).append(float(ms))
+                        if first is None:
+                            first = frame
+                        identical[(size, n, view)] &= _same_bytes(first, frame)
     result: dict[str, dict[str, Any]] = {}
-    for size, n in runs:
+    for size, n, view in runs:
         row: dict[str, Any] = {
-            "median_ms": _median(totals[(size, n)]),
-            "stages": {stage: _median(values) for stage, values in stages[(size, n)].items()},
+            "median_ms": _median(totals[(size, n, view)]),
+            "stages": {stage: _median(values) for stage, values in stages[(size, n, view)].items()},
         }
         if len(threads) > 1:
-            base = _median(totals[(size, threads[0])])
+            base = _median(totals[(size, threads[0], view)])
             row.update(threads=n, speedup=round(base / max(row["median_ms"], 1e-9), 2),
-                       identical=identical[(size, n)])
-        result[_row_key(size, n, threads)] = row
+                       identical=identical[(size, n, view)])
+        if view != CASE_CAMERA:
+            row.update(camera=view, ratio=round(row["median_ms"] / max(_median(totals[(size, n, CASE_CAMERA)]),
+                                                                        1e-9), 2))
+        result[_row_key(size, n, threads, view, views)] = row
     return result
 
 
 def format_table(result: dict[str, dict[str, Any]]) -> str:
-    """A plain-text table: one row per size (and thread count), total then every stage (median ms), then the
-    speed-up over the first thread count and whether the bytes matched it, when several were timed."""
+    """A plain-text table: one row per size (and thread count, and camera), total then every stage (median ms),
+    then the speed-up over the first thread count and whether the bytes matched it, when several were timed, and
+    a preset camera's ratio to the case camera, when presets were timed."""
     stages = sorted({stage for row in result.values() for stage in row["stages"]})
     extra = ["speedup", "identical"] if any("speedup" in row for row in result.values()) else []
+    extra += ["ratio"] if any("ratio" in row for row in result.values()) else []
     header = ["size", "ms/frame", *stages, *extra]
     rows = [[size, f"{row['median_ms']:.1f}", *(f"{row['stages'].get(stage, 0.0):.1f}" for stage in stages),
-             *(str(row[key]) for key in extra)]
+             *(str(row.get(key, "")) for key in extra)]
             for size, row in result.items()]
     widths = [max(len(line[i]) for line in [header, *rows]) for i in range(len(header))]
     return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths)) for line in [header, *rows])

@@ -108,15 +108,73 @@ def face_sun_terms(face_normal: np.ndarray, sun_dir_world: np.ndarray) -> np.nda
 
 
 @kernel(inline="always")
-def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
-                   bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray, R_light: np.ndarray,
-                   penumbra: float) -> float:
-    """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges.
+def _visibility_at(maps: np.ndarray, cells: np.ndarray, c: int, x: float, y: float, d: float, bias: float,
+                   scale: float, penumbra: float) -> float:
+    """Fraction of the sun seen at map coordinates (x, y) (texels, at least 2 inside the map) of cascade ``c`` by
+    a point at light depth ``d``, with contact-hardening soft edges.
 
-    ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``.
     The soft edge's taps reach less than 2**COARSE_SHIFT texels, so the point's dilated coarse cell answers
     "all lit" (its nearest caster is behind the point) and "all shaded" (its farthest one is in front); only
     between the two are the taps read.
+    """
+    size = maps.shape[1]
+    cell_y, cell_x = int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT
+    nearest = cells[c, cell_y, cell_x, NEAR_AROUND]
+    lit = 1.0
+    if nearest >= d - bias:
+        lit = 1.0
+    elif cells[c, cell_y, cell_x, FAR_AROUND] < d - bias:
+        lit = 0.0
+    else:
+        # The caster right above the point (else the nearest one around) sets the penumbra width.
+        z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
+        blocker = z_center if z_center < d - bias else nearest
+        radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
+        x0, x_span, wx0, wx1, wx2, wx3 = _window_weights(x, radius)
+        y0, y_span, wy0, wy1, wy2, wy3 = _window_weights(y, radius)
+        if x_span <= 2 and y_span <= 2:  # a narrow soft edge: the nine taps read a 4x4 window of texels
+            limit = d - bias
+            taps = wy0 * _window_row(maps, c, y0, x0, limit, wx0, wx1, wx2, wx3)
+            taps += wy1 * _window_row(maps, c, y0 + 1, x0, limit, wx0, wx1, wx2, wx3)
+            taps += wy2 * _window_row(maps, c, y0 + 2, x0, limit, wx0, wx1, wx2, wx3)
+            taps += wy3 * _window_row(maps, c, y0 + 3, x0, limit, wx0, wx1, wx2, wx3)
+        else:
+            taps = 0.0
+            for j in range(-1, 2):
+                for i in range(-1, 2):
+                    taps += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
+        lit = taps / 9.0
+    # Every path ends on a use of both arrays, so numba releases them in one place (see ``_jit``).
+    return lit if maps.shape[0] == cells.shape[0] else lit
+
+
+@kernel(inline="always")
+def _cells_decide(cells: np.ndarray, c: int, x_lo: float, x_hi: float, y_lo: float, y_hi: float, d_lo: float,
+                  d_hi: float) -> float:
+    """1 when every point of the map box [x_lo, x_hi] x [y_lo, y_hi] (texels) at light depths up to ``d_hi`` is
+    lit by the coarse test of its own cell, 0 when every one at depths from ``d_lo`` is shaded, else -1 (read the
+    taps)."""
+    lit, shaded = True, True
+    for cell_y in range(int(y_lo) >> COARSE_SHIFT, (int(y_hi) >> COARSE_SHIFT) + 1):
+        for cell_x in range(int(x_lo) >> COARSE_SHIFT, (int(x_hi) >> COARSE_SHIFT) + 1):
+            lit = lit and cells[c, cell_y, cell_x, NEAR_AROUND] >= d_hi
+            shaded = shaded and cells[c, cell_y, cell_x, FAR_AROUND] < d_lo
+    decided = 1.0 if lit else (0.0 if shaded else -1.0)
+    return decided if cells.shape[0] > 0 else decided
+
+
+@kernel(inline="always")
+def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
+                   bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray, R_light: np.ndarray,
+                   penumbra: float, du: tuple[float, float, float], dv: tuple[float, float, float]) -> float:
+    """Fraction of the sun seen from world point ``p`` (1 = lit), averaged over the pixel's footprint, the
+    parallelogram p + a du + b dv (|a|, |b| <= 1/2; du, dv are the world steps of one pixel across and down on
+    the surface; zero steps read the point alone, as the ideal render does).
+
+    ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``. Each side is read
+    once per shadow-map texel of its length on the surface, at most FOOTPRINT_TAPS, all in the cascade that holds
+    p: shadows finer than a pixel (a slatted fence's far off) average to their share of shade instead of beating
+    with the pixel grid (moire). When the coarse cells under the whole footprint agree, no tap is read.
     """
     q0 = px + nx * offset
     q1 = py + ny * offset
@@ -124,6 +182,13 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    # The footprint's sides in light space (metres), read before any branch (see ``_jit``).
+    ux = R_light[0, 0] * du[0] + R_light[0, 1] * du[1] + R_light[0, 2] * du[2]
+    uy = R_light[1, 0] * du[0] + R_light[1, 1] * du[1] + R_light[1, 2] * du[2]
+    ud = R_light[2, 0] * du[0] + R_light[2, 1] * du[1] + R_light[2, 2] * du[2]
+    vx = R_light[0, 0] * dv[0] + R_light[0, 1] * dv[1] + R_light[0, 2] * dv[2]
+    vy = R_light[1, 0] * dv[0] + R_light[1, 1] * dv[1] + R_light[1, 2] * dv[2]
+    vd = R_light[2, 0] * dv[0] + R_light[2, 1] * dv[1] + R_light[2, 2] * dv[2]
     size = maps.shape[1]
     cascades = maps.shape[0]
     c = 0
@@ -138,73 +203,28 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     lit = 1.0
     if c < cascades:
         bias = bias_texels / scale
-        # Nearest caster within the point's coarse cell and its neighbours (pre-dilated): none -> fully lit.
-        cell_y, cell_x = int(y) >> COARSE_SHIFT, int(x) >> COARSE_SHIFT
-        nearest = cells[c, cell_y, cell_x, NEAR_AROUND]
-        if nearest >= d - bias:
-            lit = 1.0
-        elif cells[c, cell_y, cell_x, FAR_AROUND] < d - bias:
-            lit = 0.0
+        ux, uy, vx, vy = ux * scale, uy * scale, vx * scale, vy * scale
+        n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
+        n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
+        if n_u * n_v == 1:
+            lit = _visibility_at(maps, cells, c, x, y, d, bias, scale, penumbra)
         else:
-            # The caster right above the point (else the nearest one around) sets the penumbra width.
-            z_center = maps[c, min(int(y), size - 1), min(int(x), size - 1)]
-            blocker = z_center if z_center < d - bias else nearest
-            radius = max(0.7, min(penumbra * (d - blocker) * scale, PCF_MAX_TEXELS))
-            x0, x_span, wx0, wx1, wx2, wx3 = _window_weights(x, radius)
-            y0, y_span, wy0, wy1, wy2, wy3 = _window_weights(y, radius)
-            if x_span <= 2 and y_span <= 2:  # a narrow soft edge: the nine taps read a 4x4 window of texels
-                limit = d - bias
-                taps = wy0 * _window_row(maps, c, y0, x0, limit, wx0, wx1, wx2, wx3)
-                taps += wy1 * _window_row(maps, c, y0 + 1, x0, limit, wx0, wx1, wx2, wx3)
-                taps += wy2 * _window_row(maps, c, y0 + 2, x0, limit, wx0, wx1, wx2, wx3)
-                taps += wy3 * _window_row(maps, c, y0 + 3, x0, limit, wx0, wx1, wx2, wx3)
-            else:
-                taps = 0.0
-                for j in range(-1, 2):
-                    for i in range(-1, 2):
-                        taps += _shadow_tap(maps, c, x + i * radius, y + j * radius, d, bias)
-            lit = taps / 9.0
+            lo, hi = 2.0, size - 2.0
+            hx, hy, hd = 0.5 * (abs(ux) + abs(vx)), 0.5 * (abs(uy) + abs(vy)), 0.5 * (abs(ud) + abs(vd))
+            lit = _cells_decide(cells, c, max(x - hx, lo), min(x + hx, hi), max(y - hy, lo), min(y + hy, hi),
+                                d - hd - bias, d + hd - bias)
+            if lit < 0.0:
+                total = 0.0
+                for j in range(n_v):
+                    b = (j + 0.5) / n_v - 0.5
+                    for i in range(n_u):
+                        a = (i + 0.5) / n_u - 0.5
+                        total += _visibility_at(maps, cells, c, min(max(x + a * ux + b * vx, lo), hi),
+                                                min(max(y + a * uy + b * vy, lo), hi), d + a * ud + b * vd, bias,
+                                                scale, penumbra)
+                lit = total / (n_u * n_v)
     # Every path ends on a use of the three arrays, so numba releases them in one place (see ``_jit``).
     return lit if maps.shape[0] == cells.shape[0] == params.shape[0] else lit
-
-
-@kernel(inline="always")
-def _texels_per_metre(px: float, py: float, pz: float, params: np.ndarray, R_light: np.ndarray, size: int) -> float:
-    """Texels per metre of the first cascade that holds world point p (the last one's when none does)."""
-    u = R_light[0, 0] * px + R_light[0, 1] * py + R_light[0, 2] * pz
-    v = R_light[1, 0] * px + R_light[1, 1] * py + R_light[1, 2] * pz
-    scale = params[params.shape[0] - 1, 2]
-    for c in range(params.shape[0]):
-        x = (u - params[c, 0]) * params[c, 2]
-        y = (v - params[c, 1]) * params[c, 2]
-        if x >= 2 and y >= 2 and x <= size - 2 and y <= size - 2:
-            scale = params[c, 2]
-            break
-    return scale if params.shape[1] == R_light.shape[1] else scale  # one release of both arrays (see ``_jit``)
-
-
-@kernel(inline="always")
-def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
-                        bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray,
-                        R_light: np.ndarray, penumbra: float, du: tuple[float, float, float],
-                        dv: tuple[float, float, float]) -> float:
-    """The mean of ``sun_visibility`` over a pixel's footprint, the parallelogram p + a du + b dv (|a|, |b| <=
-    1/2; du, dv are the world steps of one pixel across and down on the surface): a lookup every shadow-map texel
-    or so along each side, at most FOOTPRINT_TAPS. Shadows finer than a pixel (a slatted fence's far off) then
-    average to their share of shade instead of beating with the pixel grid (moire)."""
-    scale = _texels_per_metre(px, py, pz, params, R_light, maps.shape[1])
-    n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
-    n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
-    total = 0.0
-    for j in range(n_v):
-        b = (j + 0.5) / n_v - 0.5
-        for i in range(n_u):
-            a = (i + 0.5) / n_u - 0.5
-            total += sun_visibility(px + a * du[0] + b * dv[0], py + a * du[1] + b * dv[1],
-                                    pz + a * du[2] + b * dv[2], nx, ny, nz, offset, bias_texels, maps, cells, params,
-                                    R_light, penumbra)
-    mean = total / (n_u * n_v)
-    return mean if maps.shape[0] == cells.shape[0] == params.shape[0] else mean  # see ``sun_visibility``
 
 
 @kernel(inline="always")

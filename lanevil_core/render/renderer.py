@@ -261,9 +261,7 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
         cols = np.clip(np.rint(map_u), 0, depth.shape[1] - 1).astype(np.intp)
         rows = np.clip(np.rint(map_v), 0, depth.shape[0] - 1).astype(np.intp)
         depth, object_id = depth[rows, cols], object_id[rows, cols]
-    else:
-        depth, object_id = depth.copy(), object_id.copy()
-    lap("lens")
+    lap("lens")  # the buffers are this frame's own: the bonnet below may write into them
     if mount.bonnet is not None:
         env = scene.env
         mask = bonnet_mask(camera, mount, mount.bonnet)

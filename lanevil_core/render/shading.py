@@ -34,7 +34,6 @@ from .lighting import (
     sky_openness,
     sky_radiance,
     sun_visibility,
-    sun_visibility_over,
 )
 from .surface import CHIP_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
@@ -550,14 +549,12 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         fresnel = fresnel_schlick(n_dot_v, max(surface[kind, F0], gloss * 0.08))
         n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        if sun_i > 0.0 and n_dot_l > 0.0 and detail > 0.0:  # a photograph: shadows filtered over the pixel
-            du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
-            vis = sun_visibility_over(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS],
-                                      maps, cells, shadow_params, R_light, penumbra, du, dv)
-            direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
-        elif sun_i > 0.0 and n_dot_l > 0.0:
+        if sun_i > 0.0 and n_dot_l > 0.0:
+            du = dv = (0.0, 0.0, 0.0)  # the ideal render reads the point; a photograph filters over the pixel
+            if detail > 0.0:
+                du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
             vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
-                                 cells, shadow_params, R_light, penumbra)
+                                 cells, shadow_params, R_light, penumbra, du, dv)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)

@@ -161,6 +161,29 @@ def test_sensor_noise_is_there_and_scales(make_case: Callable[..., Case]) -> Non
     assert 0.5 < float(diff.std()) < 30.0
 
 
+def test_sensor_noise_has_the_modelled_sigma_and_independent_channels() -> None:
+    """Through a linear tone curve, each channel's noise on a flat grey field has the standard deviation of the
+    shot + read model and the three channels draw independently (one hash per pixel picks three table entries)."""
+    from lanevil_core.camera.sensor import TONE_LUT_SIZE
+    from lanevil_core.render.develop import NOISE_TABLE, develop
+
+    assert abs(float(NOISE_TABLE.mean())) < 0.05 and abs(float(NOISE_TABLE.std()) - 1.0) < 0.03
+    level, shot, read = 0.4, 4e-3, 1e-2
+    hdr = np.full((240, 320, 3), level, np.float32)
+    linear = np.round(np.linspace(0.0, 255.0, TONE_LUT_SIZE)).astype(np.uint8)
+    out = np.empty(hdr.shape, np.uint8)
+    develop(hdr, 1.0, np.ones(3), 0.0, (160.0, 120.0), shot, read, 1.0, 11, linear, out)
+    values = out.reshape(-1, 3).astype(np.float64) / 255.0
+    expected = np.sqrt(level * shot + read * read)
+    assert np.allclose(values.mean(axis=0), level, atol=0.005)
+    assert np.allclose(values.std(axis=0), expected, rtol=0.05)
+    correlation = np.corrcoef(values.T)
+    assert np.all(np.abs(correlation[np.triu_indices(3, 1)]) < 0.03)
+    again = np.empty_like(out)
+    develop(hdr, 1.0, np.ones(3), 0.0, (160.0, 120.0), shot, read, 1.0, 11, linear, again, threads=2)
+    assert np.array_equal(out, again)
+
+
 def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: Callable[..., Case]) -> None:
     """A metered camera shows sun-lit asphalt bright and its shadow dark: the ratio of the two is lower than the
     ideal render's, as on a photograph."""

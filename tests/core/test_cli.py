@@ -74,6 +74,7 @@ def test_invalid_case_names_the_field(tmp_path, capsys):
         (["export", "{case}", "--out", "{tmp}/e", "--frames", "x"], "START:STOP"),
         (["export", "{case}", "--out", "{tmp}/e", "--format", "kitti"], "argument --format"),
         (["bench", "--frames-per-case", "0"], "--frames-per-case"),
+        (["bench", "--camera", "fisheye"], "argument --camera: invalid choice: 'fisheye'"),
         (["paint"], "invalid choice"),
         ([], "required"),
     ],
@@ -199,6 +200,21 @@ def test_bench_json_is_one_object(monkeypatch, capsys, make_case):
         assert row["median_ms"] > 0 and {"raster", "shade"} <= set(row["stages"])
     table = bench.format_table(result)
     assert table.splitlines()[0].split()[:2] == ["size", "ms/frame"] and len(table.splitlines()) == 3
+
+
+def test_bench_times_camera_presets_beside_the_case_camera(monkeypatch, capsys, make_case):
+    monkeypatch.setattr(bench, "run_benchmark", partial(bench.run_benchmark, sizes=((160, 90),)))
+    monkeypatch.setattr(bench, "bench_cases", lambda paths: [make_case()])
+    assert cli.main(["bench", "--json", "--frames-per-case", "1", "--camera", "carla", "dashcam"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result) == ["160x90 case", "160x90 carla", "160x90 dashcam"]
+    case_ms = result["160x90 case"]["median_ms"]
+    for name in ("carla", "dashcam"):
+        row = result[f"160x90 {name}"]
+        assert row["camera"] == name and row["ratio"] == round(row["median_ms"] / case_ms, 2)
+        assert "lens" in row["stages"]  # the photographed path ran
+    assert "ratio" not in result["160x90 case"] and "lens" not in result["160x90 case"]["stages"]
+    assert bench.format_table(result).splitlines()[0].split()[-1] == "ratio"
 
 
 def test_frames_to_time_spreads_over_the_drive(make_case):
