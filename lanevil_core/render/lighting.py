@@ -182,13 +182,6 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
-    # The footprint's sides in light space (metres), read before any branch (see ``_jit``).
-    ux = R_light[0, 0] * du[0] + R_light[0, 1] * du[1] + R_light[0, 2] * du[2]
-    uy = R_light[1, 0] * du[0] + R_light[1, 1] * du[1] + R_light[1, 2] * du[2]
-    ud = R_light[2, 0] * du[0] + R_light[2, 1] * du[1] + R_light[2, 2] * du[2]
-    vx = R_light[0, 0] * dv[0] + R_light[0, 1] * dv[1] + R_light[0, 2] * dv[2]
-    vy = R_light[1, 0] * dv[0] + R_light[1, 1] * dv[1] + R_light[1, 2] * dv[2]
-    vd = R_light[2, 0] * dv[0] + R_light[2, 1] * dv[1] + R_light[2, 2] * dv[2]
     size = maps.shape[1]
     cascades = maps.shape[0]
     c = 0
@@ -203,12 +196,17 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     lit = 1.0
     if c < cascades:
         bias = bias_texels / scale
-        ux, uy, vx, vy = ux * scale, uy * scale, vx * scale, vy * scale
         n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
         n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
         if n_u * n_v == 1:
             lit = _visibility_at(maps, cells, c, x, y, d, bias, scale, penumbra)
-        else:
+        else:  # the footprint's sides in the map (texels) and in light depth (m)
+            ux = (R_light[0, 0] * du[0] + R_light[0, 1] * du[1] + R_light[0, 2] * du[2]) * scale
+            uy = (R_light[1, 0] * du[0] + R_light[1, 1] * du[1] + R_light[1, 2] * du[2]) * scale
+            ud = R_light[2, 0] * du[0] + R_light[2, 1] * du[1] + R_light[2, 2] * du[2]
+            vx = (R_light[0, 0] * dv[0] + R_light[0, 1] * dv[1] + R_light[0, 2] * dv[2]) * scale
+            vy = (R_light[1, 0] * dv[0] + R_light[1, 1] * dv[1] + R_light[1, 2] * dv[2]) * scale
+            vd = R_light[2, 0] * dv[0] + R_light[2, 1] * dv[1] + R_light[2, 2] * dv[2]
             lo, hi = 2.0, size - 2.0
             hx, hy, hd = 0.5 * (abs(ux) + abs(vx)), 0.5 * (abs(uy) + abs(vy)), 0.5 * (abs(ud) + abs(vd))
             lit = _cells_decide(cells, c, max(x - hx, lo), min(x + hx, hi), max(y - hy, lo), min(y + hy, hi),
@@ -223,8 +221,8 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
                                                 min(max(y + a * uy + b * vy, lo), hi), d + a * ud + b * vd, bias,
                                                 scale, penumbra)
                 lit = total / (n_u * n_v)
-    # Every path ends on a use of the three arrays, so numba releases them in one place (see ``_jit``).
-    return lit if maps.shape[0] == cells.shape[0] == params.shape[0] else lit
+    # Every path ends on a use of the four arrays, so numba releases them in one place (see ``_jit``).
+    return lit if maps.shape[0] == cells.shape[0] == params.shape[0] and R_light.shape[0] == 3 else lit
 
 
 @kernel(inline="always")

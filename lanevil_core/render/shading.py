@@ -455,6 +455,9 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     wetness, puddles, sun_i, cloud, penumbra = env_f[WETNESS], env_f[PUDDLES], env_f[SUN_I], env_f[CLOUD], \
         env_f[PENUMBRA]
     detail = env_f[DETAIL]
+    finest = 0.0  # texels per metre of the finest shadow cascade
+    for c in range(shadow_params.shape[0]):
+        finest = max(finest, shadow_params[c, 2])
     last = stripe_index.shape[1] - 1
     width = face.shape[1]
     span = -1  # the sky samples below are those of columns span * SKY_STEP and (span + 1) * SKY_STEP
@@ -551,7 +554,9 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if sun_i > 0.0 and n_dot_l > 0.0:
             du = dv = (0.0, 0.0, 0.0)  # the ideal render reads the point; a photograph filters over the pixel
-            if detail > 0.0:
+            # ... unless no side of the footprint can reach a texel of the finest cascade (|du| is at most
+            # depth / fx * (1 + 1 / n.v), |dv| likewise): then one lookup is the filter
+            if detail > 0.0 and depth * max(1.0 / fx, 1.0 / fy) * (1.0 + 1.0 / max(n_dot_v, 1e-4)) * finest >= 1.0:
                 du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
             vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
                                  cells, shadow_params, R_light, penumbra, du, dv)
