@@ -7,6 +7,7 @@ with ``transformed(mesh, pose_on_road(line, s, t, yaw))``.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 import numpy.typing as npt
@@ -31,11 +32,49 @@ def to_mesh(
     casts_shadow: bool = True,
 ) -> Mesh:
     """A ``Mesh`` from a trimesh: ``color`` (3,) or (m, 3) linear albedo; ``emission`` likewise or None."""
-    m = len(tm.faces)
+    return _mesh(np.array(tm.vertices, np.float64), np.array(tm.faces, np.int32), color, name=name, kind=kind,
+                 gloss=gloss, emission=emission, casts_shadow=casts_shadow)
+
+
+def _mesh(vertices: FloatArray, faces: IntArray, color: ColorLike, *, name: str = "object", kind: str = "prop",
+          gloss: float = 0.0, emission: ColorLike | None = None, casts_shadow: bool = True) -> Mesh:
+    """A ``Mesh`` of its own (n, 3) float64 ``vertices`` and (m, 3) int32 ``faces`` (see ``to_mesh``)."""
+    m = len(faces)
     colors = np.broadcast_to(np.asarray(color, np.float32), (m, 3))
     emitted = None if emission is None else np.broadcast_to(np.asarray(emission, np.float32), (m, 3))
-    return Mesh(np.array(tm.vertices, np.float64), np.array(tm.faces, np.int32), colors, name=name, kind=kind,
-                casts_shadow=casts_shadow, gloss=gloss, emission=emitted)
+    return Mesh(vertices, faces, colors, name=name, kind=kind, casts_shadow=casts_shadow, gloss=gloss,
+                emission=emitted)
+
+
+def _key(values: PointsLike | None) -> tuple[float, ...] | None:
+    """A hashable copy of a few coordinates (a cache key)."""
+    return None if values is None else tuple(float(v) for v in np.asarray(values, np.float64).ravel())
+
+
+@lru_cache(maxsize=1024)
+def _box_arrays(extents: tuple[float, ...], center: tuple[float, ...]) -> tuple[FloatArray, IntArray]:
+    """Vertices and faces of ``box`` (kept read-only: traffic builds the same few boxes for every vehicle)."""
+    tm = trimesh.creation.box(extents=np.array(extents), transform=translation(center))
+    return _frozen(tm)
+
+
+@lru_cache(maxsize=1024)
+def _cylinder_arrays(radius: float, height: float | None, center: tuple[float, ...],
+                     segment: tuple[float, ...] | None, sections: int) -> tuple[FloatArray, IntArray]:
+    """Vertices and faces of ``cylinder`` (kept read-only: every wheel of a vehicle type is the same)."""
+    if segment is not None:
+        tm = trimesh.creation.cylinder(radius=radius, segment=np.array(segment).reshape(2, 3), sections=sections)
+    else:
+        tm = trimesh.creation.cylinder(radius=radius, height=height, sections=sections,
+                                       transform=translation(center))
+    return _frozen(tm)
+
+
+def _frozen(tm: trimesh.Trimesh) -> tuple[FloatArray, IntArray]:
+    vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int32)
+    vertices.setflags(write=False)
+    faces.setflags(write=False)
+    return vertices, faces
 
 
 def flat_trimesh(vertices: FloatArray, faces: IntArray, colors: Float32Array) -> trimesh.Trimesh:
@@ -94,8 +133,8 @@ def rotation_z(angle: float) -> FloatArray:
 
 def box(extents: ColorLike, center: ColorLike = (0.0, 0.0, 0.0), color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     """An axis-aligned box (12 faces) with full ``extents`` (3,) centred at ``center`` (3,)."""
-    tm = trimesh.creation.box(extents=np.asarray(extents, np.float64), transform=translation(center))
-    return to_mesh(tm, color, **kw)
+    vertices, faces = _box_arrays(_key(extents), _key(center))
+    return _mesh(vertices.copy(), faces.copy(), color, **kw)
 
 
 def cylinder(
@@ -109,14 +148,11 @@ def cylinder(
     **kw,
 ) -> Mesh:
     """A closed cylinder: along +Z of ``height`` centred at ``center``, or along ``segment`` (2, 3) end to end."""
-    if segment is not None:
-        tm = trimesh.creation.cylinder(radius=radius, segment=np.asarray(segment, np.float64), sections=sections)
-    else:
-        if height is None:
-            raise ValueError("cylinder needs a height or a segment")
-        tm = trimesh.creation.cylinder(radius=radius, height=height, sections=sections,
-                                       transform=translation(center))
-    return to_mesh(tm, color, **kw)
+    if segment is None and height is None:
+        raise ValueError("cylinder needs a height or a segment")
+    vertices, faces = _cylinder_arrays(float(radius), None if height is None else float(height), _key(center),
+                                       _key(segment), sections)
+    return _mesh(vertices.copy(), faces.copy(), color, **kw)
 
 
 def prism(profile: PointsLike, lo: float, hi: float, color: ColorLike = (0.2, 0.2, 0.2), *, axis: str = "y",

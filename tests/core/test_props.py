@@ -188,3 +188,24 @@ def test_pose_on_road_stands_upright_along_the_heading() -> None:
         np.testing.assert_allclose(T[:3, 3], line.to_world(s, -3.0, 0.1))
     car = transformed(props.car(), pose_on_road(line, 100.0, -1.75))
     assert signed_volume(car) == pytest.approx(signed_volume(props.car()))
+
+
+def test_primitives_reuse_their_geometry_and_hand_out_meshes_of_their_own() -> None:
+    """Boxes and cylinders are built once per shape (traffic builds the same wheels for every vehicle) and equal
+    trimesh's own; a mesh handed out can be moved in place without changing the next one."""
+    import trimesh
+
+    segment = [(1.2, 0.6, 0.33), (1.2, 0.85, 0.33)]
+    wheel = cylinder(0.33, segment=segment, sections=12, color=(0.1, 0.1, 0.1), name="tyre")
+    direct = trimesh.creation.cylinder(radius=0.33, segment=np.array(segment), sections=12)
+    assert np.array_equal(wheel.vertices, direct.vertices) and np.array_equal(wheel.faces, direct.faces)
+    assert wheel.name == "tyre" and wheel.colors.shape == (len(wheel.faces), 3)
+    crate = box((1.0, 2.0, 0.5), center=(0.0, 1.0, 0.25))
+    assert np.array_equal(crate.vertices, trimesh.creation.box(extents=(1.0, 2.0, 0.5)).vertices + (0.0, 1.0, 0.25))
+    wheel.vertices += 10.0  # posing a mesh moves its own arrays
+    crate.vertices[:] = 0.0
+    again = cylinder(0.33, segment=np.array(segment), sections=12)
+    assert np.array_equal(again.vertices, direct.vertices) and again.vertices.flags.writeable
+    assert np.array_equal(box([1.0, 2.0, 0.5], center=np.array([0.0, 1.0, 0.25])).vertices.max(0), (0.5, 2.0, 0.5))
+    with pytest.raises(ValueError, match="height or a segment"):
+        cylinder(0.3)
