@@ -164,12 +164,49 @@ def _cells_decide(cells: np.ndarray, c: int, x_lo: float, x_hi: float, y_lo: flo
 
 
 @kernel(inline="always")
+def _cascade_of(u: float, v: float, params: np.ndarray, size: int) -> tuple[int, float, float, float]:
+    """(cascade, x, y, texels per metre): the first cascade whose map holds light-space point (u, v) at least 2
+    texels inside, and the point's map coordinates there; the cascade count when none does."""
+    c = 0
+    x = y = scale = 0.0
+    while c < params.shape[0]:
+        scale = params[c, 2]
+        x = (u - params[c, 0]) * scale
+        y = (v - params[c, 1]) * scale
+        if x >= 2 and y >= 2 and x <= size - 2 and y <= size - 2:
+            break
+        c += 1
+    return (c, x, y, scale) if params.shape[1] > 0 else (c, x, y, scale)
+
+
+@kernel(inline="always")
 def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
                    bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray, R_light: np.ndarray,
-                   penumbra: float, du: tuple[float, float, float], dv: tuple[float, float, float]) -> float:
+                   penumbra: float) -> float:
+    """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges (see
+    ``_visibility_at``). ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``."""
+    q0 = px + nx * offset
+    q1 = py + ny * offset
+    q2 = pz + nz * offset
+    u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
+    v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
+    d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    c, x, y, scale = _cascade_of(u, v, params, maps.shape[1])
+    lit = 1.0
+    if c < maps.shape[0]:
+        lit = _visibility_at(maps, cells, c, x, y, d, bias_texels / scale, scale, penumbra)
+    # Every path ends on a use of the four arrays, so numba releases them in one place (see ``_jit``).
+    return lit if maps.shape[0] == cells.shape[0] == params.shape[0] and R_light.shape[0] == 3 else lit
+
+
+@kernel(inline="always")
+def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, nz: float, offset: float,
+                        bias_texels: float, maps: np.ndarray, cells: np.ndarray, params: np.ndarray,
+                        R_light: np.ndarray, penumbra: float, du: tuple[float, float, float],
+                        dv: tuple[float, float, float]) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), averaged over the pixel's footprint, the
     parallelogram p + a du + b dv (|a|, |b| <= 1/2; du, dv are the world steps of one pixel across and down on
-    the surface; zero steps read the point alone, as the ideal render does).
+    the surface; zero steps read the point alone, as ``sun_visibility`` does).
 
     ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``. Each side is read
     once per shadow-map texel of its length on the surface, at most FOOTPRINT_TAPS, all in the cascade that holds
@@ -183,44 +220,35 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
     size = maps.shape[1]
-    cascades = maps.shape[0]
-    c = 0
-    x = y = scale = 0.0
-    while c < cascades:  # the first cascade that holds the point
-        scale = params[c, 2]
-        x = (u - params[c, 0]) * scale
-        y = (v - params[c, 1]) * scale
-        if x >= 2 and y >= 2 and x <= size - 2 and y <= size - 2:
-            break
-        c += 1
+    c, x, y, scale = _cascade_of(u, v, params, size)
     lit = 1.0
-    if c < cascades:
+    if c < maps.shape[0]:
         bias = bias_texels / scale
         n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
         n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
-        if n_u * n_v == 1:
-            lit = _visibility_at(maps, cells, c, x, y, d, bias, scale, penumbra)
-        else:  # the footprint's sides in the map (texels) and in light depth (m)
+        lo, hi = 2.0, size - 2.0
+        ux = uy = ud = vx = vy = vd = 0.0  # the footprint's sides in the map (texels) and in light depth (m)
+        lit = -1.0
+        if n_u * n_v > 1:
             ux = (R_light[0, 0] * du[0] + R_light[0, 1] * du[1] + R_light[0, 2] * du[2]) * scale
             uy = (R_light[1, 0] * du[0] + R_light[1, 1] * du[1] + R_light[1, 2] * du[2]) * scale
             ud = R_light[2, 0] * du[0] + R_light[2, 1] * du[1] + R_light[2, 2] * du[2]
             vx = (R_light[0, 0] * dv[0] + R_light[0, 1] * dv[1] + R_light[0, 2] * dv[2]) * scale
             vy = (R_light[1, 0] * dv[0] + R_light[1, 1] * dv[1] + R_light[1, 2] * dv[2]) * scale
             vd = R_light[2, 0] * dv[0] + R_light[2, 1] * dv[1] + R_light[2, 2] * dv[2]
-            lo, hi = 2.0, size - 2.0
             hx, hy, hd = 0.5 * (abs(ux) + abs(vx)), 0.5 * (abs(uy) + abs(vy)), 0.5 * (abs(ud) + abs(vd))
             lit = _cells_decide(cells, c, max(x - hx, lo), min(x + hx, hi), max(y - hy, lo), min(y + hy, hi),
                                 d - hd - bias, d + hd - bias)
-            if lit < 0.0:
-                total = 0.0
-                for j in range(n_v):
-                    b = (j + 0.5) / n_v - 0.5
-                    for i in range(n_u):
-                        a = (i + 0.5) / n_u - 0.5
-                        total += _visibility_at(maps, cells, c, min(max(x + a * ux + b * vx, lo), hi),
-                                                min(max(y + a * uy + b * vy, lo), hi), d + a * ud + b * vd, bias,
-                                                scale, penumbra)
-                lit = total / (n_u * n_v)
+        if lit < 0.0:  # one loop for one tap or many: the soft-edge code is inlined once (see ``_jit``)
+            total = 0.0
+            for j in range(n_v):
+                b = (j + 0.5) / n_v - 0.5
+                for i in range(n_u):
+                    a = (i + 0.5) / n_u - 0.5
+                    total += _visibility_at(maps, cells, c, min(max(x + a * ux + b * vx, lo), hi),
+                                            min(max(y + a * uy + b * vy, lo), hi), d + a * ud + b * vd, bias, scale,
+                                            penumbra)
+            lit = total / (n_u * n_v)
     # Every path ends on a use of the four arrays, so numba releases them in one place (see ``_jit``).
     return lit if maps.shape[0] == cells.shape[0] == params.shape[0] and R_light.shape[0] == 3 else lit
 

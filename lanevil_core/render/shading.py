@@ -34,6 +34,7 @@ from .lighting import (
     sky_openness,
     sky_radiance,
     sun_visibility,
+    sun_visibility_over,
 )
 from .surface import CHIP_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
@@ -553,13 +554,15 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if sun_i > 0.0 and n_dot_l > 0.0:
-            du = dv = (0.0, 0.0, 0.0)  # the ideal render reads the point; a photograph filters over the pixel
-            # ... unless no side of the footprint can reach a texel of the finest cascade (|du| is at most
-            # depth / fx * (1 + 1 / n.v), |dv| likewise): then one lookup is the filter
+            # The ideal render reads the point; a photograph filters over the pixel's footprint, unless no side of
+            # it can reach a texel of the finest cascade (|du| <= depth / fx * (1 + 1 / n.v), |dv| likewise).
             if detail > 0.0 and depth * max(1.0 / fx, 1.0 / fy) * (1.0 + 1.0 / max(n_dot_v, 1e-4)) * finest >= 1.0:
                 du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
-            vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
-                                 cells, shadow_params, R_light, penumbra, du, dv)
+                vis = sun_visibility_over(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS],
+                                          maps, cells, shadow_params, R_light, penumbra, du, dv)
+            else:
+                vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
+                                     cells, shadow_params, R_light, penumbra)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
