@@ -164,6 +164,15 @@ def _cells_decide(cells: np.ndarray, c: int, x_lo: float, x_hi: float, y_lo: flo
 
 
 @kernel(inline="always")
+def _light_space(q0: float, q1: float, q2: float, R_light: np.ndarray) -> tuple[float, float, float]:
+    """World point q in the sun's frame: (u, v) across the shadow maps (m), d its depth along the light."""
+    u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
+    v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
+    d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    return u, v, d
+
+
+@kernel(inline="always")
 def _cascade_of(u: float, v: float, params: np.ndarray, size: int) -> tuple[int, float, float, float]:
     """(cascade, x, y, texels per metre): the first cascade whose map holds light-space point (u, v) at least 2
     texels inside, and the point's map coordinates there; the cascade count when none does."""
@@ -185,12 +194,7 @@ def sun_visibility(px: float, py: float, pz: float, nx: float, ny: float, nz: fl
                    penumbra: float) -> float:
     """Fraction of the sun seen from world point ``p`` (1 = lit), with contact-hardening soft edges (see
     ``_visibility_at``). ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``."""
-    q0 = px + nx * offset
-    q1 = py + ny * offset
-    q2 = pz + nz * offset
-    u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
-    v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
-    d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    u, v, d = _light_space(px + nx * offset, py + ny * offset, pz + nz * offset, R_light)
     c, x, y, scale = _cascade_of(u, v, params, maps.shape[1])
     lit = 1.0
     if c < maps.shape[0]:
@@ -213,12 +217,7 @@ def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, n
     p: shadows finer than a pixel (a slatted fence's far off) average to their share of shade instead of beating
     with the pixel grid (moire). When the coarse cells under the whole footprint agree, no tap is read.
     """
-    q0 = px + nx * offset
-    q1 = py + ny * offset
-    q2 = pz + nz * offset
-    u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
-    v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
-    d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
+    u, v, d = _light_space(px + nx * offset, py + ny * offset, pz + nz * offset, R_light)
     size = maps.shape[1]
     c, x, y, scale = _cascade_of(u, v, params, size)
     lit = 1.0
