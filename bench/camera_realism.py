@@ -21,8 +21,9 @@ from PIL import Image
 
 from lanevil_core.case import load_case
 from lanevil_core.metrics.realism import frame_statistics, summary
+from lanevil_core.pipeline.bench import with_camera
 from lanevil_core.pipeline.compile import compile_scene
-from lanevil_core.presets import CAMERA_PRESET_NAMES, camera_preset_values
+from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import render_frame
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,8 +44,7 @@ def main() -> None:
         base = load_case(path)
         scenes = {IDEAL: compile_scene(base)}
         for name in args.cameras:
-            case = base.model_copy(update={"camera": type(base.camera).model_validate(camera_preset_values(name))})
-            scenes[name] = compile_scene(case)
+            scenes[name] = compile_scene(with_camera(base, name))
         for name in cameras:
             render_frame(scenes[name], args.frames[0], (1280, 720))  # warm the scene's caches
         for frame in args.frames:

@@ -165,7 +165,7 @@ def _cells_decide(cells: np.ndarray, c: int, x_lo: float, x_hi: float, y_lo: flo
 
 @kernel(inline="always")
 def _light_space(q0: float, q1: float, q2: float, R_light: np.ndarray) -> tuple[float, float, float]:
-    """World point q in the sun's frame: (u, v) across the shadow maps (m), d its depth along the light."""
+    """World point (or step) q in the sun's frame: (u, v) across the shadow maps (m), d its depth along the light."""
     u = R_light[0, 0] * q0 + R_light[0, 1] * q1 + R_light[0, 2] * q2
     v = R_light[1, 0] * q0 + R_light[1, 1] * q1 + R_light[1, 2] * q2
     d = R_light[2, 0] * q0 + R_light[2, 1] * q1 + R_light[2, 2] * q2
@@ -229,12 +229,9 @@ def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, n
         ux = uy = ud = vx = vy = vd = 0.0  # the footprint's sides in the map (texels) and in light depth (m)
         lit = -1.0
         if n_u * n_v > 1:
-            ux = (R_light[0, 0] * du[0] + R_light[0, 1] * du[1] + R_light[0, 2] * du[2]) * scale
-            uy = (R_light[1, 0] * du[0] + R_light[1, 1] * du[1] + R_light[1, 2] * du[2]) * scale
-            ud = R_light[2, 0] * du[0] + R_light[2, 1] * du[1] + R_light[2, 2] * du[2]
-            vx = (R_light[0, 0] * dv[0] + R_light[0, 1] * dv[1] + R_light[0, 2] * dv[2]) * scale
-            vy = (R_light[1, 0] * dv[0] + R_light[1, 1] * dv[1] + R_light[1, 2] * dv[2]) * scale
-            vd = R_light[2, 0] * dv[0] + R_light[2, 1] * dv[1] + R_light[2, 2] * dv[2]
+            ux, uy, ud = _light_space(du[0], du[1], du[2], R_light)
+            vx, vy, vd = _light_space(dv[0], dv[1], dv[2], R_light)
+            ux, uy, vx, vy = ux * scale, uy * scale, vx * scale, vy * scale
             hx, hy, hd = 0.5 * (abs(ux) + abs(vx)), 0.5 * (abs(uy) + abs(vy)), 0.5 * (abs(ud) + abs(vd))
             lit = _cells_decide(cells, c, max(x - hx, lo), min(x + hx, hi), max(y - hy, lo), min(y + hy, hi),
                                 d - hd - bias, d + hd - bias)
