@@ -15,6 +15,11 @@ from .lens import covers
 
 HFOV_DEG = (45.0, 100.0)
 HEIGHT_M = (1.2, 3.5)
+# Most dash and windscreen cameras sit 1.2-1.6 m over the road (a car's roof is about 1.45 m); the paper's 3 m
+# camera and trucks' and buses' cameras fill the rest of HEIGHT_M. A lane line's slope in the image is its lateral
+# offset over the camera's height, so a detector that places lanes from the whole frame learns this prior.
+CAR_HEIGHT_M = (1.2, 1.6)
+CAR_HEIGHT_SHARE = 0.6
 AHEAD_M = (0.4, 2.0)
 PITCH_DEG = (-2.0, 6.0)  # positive looks down
 ROLL_DEG = (-2.0, 2.0)
@@ -46,13 +51,21 @@ def _pick(u: float, lo_hi: tuple[float, float], digits: int = 3) -> float:
     return round(lo + (hi - lo) * u, digits)
 
 
+def _height(u: float) -> float:
+    """The mount height for one uniform draw ``u``: within CAR_HEIGHT_M for a share CAR_HEIGHT_SHARE of draws,
+    above it up to HEIGHT_M's top for the rest (one draw either way)."""
+    if u < CAR_HEIGHT_SHARE:
+        return _pick(u / CAR_HEIGHT_SHARE, CAR_HEIGHT_M, 2)
+    return _pick((u - CAR_HEIGHT_SHARE) / (1.0 - CAR_HEIGHT_SHARE), (CAR_HEIGHT_M[1], HEIGHT_M[1]), 2)
+
+
 def random_camera(rng: np.random.Generator, size: tuple[int, int] = (1280, 720)) -> dict[str, Any]:
     """Camera fields (a dict for ``Case.camera``) of an image of ``size`` drawn from the ranges above, always
     ``DRAWS`` uniform draws."""
     u = rng.uniform(0.0, 1.0, DRAWS)
     camera = camera_preset_values(CAMERA_PRESET_NAMES[int(u[0] * len(CAMERA_PRESET_NAMES))])
     camera.update(width=size[0], height=size[1])
-    camera.update(fov=_pick(u[1], HFOV_DEG, 1), z=_pick(u[2], HEIGHT_M, 2), x=_pick(u[3], AHEAD_M, 2),
+    camera.update(fov=_pick(u[1], HFOV_DEG, 1), z=_height(u[2]), x=_pick(u[3], AHEAD_M, 2),
                   pitch=_pick(u[4], PITCH_DEG, 2), roll=_pick(u[5], ROLL_DEG, 2), yaw=_pick(u[6], YAW_DEG, 2),
                   lens={"k1": _pick(u[7], K1, 4), "k2": _pick(u[8], K2, 4)})
     camera["bonnet"] = ({"reach": _pick(u[10], BONNET_REACH_M, 2), "drop": _pick(u[11], BONNET_DROP_M, 2)}

@@ -32,6 +32,9 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
                         help="training augmentation / defence: the paper's baselines, aam (Attention Area Mixing "
                              "with hard examples rendered from training variations) or pgd (adversarial training) "
                              "(default none)")
+    parser.add_argument("--affine", action="store_true",
+                        help="UFLD's geometric augmentation: every training sample rotated by up to 6 degrees and "
+                             "shifted by up to 14 %% of the height and 16 %% of the width, labels with it")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
     parser.add_argument("--seed", type=count(0), default=0, help="default 0")
     parser.add_argument("--val", type=float, default=0.1, dest="val_fraction",
@@ -64,7 +67,8 @@ def _run_train(args: argparse.Namespace) -> int:
     try:
         spec = ModelSpec(family=args.model, backbone=args.backbone, width=args.width, input_size=args.size)
         settings = TrainSettings(data=args.data, out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,
-                                 lr=args.lr, augment=args.augment, device=args.device, seed=args.seed,
+                                 lr=args.lr, augment=args.augment, affine=args.affine, device=args.device,
+                                 seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
                                  max_steps=args.max_steps, threads=args.threads)
         summary = train(settings, show_progress=not args.quiet)

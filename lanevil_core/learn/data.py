@@ -7,7 +7,8 @@ Two sources give the same samples:
   labels code the dataset writer uses (``labels.tusimple_record``).
 
 A sample's targets come from ``detect.lane_slots``: lanes placed in slots, row-anchor classes and a lane mask.
-A horizontal flip (half the training samples) mirrors image and slots; ``--augment`` adds one of ``augment``.
+A horizontal flip (half the training samples) mirrors image and slots; ``--augment`` adds one of ``augment``;
+``--affine`` rotates and shifts every training sample (``affine``).
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from ..detect.model_spec import ModelSpec
 from ..detect.split import read_rgb
 from ..metrics.formats import split_labels
 from ..typed import UInt8Array
+from .affine import draw_affine, warp_image, warp_lines
 from .augment import AUGMENT_PROBABILITY, Augment
 
 
@@ -73,9 +75,14 @@ def _keypoint_targets(placed: list[LaneLine | None], spec: ModelSpec) -> dict[st
 FAMILY_TARGETS = {"laneatt": _anchor_targets, "bezier": _curve_targets, "ganet": _keypoint_targets}
 
 
-def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: ModelSpec, flip: bool) -> Targets:
-    """The targets of a TuSimple record of a frame of ``frame_size`` (width, height)."""
-    placed = assign_slots(lane_lines(record["lanes"], record["h_samples"], frame_size), spec.slots)
+def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: ModelSpec, flip: bool,
+                M_out_in: np.ndarray | None = None) -> Targets:
+    """The targets of a TuSimple record of a frame of ``frame_size`` (width, height); ``M_out_in`` is the
+    ``affine.draw_affine`` map the image went through (before the flip), in pixels of the input size."""
+    lines = lane_lines(record["lanes"], record["h_samples"], frame_size)
+    if M_out_in is not None:
+        lines = warp_lines(lines, M_out_in, spec.input_size)
+    placed = assign_slots(lines, spec.slots)
     if flip:
         placed = mirror_slots(placed)
     extra = FAMILY_TARGETS[spec.family](placed, spec) if spec.family in FAMILY_TARGETS else {}
@@ -96,10 +103,12 @@ class _Frames(Dataset):
     """Shared sample assembly over ``images`` ((N, H, W, 3) uint8 at the input size), their TuSimple ``records``
     and the ``frame_sizes`` the records refer to, which the subclasses fill."""
 
-    def __init__(self, spec: ModelSpec, train: bool, augment: Augment | None, seed: int) -> None:
+    def __init__(self, spec: ModelSpec, train: bool, augment: Augment | None, seed: int,
+                 affine: bool = False) -> None:
         self.spec = spec
         self.train = train
         self.augment = augment
+        self.affine = affine
         self.seed = seed
         self.epoch = 0
         self.records: list[dict[str, Any]] = []
@@ -116,15 +125,19 @@ class _Frames(Dataset):
     def __getitem__(self, index: int) -> dict[str, torch.Tensor]:
         image = self.image(index)
         flip = False
+        M_out_in = None
         if self.train:  # per (seed, epoch, index): the same run draws the same augmentations, also on resume
             rng = np.random.default_rng([self.seed, self.epoch, index])
             flip = bool(rng.random() < 0.5)
             if self.augment is not None and rng.random() < AUGMENT_PROBABILITY:
                 other = self.image(int(rng.integers(len(self))))
                 image = self.augment(image, rng, other)
+            if self.affine:  # drawn last, so the draws above are those of a run without it
+                M_out_in = draw_affine(rng, self.spec.input_size)
+                image = warp_image(image, M_out_in)
             if flip:
                 image = np.ascontiguousarray(image[:, ::-1])
-        targets = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip)
+        targets = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip, M_out_in)
         return {"image": torch.from_numpy(network_input(image, self.spec.input_size)),
                 "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask),
                 "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index),
@@ -144,8 +157,8 @@ class LabelledFrames(_Frames):
     """Frames of a split folder (``DIR/train``), the chosen ``indices`` of its label file, held in memory."""
 
     def __init__(self, split_dir: str | Path, spec: ModelSpec, indices: list[int] | None = None, train: bool = True,
-                 augment: Augment | None = None, seed: int = 0) -> None:
-        super().__init__(spec, train, augment, seed)
+                 augment: Augment | None = None, seed: int = 0, affine: bool = False) -> None:
+        super().__init__(spec, train, augment, seed, affine)
         self.split_dir = Path(split_dir)
         records = read_records(split_labels(self.split_dir))
         chosen = range(len(records)) if indices is None else indices
@@ -164,8 +177,8 @@ class RenderedFrames(_Frames):
     ``render_size`` and labelled by ``labels.tusimple_record``; the last few compiled scenes are kept."""
 
     def __init__(self, items: list[tuple[str | Path, int]], spec: ModelSpec, render_size: tuple[int, int] = (640, 360),
-                 train: bool = True, augment: Augment | None = None, seed: int = 0) -> None:
-        super().__init__(spec, train, augment, seed)
+                 train: bool = True, augment: Augment | None = None, seed: int = 0, affine: bool = False) -> None:
+        super().__init__(spec, train, augment, seed, affine)
         self.items = [(Path(path), int(frame)) for path, frame in items]
         self.render_size = render_size
         self._scenes: OrderedDict[Path, Any] = OrderedDict()

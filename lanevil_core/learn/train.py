@@ -65,6 +65,7 @@ class TrainSettings:
     lr: float = 2e-3
     weight_decay: float = 1e-4
     augment: str = "none"
+    affine: bool = False  # UFLD's rotation and shifts of every training sample (learn.affine)
     device: str = "auto"
     seed: int = 0
     val_fraction: float = 0.1
@@ -189,7 +190,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     groups = [str(Path(r["raw_file"]).parent) for r in records]
     train_idx, val_idx = split_indices(len(records), groups, settings.val_fraction, settings.seed)
     augment = AUGMENTS.get(settings.augment)
-    train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed)
+    train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed,
+                               affine=settings.affine)
     val_set = LabelledFrames(split_dir, spec, val_idx, train=False) if val_idx else None
 
     out = settings.out
@@ -280,6 +282,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "batch": settings.batch,
         "lr": settings.lr,
         "augment": settings.augment,
+        "affine": settings.affine,
         "seed": settings.seed,
         "device": device.type,
         "threads": torch.get_num_threads(),

@@ -233,6 +233,16 @@ def test_vary_camera_draws_cameras_within_the_ranges_and_keeps_the_rest_of_the_v
     assert 12 <= drawn < 24
 
 
+def test_drawn_mount_heights_favour_car_cameras_and_still_span_the_whole_range() -> None:
+    from lanevil_core.camera.variation import CAR_HEIGHT_M, CAR_HEIGHT_SHARE, HEIGHT_M, random_camera
+
+    heights = np.array([random_camera(np.random.default_rng([11, index]))["z"] for index in range(400)])
+    assert heights.min() >= HEIGHT_M[0] and heights.max() <= HEIGHT_M[1]
+    car = np.mean(heights <= CAR_HEIGHT_M[1])
+    assert abs(car - CAR_HEIGHT_SHARE) < 0.08  # a uniform draw over HEIGHT_M would put 17 % there
+    assert heights.max() > 3.2 and heights.min() < 1.3
+
+
 def test_a_lens_that_turns_back_inside_the_image_is_refused_and_drawn_lenses_cover_their_view() -> None:
     from lanevil_core.camera.cover import cover_camera
     from lanevil_core.camera.variation import random_camera

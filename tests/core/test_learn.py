@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -14,6 +15,7 @@ torch = pytest.importorskip("torch")
 
 from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.lane_slots import (  # noqa: E402
+    LaneLine,
     assign_slots,
     decode_lane_masks,
     decode_row_anchors,
@@ -361,3 +363,49 @@ def test_rendered_frames_give_the_same_samples_as_files(tmp_path):
     lanes = frames.records[1]["lanes"]
     assert int(sample["exist"].sum()) == sum(sum(x >= 0 for x in lane) >= 2 for lane in lanes)
     assert (sample["rows"] < spec.grid).any()  # lanes were encoded
+
+
+def test_affine_moves_the_lines_with_the_paint_and_the_identity_moves_nothing():
+    from lanevil_core.learn.affine import draw_affine, warp_image, warp_lines
+
+    size = (320, 180)
+    y = np.linspace(0.4, 1.0, 25)
+    line = LaneLine(np.stack([0.45 - 0.55 * (y - 0.4) + 0.1 * (y - 0.4) ** 2, y], axis=1))
+    image = np.zeros((size[1], size[0], 3), np.uint8)
+    pixels = line.points * np.array(size)
+    cv2.polylines(image, [np.rint(pixels * 16).astype(np.int32)], False, (255, 255, 255), 3, cv2.LINE_AA, shift=4)
+    identity = np.hstack([np.eye(2), np.zeros((2, 1))])
+    assert np.array_equal(warp_image(image, identity), image)
+    assert np.allclose(warp_lines([line], identity, size)[0].points, line.points)
+    for seed in range(6):
+        M = draw_affine(np.random.default_rng(seed), size)
+        assert np.array_equal(M, draw_affine(np.random.default_rng(seed), size))  # deterministic per draw
+        warped = warp_image(image, M)
+        moved = warp_lines([line], M, size)
+        assert len(moved) == 1 and np.all(np.diff(moved[0].points[:, 1]) >= 0)
+        ys = np.linspace(moved[0].points[0, 1], moved[0].points[-1, 1], 40)
+        xs = moved[0].x_at(ys)
+        cols, rows = np.floor(xs * size[0]).astype(int), np.floor(ys * size[1]).astype(int)
+        inside = (cols >= 0) & (cols < size[0]) & (rows >= 0) & (rows < size[1])
+        assert inside.sum() >= 10
+        # every sampled point of the moved line lies on the moved paint (within a pixel)
+        near = [warped[max(r - 1, 0):r + 2, max(c - 1, 0):c + 2, 0].max() for c, r in zip(cols[inside], rows[inside])]
+        assert min(near) > 100
+
+
+def test_affine_training_draws_the_same_samples_and_leaves_plain_runs_unchanged(tiny_dataset, tmp_path):
+    from lanevil_core.learn.data import LabelledFrames
+
+    spec = ModelSpec(family="ufld", width=TINY_SPEC["width"], input_size=tuple(TINY_SPEC["input_size"]))
+    split = tiny_dataset / "train"
+    plain = LabelledFrames(split, spec, seed=2)
+    moved_a = LabelledFrames(split, spec, seed=2, affine=True)
+    moved_b = LabelledFrames(split, spec, seed=2, affine=True)
+    changed = 0
+    for index in range(len(plain)):
+        a, b, p = moved_a[index], moved_b[index], plain[index]
+        assert all(torch.equal(a[key], b[key]) for key in a)
+        changed += int(not torch.equal(a["image"], p["image"]))
+    assert changed == len(plain)
+    assert _train(tiny_dataset, tmp_path, "ufld", "--affine") == 0
+    assert json.loads((tmp_path / "training.json").read_text())["affine"] is True
