@@ -409,3 +409,17 @@ def test_affine_training_draws_the_same_samples_and_leaves_plain_runs_unchanged(
     assert changed == len(plain)
     assert _train(tiny_dataset, tmp_path, "ufld", "--affine") == 0
     assert json.loads((tmp_path / "training.json").read_text())["affine"] is True
+
+
+def test_row_anchor_location_is_local_to_the_most_likely_cell():
+    from lanevil_core.detect.lane_slots import LOCATION_WINDOW
+
+    grid, anchors = 56, np.linspace(0.4, 1.0, 8)
+    probs = np.zeros((1, len(anchors), grid + 1))
+    probs[0, :, 9:12] = [0.15, 0.3, 0.15]  # the lane, centred on cell 10
+    probs[0, :, 40] = 0.25  # a second guess far off: the whole-row expectation would move to cell 17.5
+    probs[0, :, grid] = 0.15
+    line = decode_row_anchors(probs, anchors)[0]
+    assert line is not None and np.allclose(line.points[:, 0], 10.5 / grid)
+    whole_row = decode_row_anchors(probs, anchors, window=grid)[0]
+    assert whole_row is not None and whole_row.points[0, 0] > 15 / grid and LOCATION_WINDOW < 30
