@@ -61,3 +61,10 @@ def warp_lines(lines: list[LaneLine], M_out_in: np.ndarray, size: tuple[int, int
         if len(p_out) >= 2:
             warped.append(LaneLine(p_out[np.argsort(p_out[:, 1], kind="stable")]))
     return warped
+
+
+def ego_column(M_out_in: np.ndarray, size: tuple[int, int]) -> float:
+    """x_norm of the bottom middle of the image (where the ego's lane starts, ``lane_slots.assign_slots``'s
+    ``camera_x``) after ``M_out_in``: the lanes keep their places left and right of the ego."""
+    width, height = size
+    return float((M_out_in[0, :2] @ np.array([width / 2.0, float(height)]) + M_out_in[0, 2]) / width)

@@ -41,7 +41,7 @@ from ..detect.model_spec import ModelSpec
 from ..detect.split import read_rgb
 from ..metrics.formats import split_labels
 from ..typed import UInt8Array
-from .affine import draw_affine, warp_image, warp_lines
+from .affine import draw_affine, ego_column, warp_image, warp_lines
 from .augment import AUGMENT_PROBABILITY, Augment
 
 
@@ -80,9 +80,11 @@ def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: Model
     """The targets of a TuSimple record of a frame of ``frame_size`` (width, height); ``M_out_in`` is the
     ``affine.draw_affine`` map the image went through (before the flip), in pixels of the input size."""
     lines = lane_lines(record["lanes"], record["h_samples"], frame_size)
-    if M_out_in is not None:
+    camera_x = 0.5
+    if M_out_in is not None:  # the lanes keep their places beside the ego, which moved with the image
         lines = warp_lines(lines, M_out_in, spec.input_size)
-    placed = assign_slots(lines, spec.slots)
+        camera_x = ego_column(M_out_in, spec.input_size)
+    placed = assign_slots(lines, spec.slots, camera_x)
     if flip:
         placed = mirror_slots(placed)
     extra = FAMILY_TARGETS[spec.family](placed, spec) if spec.family in FAMILY_TARGETS else {}

@@ -423,3 +423,22 @@ def test_row_anchor_location_is_local_to_the_most_likely_cell():
     assert line is not None and np.allclose(line.points[:, 0], 10.5 / grid)
     whole_row = decode_row_anchors(probs, anchors, window=grid)[0]
     assert whole_row is not None and whole_row.points[0, 0] > 15 / grid and LOCATION_WINDOW < 30
+
+
+def test_affine_shift_keeps_each_lane_in_its_slot_beside_the_ego():
+    from lanevil_core.detect.model_spec import ModelSpec
+    from lanevil_core.learn.affine import ego_column
+    from lanevil_core.learn.data import targets_for
+
+    size = (320, 180)
+    shift = np.array([[1.0, 0.0, 0.3 * size[0]], [0.0, 1.0, 0.0]])  # the whole image 30 % to the right
+    assert ego_column(np.hstack([np.eye(2), np.zeros((2, 1))]), size) == 0.5
+    assert np.isclose(ego_column(shift, size), 0.8)
+    h_samples = list(range(400, 720, 10))
+    record = {"h_samples": h_samples, "lanes": [[round(560 - 0.8 * (y - 400)) for y in h_samples],
+                                                [round(720 + 0.8 * (y - 400)) for y in h_samples]]}
+    spec = ModelSpec(family="ufld", input_size=size)
+    plain = targets_for(record, (1280, 720), spec, False)
+    moved = targets_for(record, (1280, 720), spec, False, shift)
+    assert np.array_equal(plain.exist, moved.exist) and plain.exist[2] == plain.exist[3] == 1.0
+    assert np.all(moved.rows[2][moved.rows[2] < spec.grid] > plain.rows[2][moved.rows[2] < spec.grid])
