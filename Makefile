@@ -49,8 +49,8 @@ test-browser: $(STAMP)
 # fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
 # and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate, then
 # laneatt 8 more); ufld and seg then 8 and 6 more epochs at half the rate on a second randomised split (4,000
-# frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere, 60 % of its cameras at car heights). scnn and bezier train on the first split only,
-# bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The three splits
+# frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere, 60 % of its cameras at car
+# heights). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The three splits
 # render in about 3 + 3 + 13 min (the last measured with one worker beside two training runs); MODELS_DATA,
 # MODELS_DATA_VARIED and MODELS_DATA_VARIED2 keep the renders for reruns.
 MODELS_DATA ?= out/models-data

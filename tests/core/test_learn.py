@@ -15,6 +15,7 @@ torch = pytest.importorskip("torch")
 
 from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.lane_slots import (  # noqa: E402
+    LOCATION_WINDOW,
     LaneLine,
     assign_slots,
     decode_lane_masks,
@@ -412,8 +413,6 @@ def test_affine_training_draws_the_same_samples_and_leaves_plain_runs_unchanged(
 
 
 def test_row_anchor_location_is_local_to_the_most_likely_cell():
-    from lanevil_core.detect.lane_slots import LOCATION_WINDOW
-
     grid, anchors = 56, np.linspace(0.4, 1.0, 8)
     probs = np.zeros((1, len(anchors), grid + 1))
     probs[0, :, 9:12] = [0.15, 0.3, 0.15]  # the lane, centred on cell 10
@@ -426,7 +425,6 @@ def test_row_anchor_location_is_local_to_the_most_likely_cell():
 
 
 def test_affine_shift_keeps_each_lane_in_its_slot_beside_the_ego():
-    from lanevil_core.detect.model_spec import ModelSpec
     from lanevil_core.learn.affine import ego_column
     from lanevil_core.learn.data import targets_for
 
