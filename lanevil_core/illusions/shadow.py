@@ -42,6 +42,8 @@ ROAD_END_MARGIN_M = 5.0
 MAX_AHEAD_DEG = 75.0  # the sun never stands further ahead than this when its azimuth is solved for
 UPRIGHT_KINDS = ("streetlight", "pole")  # props already standing beside the road that our posts must not hit
 UPRIGHT_CLEARANCE_M = 1.5
+MIN_FENCE_SUN_DEG = 10.0  # the fence shadow's solved sun sinks no lower than this
+FENCE_EDGE_LANES = 0.5  # the level-5 fence's shadow ends this many ego lane widths past the lane's near line
 
 
 @dataclass(frozen=True)
@@ -88,14 +90,16 @@ class SunShadowIllusion(Illusion):
         """Sun altitude (degrees): the override or the table's."""
         return float(self.level().sun_altitude if self.sun_altitude is None else self.sun_altitude)
 
-    def apply_sun(self, ctx: CompileContext, s_road: float, side_sign: float, ahead: float | None = None) -> None:
+    def apply_sun(self, ctx: CompileContext, s_road: float, side_sign: float, ahead: float | None = None,
+                  altitude: float | None = None) -> None:
         """Set the environment's sun from the table row or the overrides.
 
         ``side_sign`` is +1 when the shadow-casting structure stands left of the road, -1 when right; ``ahead``
-        (degrees from square-on towards the direction of travel) defaults to the table's ``sun_ahead``.
+        (degrees from square-on towards the direction of travel) defaults to the table's ``sun_ahead``,
+        ``altitude`` to ``altitude()``.
         """
         level = self.level()
-        altitude = self.altitude()
+        altitude = self.altitude() if altitude is None else altitude
         azimuth = self.sun_azimuth
         if azimuth is None:
             heading_deg = float(np.degrees(ctx.network.main.line.heading_at(s_road)))
@@ -238,27 +242,33 @@ class FenceShadowLevel(SunAheadLevel):
     """What one severity level of ``FenceShadow`` sets."""
 
     height: float
-    slat_width: float
-    slat_gap: float
+    board: float  # height of each horizontal board (m)
+    gap: float  # gap between boards (m): a line of light on the road, parallel to the lanes
 
 
 @register
 class FenceShadow(SunShadowIllusion):
     """A slatted fence beside the road whose low-sun shadow lays stripes across the lanes."""
 
-    # One low sun from a fixed bearing at every level; the fence grows taller and its slats denser, so the
-    # striped shadow reaches further across the lanes and darkens more of them.
+    # A board fence (horizontal boards with narrow gaps between them) under a low sun nearly square-on from its
+    # side: the fence's shadow lies across the lanes and each gap lets through a line of light parallel to them, a
+    # bright lane-like line in the shade where the real paint falls dark (a camera exposed for the sunlit road).
+    # One sun at every level, its altitude solved from the road so that the shadow of the level-5 fence ends in
+    # the middle of the ego lane (``FENCE_EDGE_LANES``; the table's altitude is the highest it may stand,
+    # ``MIN_FENCE_SUN_DEG`` the lowest); the fence grows taller and the sun harder with the level, so the shade
+    # reaches from beside the ego lane (level 1) into it, with more lines of light. A shadow edge in the lane, with
+    # lines of light in the shade, fools the detectors more than a shade over the whole lane.
     SEVERITY: ClassVar[tuple[FenceShadowLevel, ...]] = (
-        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=0.7,
-                         slat_width=0.06, slat_gap=0.50),  # a low, open fence: a thin striped edge
-        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=1.5,
-                         slat_width=0.10, slat_gap=0.36),
-        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=2.2,
-                         slat_width=0.12, slat_gap=0.28),
-        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=2.8,
-                         slat_width=0.14, slat_gap=0.21),
-        FenceShadowLevel(sun_altitude=20.0, sun_ahead=32.0, sun_intensity=1.05, penumbra=0.008, height=3.4,
-                         slat_width=0.16, slat_gap=0.14),  # a tall dense fence: stripes over the ego's lane and beyond
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.05, penumbra=0.008, height=1.2,
+                         board=0.95, gap=0.16),  # a low fence: its shadow beside the ego lane
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.15, penumbra=0.008, height=1.7,
+                         board=0.95, gap=0.16),
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.25, penumbra=0.008, height=2.2,
+                         board=0.95, gap=0.16),
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.4, penumbra=0.008, height=2.65,
+                         board=0.95, gap=0.16),
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=3.1,
+                         board=0.95, gap=0.16),  # tall: shade to the ego lane's middle, lines of light in it
     )
 
     type: Literal["fence_shadow"] = "fence_shadow"
@@ -278,11 +288,25 @@ class FenceShadow(SunShadowIllusion):
         piece = ctx.network.main
         sign = side_sign(self.side)
         s0, s1 = self.extent(ctx.drive, self.length)
-        self.apply_sun(ctx, s0, sign)
         t_fence = roadside_t(piece, self.offset, sign)
+        self.apply_sun(ctx, s0, sign, altitude=self._altitude(ctx, t_fence, sign))
         for index, (a, b) in enumerate(clear_runs(s0, s1, t_fence, blocked(ctx, piece))):
-            ctx.add_mesh(fence(piece.line, a, b, t_fence, level.height, level.slat_width, level.slat_gap,
-                               ground=ground_height(piece, t_fence), color=self.color, name=f"fence {index + 1}"))
+            ctx.add_mesh(fence(piece.line, a, b, t_fence, level.height, level.board, level.gap,
+                               ground=ground_height(piece, t_fence), color=self.color, boards=True,
+                               name=f"fence {index + 1}"))
+
+    def _altitude(self, ctx: CompileContext, t_fence: float, sign: float) -> float:
+        """The override, or the sun altitude (degrees) at which the top of the level-5 fence's shadow falls
+        ``FENCE_EDGE_LANES`` ego lane widths past the lane's near line, within [MIN_FENCE_SUN_DEG, the table's
+        altitude]."""
+        if self.sun_altitude is not None:
+            return float(self.sun_altitude)
+        top = self.SEVERITY[-1]
+        width = ctx.network.lane_width
+        t_near = ctx.network.lane_center_t(ctx.drive.lane) + sign * width / 2
+        across = abs(t_fence - t_near) + FENCE_EDGE_LANES * width
+        solved = float(np.degrees(np.arctan2(top.height, across)))
+        return float(np.clip(solved, MIN_FENCE_SUN_DEG, self.level().sun_altitude))
 
 
 @dataclass(frozen=True)

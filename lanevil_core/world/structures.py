@@ -286,10 +286,12 @@ def guard_rail(line: ReferenceLine, s0: float, s1: float, t: float, ground: floa
 
 def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1.8, slat_width: float = 0.1,
           slat_gap: float = 0.1, ground: float = 0.0, post_spacing: float = 2.5, color: Color = WOOD,
-          name: str = "fence") -> Mesh:
+          boards: bool = False, name: str = "fence") -> Mesh:
     """A slatted fence: posts every ``post_spacing`` m, two rails, vertical slats on the road side.
 
-    The slats (``slat_width`` along the road, ``slat_gap`` apart, 2.5 cm thick) make its shadow striped.
+    The slats (``slat_width`` along the road, ``slat_gap`` apart, 2.5 cm thick) make its shadow striped. With
+    ``boards`` the slats lie horizontally instead (``slat_width`` high, ``slat_gap`` apart, from 0.1 m up to
+    ``height``): under a low sun from the fence's side each gap lets through a line of light parallel to the road.
 
     Returns:
         Mesh, world frame; 12 faces per slat.
@@ -301,6 +303,9 @@ def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1
     s_posts = _stations(s0, s1, post_spacing)
     posts = _boxes(line, s_posts, t, ground + (height + 0.1 - FOOTING_M) / 2, (0.1, 0.1, height + 0.1 + FOOTING_M),
                    color, name, "fence")
+    if boards:
+        boards_ = _boards(line, s0, s1, t + toward * 0.1125, ground, height, slat_width, slat_gap, toward, color)
+        return merge([posts, *boards_], name=name, kind="fence")
     rails = []
     for v in (0.3, height - 0.3):
         rail_v, rail_f = sweep(line, _stations(s0, s1, 2.0), t, ground, _rect_uv(0.05, 0.10, v - 0.045, v + 0.045),
@@ -311,6 +316,17 @@ def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1
     slats = _boxes(line, s_slats, t + toward * 0.1125, ground + (height + 0.05) / 2, (slat_width, 0.025, height - 0.05),
                    color, name, "fence")
     return merge([posts, *rails, slats], name=name, kind="fence")
+
+
+def _boards(line: ReferenceLine, s0: float, s1: float, t: float, ground: float, height: float, board: float,
+            gap: float, toward: float, color: Color) -> list[Mesh]:
+    """Horizontal boards ``board`` m high, ``gap`` m apart, 2.5 cm thick, the top one ending at ``height`` and the
+    lowest no lower than 0.1 m."""
+    stations = _stations(s0, s1, 2.0)
+    tops = np.arange(height, 0.1 + 1e-9, -(board + gap))
+    return [Mesh(*sweep(line, stations, t, ground, _rect_uv(-0.0125, 0.0125, max(top - board, 0.1), top), toward),
+                 np.asarray(color, np.float32))
+            for top in tops if top - 0.1 > 0.02]
 
 
 # ---------------------------------------------------------------------------------------------------------------
