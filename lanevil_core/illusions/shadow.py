@@ -248,7 +248,7 @@ class FenceShadowLevel(SunAheadLevel):
 
 @register
 class FenceShadow(SunShadowIllusion):
-    """A slatted fence beside the road whose low-sun shadow lays stripes across the lanes."""
+    """A board fence beside the road: its low-sun shadow shades the lanes, with lines of light along them."""
 
     # A board fence (horizontal boards with narrow gaps between them) under a low sun nearly square-on from its
     # side: the fence's shadow lies across the lanes and each gap lets through a line of light parallel to them, a
