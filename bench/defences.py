@@ -10,7 +10,8 @@ Usage::
     lanevil dataset --cases scenes/00_clean --out data/train2k --train-frames 2000 --size 640x360
     lanevil dataset --cases scenes --out data/bench --frames-per-case 10 --train-frames 0 --no-paint
     python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
-        [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd] [--seeds 0,1,2] [--jobs 2]
+        [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd] [--seeds 0,1,2] [--jobs 2] \\
+        [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3]
 
 Writes ``OUT/models/AUGMENT@SEED/``, ``OUT/pred/AUGMENT@SEED.json`` and ``OUT/report/`` (``compare.md`` holds the
 defence tables); prints each run's seconds and the report's path.
@@ -43,6 +44,8 @@ def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
     started = time.perf_counter()
     if not (model_dir / "model.onnx").is_file():
         extra = ["--max-steps", str(args.max_steps)] if args.max_steps else []
+        extra += ["--init", str(args.init)] if args.init else []
+        extra += ["--lr", str(args.lr)] if args.lr else []
         lanevil("train", "--data", str(args.data), "--out", str(model_dir), "--model", args.family,
                 "--epochs", str(args.epochs), "--augment", augment, "--seed", seed, "--threads", "1", "--quiet",
                 *extra)
@@ -63,6 +66,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", default="0,1,2")
     parser.add_argument("--jobs", type=int, default=2, help="runs at a time (each trains with one thread)")
     parser.add_argument("--max-steps", type=int, default=None, help="optimiser steps per epoch at most (smoke runs)")
+    parser.add_argument("--init", type=Path, default=None,
+                        help="every run fine-tunes from these weights (e.g. the shipped model's weights.pt) instead "
+                             "of training from scratch")
+    parser.add_argument("--lr", type=float, default=None, help="peak learning rate (default: lanevil train's)")
     args = parser.parse_args(argv)
     augments = [a for a in args.augments.split(",") if a]
     unknown = sorted(set(augments) - set(AUGMENTS))

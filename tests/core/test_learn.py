@@ -440,3 +440,34 @@ def test_affine_shift_keeps_each_lane_in_its_slot_beside_the_ego():
     moved = targets_for(record, (1280, 720), spec, False, shift)
     assert np.array_equal(plain.exist, moved.exist) and plain.exist[2] == plain.exist[3] == 1.0
     assert np.all(moved.rows[2][moved.rows[2] < spec.grid] > plain.rows[2][moved.rows[2] < spec.grid])
+
+
+@pytest.mark.slow
+def test_defence_bench_fine_tunes_every_run_from_the_given_weights(tiny_dataset, tmp_path):
+    import importlib.util
+    import sys
+
+    script = Path(__file__).resolve().parents[2] / "bench" / "defences.py"
+    spec = importlib.util.spec_from_file_location("defences_bench", script)
+    assert spec is not None and spec.loader is not None
+    defences = importlib.util.module_from_spec(spec)
+    sys.modules["defences_bench"] = defences
+    spec.loader.exec_module(defences)
+    cases = tmp_path / "cases" / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
+    cases.mkdir(parents=True)
+    for name in ("00_original.json", "01_level1.json"):
+        (cases / name).write_text((SCENES / "30_shadow" / "fence_shadow" / cases.name / name).read_text())
+    bench = tmp_path / "bench"
+    assert main(["dataset", "--cases", str(tmp_path / "cases"), "--out", str(bench), "--frames-per-case", "2",
+                 "--size", "256x144", "--workers", "1", "--quiet"]) == 0
+    init = shipped_model_dir("ufld") / "weights.pt"
+    out = tmp_path / "defences"
+    assert defences.main(["--data", str(tiny_dataset), "--bench", str(bench / "test"), "--out", str(out),
+                          "--family", "ufld", "--epochs", "1", "--max-steps", "1", "--augments", "none,cutout",
+                          "--seeds", "0", "--jobs", "1", "--init", str(init), "--lr", "1e-4"]) == 0
+    for name in ("none@0", "cutout@0"):
+        summary = json.loads((out / "models" / name / "training.json").read_text())
+        assert summary["init"] == init.name and summary["lr"] == pytest.approx(1e-4)
+        assert summary["augment"] == name.split("@")[0]
+        assert (out / "pred" / f"{name}.json").is_file()
+    assert "Defences" in (out / "report" / "compare.md").read_text()
