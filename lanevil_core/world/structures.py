@@ -290,11 +290,12 @@ def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1
     """A slatted fence: posts every ``post_spacing`` m, two rails, vertical slats on the road side.
 
     The slats (``slat_width`` along the road, ``slat_gap`` apart, 2.5 cm thick) make its shadow striped. With
-    ``boards`` the slats lie horizontally instead (``slat_width`` high, ``slat_gap`` apart, from 0.1 m up to
-    ``height``): under a low sun from the fence's side each gap lets through a line of light parallel to the road.
+    ``boards`` the slats lie horizontally instead and replace the rails (``slat_width`` high, ``slat_gap`` apart,
+    the top one ending at ``height``, see ``_boards``): under a low sun from the fence's side each gap lets
+    through a line of light parallel to the road.
 
     Returns:
-        Mesh, world frame; 12 faces per slat.
+        Mesh, world frame; 12 faces per vertical slat, a swept box per board.
     """
     _check_span(s0, s1)
     if slat_width <= 0 or slat_gap < 0 or height <= 0:
