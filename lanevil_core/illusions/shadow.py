@@ -289,18 +289,16 @@ class FenceShadow(SunShadowIllusion):
         sign = side_sign(self.side)
         s0, s1 = self.extent(ctx.drive, self.length)
         t_fence = roadside_t(piece, self.offset, sign)
-        self.apply_sun(ctx, s0, sign, altitude=self._altitude(ctx, t_fence, sign))
+        self.apply_sun(ctx, s0, sign, altitude=None if self.sun_altitude is not None else
+                       self._solved_altitude(ctx, t_fence, sign))
         for index, (a, b) in enumerate(clear_runs(s0, s1, t_fence, blocked(ctx, piece))):
             ctx.add_mesh(fence(piece.line, a, b, t_fence, level.height, level.board, level.gap,
                                ground=ground_height(piece, t_fence), color=self.color, boards=True,
                                name=f"fence {index + 1}"))
 
-    def _altitude(self, ctx: CompileContext, t_fence: float, sign: float) -> float:
-        """The override, or the sun altitude (degrees) at which the top of the level-5 fence's shadow falls
-        ``FENCE_EDGE_LANES`` ego lane widths past the lane's near line, within [MIN_FENCE_SUN_DEG, the table's
-        altitude]."""
-        if self.sun_altitude is not None:
-            return float(self.sun_altitude)
+    def _solved_altitude(self, ctx: CompileContext, t_fence: float, sign: float) -> float:
+        """The sun altitude (degrees) at which the top of the level-5 fence's shadow falls ``FENCE_EDGE_LANES`` ego
+        lane widths past the lane's near line, within [MIN_FENCE_SUN_DEG, the table's altitude]."""
         top = self.SEVERITY[-1]
         width = ctx.network.lane_width
         t_near = ctx.network.lane_center_t(ctx.drive.lane) + sign * width / 2

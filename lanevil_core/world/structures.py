@@ -324,10 +324,10 @@ def _boards(line: ReferenceLine, s0: float, s1: float, t: float, ground: float, 
     """Horizontal boards ``board`` m high, ``gap`` m apart, 2.5 cm thick, the top one ending at ``height`` and the
     lowest no lower than 0.1 m."""
     stations = _stations(s0, s1, 2.0)
-    tops = np.arange(height, 0.1 + 1e-9, -(board + gap))
+    tops = np.arange(height, 0.12, -(board + gap))  # a board under 2 cm high is left out
     return [Mesh(*sweep(line, stations, t, ground, _rect_uv(-0.0125, 0.0125, max(top - board, 0.1), top), toward),
                  np.asarray(color, np.float32))
-            for top in tops if top - 0.1 > 0.02]
+            for top in tops]
 
 
 # ---------------------------------------------------------------------------------------------------------------

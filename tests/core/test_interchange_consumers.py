@@ -4,7 +4,6 @@ byte-identical exports. The XML is read back here with its own small reader, not
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -239,22 +238,15 @@ def test_cyclists_and_pedestrians_face_as_placed(exports, name):
             assert abs(math.remainder(h - expected[private.get("entityRef")], 2 * math.pi)) < math.radians(1)
 
 
-def _carla_run():
-    spec = importlib.util.spec_from_file_location("carla_run", ROOT / "scripts" / "carla_run.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.mark.parametrize("name", TRAFFIC[:1] + JUNCTIONS[:1])
-def test_the_sun_agrees_with_the_case_and_the_carla_script(exports, name):
+def test_the_sun_agrees_with_the_case_and_the_carla_script(exports, name, load_script):
     _, root = exports[name]
     case = load_case(SCENES / name)
     sun = root.find(".//Environment/Weather/Sun")
     azimuth = math.degrees(float(sun.get("azimuth")))
     assert abs(math.remainder(math.radians(azimuth - (90.0 - case.sun.azimuth)), 2 * math.pi)) < math.radians(1)
-    assert abs(math.remainder(math.radians(azimuth - _carla_run().carla_sun_azimuth(case.sun.azimuth)),
-                              2 * math.pi)) < math.radians(1)
+    carla_azimuth = load_script("scripts/carla_run.py").carla_sun_azimuth(case.sun.azimuth)
+    assert abs(math.remainder(math.radians(azimuth - carla_azimuth), 2 * math.pi)) < math.radians(1)
     intensity = float(sun.get("intensity"))
     assert 0.0 <= intensity <= 1.0  # scenario_runner: cloudiness = 100 - 100 x intensity
     assert 100.0 - 100.0 * intensity == pytest.approx(case.weather.cloudiness)

@@ -6,7 +6,6 @@ shape (two ego lines per frame, one either side of the centre), never downloaded
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import sys
 from pathlib import Path
@@ -23,13 +22,8 @@ BENCH = Path(__file__).resolve().parents[2] / "bench"
 
 
 @pytest.fixture(scope="module")
-def real_footage():
-    spec = importlib.util.spec_from_file_location("real_footage", BENCH / "real_footage.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["real_footage"] = module
-    spec.loader.exec_module(module)
-    return module
+def real_footage(load_script):
+    return load_script("bench/real_footage.py")
 
 
 def straight(rows: list[int], bottom_x: float, slope: float, top: int) -> list[int]:
