@@ -11,7 +11,11 @@ Usage::
     lanevil dataset --cases scenes --out data/bench --frames-per-case 10 --train-frames 0 --no-paint
     python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
         [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd] [--seeds 0,1,2] [--jobs 2] \\
-        [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3]
+        [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3] [--patience 4] [--train-only]
+
+``--patience`` trains each run until its validation accuracy stops improving (``--epochs`` is then the most) and
+keeps the best epoch. ``--train-only`` stops after training: run the same command without it (on another machine,
+say, with the model folders copied over) to detect and report.
 
 Writes ``OUT/models/AUGMENT@SEED/``, ``OUT/pred/AUGMENT@SEED.json`` and ``OUT/report/`` (``compare.md`` holds the
 defence tables); prints each run's seconds and the report's path.
@@ -25,6 +29,8 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+from lanevil_core.detect.model_spec import FAMILIES
 
 AUGMENTS = ("none", "aam", "cutout", "copy_paste", "hsv", "mixup", "pgd")
 
@@ -46,10 +52,11 @@ def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
         extra = ["--max-steps", str(args.max_steps)] if args.max_steps else []
         extra += ["--init", str(args.init)] if args.init else []
         extra += ["--lr", str(args.lr)] if args.lr else []
+        extra += ["--patience", str(args.patience)] if args.patience else []
         lanevil("train", "--data", str(args.data), "--out", str(model_dir), "--model", args.family,
                 "--epochs", str(args.epochs), "--augment", augment, "--seed", seed, "--threads", "1", "--quiet",
                 *extra)
-    if not pred.is_file():
+    if not pred.is_file() and not args.train_only:
         pred.parent.mkdir(parents=True, exist_ok=True)
         lanevil("detect", str(args.bench), "--method", args.family, "--weights", str(model_dir), "--out", str(pred))
     return name, time.perf_counter() - started
@@ -58,9 +65,10 @@ def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", type=Path, required=True, help="a dataset folder with a clean train split")
-    parser.add_argument("--bench", type=Path, required=True, help="the benchmark's test split folder")
+    parser.add_argument("--bench", type=Path, default=None,
+                        help="the benchmark's test split folder (needed unless --train-only)")
     parser.add_argument("--out", type=Path, required=True)
-    parser.add_argument("--family", choices=("seg", "ufld"), default="seg")
+    parser.add_argument("--family", choices=FAMILIES, default="seg")
     parser.add_argument("--epochs", type=int, default=6)
     parser.add_argument("--augments", default=",".join(AUGMENTS))
     parser.add_argument("--seeds", default="0,1,2")
@@ -70,7 +78,12 @@ def main(argv: list[str] | None = None) -> int:
                         help="every run fine-tunes from these weights (e.g. the shipped model's weights.pt) instead "
                              "of training from scratch")
     parser.add_argument("--lr", type=float, default=None, help="peak learning rate (default: lanevil train's)")
+    parser.add_argument("--patience", type=int, default=None,
+                        help="train each run until validation accuracy has not improved for this many epochs")
+    parser.add_argument("--train-only", action="store_true", help="train every run, then stop (no detection)")
     args = parser.parse_args(argv)
+    if args.bench is None and not args.train_only:
+        parser.error("--bench: the test split to score on is needed (or --train-only)")
     augments = [a for a in args.augments.split(",") if a]
     unknown = sorted(set(augments) - set(AUGMENTS))
     if unknown or "none" not in augments:
@@ -80,6 +93,9 @@ def main(argv: list[str] | None = None) -> int:
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         for name, seconds in pool.map(lambda n: run_one(args, n), names):
             print(f"{name}: {seconds:.0f} s", flush=True)
+    if args.train_only:
+        print(f"models: {args.out / 'models'}")
+        return 0
     report = args.out / "report"
     pairs = [part for name in names for part in ("--pred", str(args.out / "pred" / f"{name}.json"), "--name", name)]
     lanevil("report", "--gt", str(args.bench), *pairs, "--baseline", "none", "--out", str(report))

@@ -24,7 +24,7 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--width", type=float, default=0.25,
                         help="backbone channel multiplier (1.0 = published ResNet widths; default 0.25)")
     parser.add_argument("--size", type=parse_size, default=(320, 180), help="network input WxH (default 320x180)")
-    parser.add_argument("--epochs", type=count(1), default=12, help="default 12")
+    parser.add_argument("--epochs", type=count(1), default=12, help="default 12 (the most, with --patience)")
     parser.add_argument("--batch", type=count(1), default=16, help="default 16")
     parser.add_argument("--lr", type=float, default=2e-3, help="peak learning rate of AdamW (default 2e-3)")
     parser.add_argument("--augment", choices=("none", "cutout", "mixup", "hsv", "copy_paste", "aam", "pgd"),
@@ -47,6 +47,9 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
                              "oversubscribed threads make training many times slower)")
     parser.add_argument("--resume", action="store_true", help="continue from MODEL_DIR/checkpoint.pt")
     parser.add_argument("--max-steps", type=count(1), default=None, help="batches per epoch at most (smoke runs)")
+    parser.add_argument("--patience", type=count(1), default=None,
+                        help="stop when validation accuracy has not improved for this many epochs and keep the best "
+                             "epoch's weights (full-length training; --epochs is then the most)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -70,7 +73,7 @@ def _run_train(args: argparse.Namespace) -> int:
                                  lr=args.lr, augment=args.augment, affine=args.affine, device=args.device,
                                  seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
-                                 max_steps=args.max_steps, threads=args.threads)
+                                 max_steps=args.max_steps, threads=args.threads, patience=args.patience)
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:
         raise UsageError(str(error)) from None
@@ -79,7 +82,9 @@ def _run_train(args: argparse.Namespace) -> int:
         return 130
     accuracy = summary["val_accuracy"]
     shown = "n/a" if accuracy is None else f"{100 * accuracy:.2f} %"
-    print(f"{args.out}: {summary['epochs']} epochs in {summary['seconds']:.0f} s, validation accuracy {shown}")
+    kept = f" (kept epoch {summary['kept_epoch']})" if summary["patience"] is not None else ""
+    print(f"{args.out}: {summary['epochs_run']} epochs in {summary['seconds']:.0f} s, "
+          f"validation accuracy {shown}{kept}")
     return 0
 
 

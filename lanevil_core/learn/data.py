@@ -117,6 +117,17 @@ class _Frames(Dataset):
         self.frame_sizes: list[tuple[int, int]] = []
         width, height = spec.input_size
         self.images: UInt8Array = np.zeros((0, height, width, 3), np.uint8)
+        # (index, flipped) -> targets: without --affine a frame's targets are one of two, so each is encoded once
+        self._targets: dict[tuple[int, bool], Targets] = {}
+
+    def targets(self, index: int, flip: bool, M_out_in: np.ndarray | None) -> Targets:
+        """The targets of frame ``index`` as drawn (encoding them is most of a sample's time)."""
+        if M_out_in is not None:
+            return targets_for(self.records[index], self.frame_sizes[index], self.spec, flip, M_out_in)
+        key = (index, flip)
+        if key not in self._targets:
+            self._targets[key] = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip)
+        return self._targets[key]
 
     def image(self, index: int) -> UInt8Array:
         return self.images[index]
@@ -139,7 +150,7 @@ class _Frames(Dataset):
                 image = warp_image(image, M_out_in)
             if flip:
                 image = np.ascontiguousarray(image[:, ::-1])
-        targets = targets_for(self.records[index], self.frame_sizes[index], self.spec, flip, M_out_in)
+        targets = self.targets(index, flip, M_out_in)
         return {"image": torch.from_numpy(network_input(image, self.spec.input_size)),
                 "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask),
                 "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index),

@@ -72,6 +72,9 @@ class TrainSettings:
     resume: bool = False
     init: Path | None = None
     max_steps: int | None = None  # stop each epoch after this many batches (tests and smoke runs)
+    # stop once validation accuracy has not improved for this many epochs, and keep the best epoch's weights
+    # (``epochs`` is then the most there can be; the learning-rate schedule still spans it)
+    patience: int | None = None
     aam: AamSettings = field(default_factory=AamSettings)
     pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
@@ -193,6 +196,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed,
                                affine=settings.affine)
     val_set = LabelledFrames(split_dir, spec, val_idx, train=False) if val_idx else None
+    if settings.patience is not None and val_set is None:
+        raise TrainError("--patience: no validation frames to watch (--val is 0 or the split has one case folder)")
 
     out = settings.out
     out.mkdir(parents=True, exist_ok=True)
@@ -209,6 +214,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     total_steps = steps_per_epoch * settings.epochs
     history: list[dict[str, Any]] = []
     start_epoch = 0
+    best: dict[str, Any] | None = None  # {"epoch", "model"} of the best validation accuracy (with --patience)
     checkpoint_path = out / CHECKPOINT_FILE
     if settings.resume and checkpoint_path.is_file():
         checkpoint = torch.load(checkpoint_path, map_location=device, weights_only=False)
@@ -219,6 +225,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         optimizer.load_state_dict(checkpoint["optimizer"])
         history = checkpoint["history"]
         start_epoch = checkpoint["epoch"] + 1
+        best = checkpoint.get("best")
     write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
 
     bank = aam_bank(settings, split_dir, records, data_sha) if settings.augment == "aam" else []
@@ -226,6 +233,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
 
     model.train()
     for epoch in range(start_epoch, settings.epochs):
+        if best is not None and settings.patience is not None and epoch + 1 - best["epoch"] > settings.patience:
+            break  # a resumed run that had already stopped
         if bank and epoch >= 1:  # the model's attention means something after one epoch
             scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
                                 [p.frame_size for p in bank], device)
@@ -265,9 +274,18 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         if show_progress:
             shown = "n/a" if val_accuracy is None else f"{100 * val_accuracy:.2f} %"
             print(f"epoch {epoch + 1}: loss {history[-1]['loss']:.4f}  val accuracy {shown}", flush=True)
+        if settings.patience is not None and val_accuracy is not None and (
+                best is None or val_accuracy > history[best["epoch"] - 1]["val_accuracy"]):
+            best = {"epoch": epoch + 1, "model": {k: v.detach().cpu().clone() for k, v in model.state_dict().items()}}
         _save({"model": model.state_dict(), "optimizer": optimizer.state_dict(), "epoch": epoch,
-               "history": history, "data_sha256": data_sha, "spec": asdict(spec)}, checkpoint_path)
+               "history": history, "data_sha256": data_sha, "spec": asdict(spec), "best": best}, checkpoint_path)
+        if best is not None and settings.patience is not None and epoch + 1 - best["epoch"] >= settings.patience:
+            if show_progress:
+                print(f"no gain for {settings.patience} epochs: keeping epoch {best['epoch']}", flush=True)
+            break
 
+    if best is not None:
+        model.load_state_dict(best["model"])
     model = model.cpu().eval()
     _save({k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}, out / WEIGHTS_FILE)
     export_onnx(model, out / ONNX_FILE)
@@ -289,7 +307,11 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "init": None if settings.init is None else settings.init.name,
         "seconds": round(float(sum(seconds)), 1),
         "seconds_per_epoch": round(float(np.median(seconds)), 1) if seconds else None,
-        "val_accuracy": history[-1]["val_accuracy"] if history else None,
+        "val_accuracy": (history[best["epoch"] - 1]["val_accuracy"] if best is not None
+                         else history[-1]["val_accuracy"] if history else None),
+        "patience": settings.patience,
+        "epochs_run": len(history),
+        "kept_epoch": best["epoch"] if best is not None else len(history),
         "history": history,
         "torch": torch.__version__,
     }

@@ -143,6 +143,37 @@ def test_same_seed_same_weights_and_resume_continues(tiny_dataset, tmp_path):
     assert [h["epoch"] for h in history] == [1, 2]
 
 
+def test_patience_stops_when_validation_stops_improving_and_keeps_the_best_epoch(tiny_dataset, tmp_path):
+    patience, most = 2, 8
+    assert _train(tiny_dataset, tmp_path, "seg", "--epochs", str(most), "--patience", str(patience),
+                  "--lr", "3e-3") == 0
+    summary = json.loads((tmp_path / "training.json").read_text())
+    accuracies = [h["val_accuracy"] for h in summary["history"]]
+    kept = int(np.argmax(accuracies)) + 1  # the first of the best
+    assert summary["kept_epoch"] == kept and summary["val_accuracy"] == accuracies[kept - 1]
+    assert summary["epochs_run"] == len(accuracies) == min(most, kept + patience)
+    best = torch.load(tmp_path / "checkpoint.pt", weights_only=False)["best"]
+    weights = torch.load(tmp_path / "weights.pt", weights_only=False)
+    assert best["epoch"] == kept
+    assert all(torch.equal(weights[k], v.half() if v.is_floating_point() else v) for k, v in best["model"].items())
+
+
+def test_training_samples_reuse_their_targets_and_match_a_fresh_encoding(tiny_dataset):
+    from lanevil_core.learn.data import LabelledFrames, targets_for
+
+    spec = ModelSpec(family="laneatt", **TINY_SPEC)
+    frames = LabelledFrames(tiny_dataset / "train", spec, train=True, seed=1)
+    for epoch in (0, 1, 2):
+        frames.epoch = epoch
+        for index in range(len(frames)):
+            sample = frames[index]
+            flip = bool(np.random.default_rng([1, epoch, index]).random() < 0.5)
+            fresh = targets_for(frames.records[index], frames.frame_sizes[index], spec, flip)
+            assert np.array_equal(sample["rows"].numpy(), fresh.rows)
+            assert np.array_equal(sample["anchor_regs"].numpy(), fresh.extra["anchor_regs"])
+    assert len(frames._targets) <= 2 * len(frames)
+
+
 def test_init_copies_a_trained_model_heads_included_or_a_backbone(tmp_path):
     from lanevil_core.learn.backbone import load_init
     from lanevil_core.learn.models import build_model
@@ -454,9 +485,11 @@ def test_defence_bench_fine_tunes_every_run_from_the_given_weights(tiny_dataset,
                  "--size", "256x144", "--workers", "1", "--quiet"]) == 0
     init = shipped_model_dir("ufld") / "weights.pt"
     out = tmp_path / "defences"
-    assert defences.main(["--data", str(tiny_dataset), "--bench", str(bench / "test"), "--out", str(out),
-                          "--family", "ufld", "--epochs", "1", "--max-steps", "1", "--augments", "none,cutout",
-                          "--seeds", "0", "--jobs", "1", "--init", str(init), "--lr", "1e-4"]) == 0
+    runs = ["--data", str(tiny_dataset), "--out", str(out), "--family", "ufld", "--epochs", "1", "--max-steps", "1",
+            "--augments", "none,cutout", "--seeds", "0", "--jobs", "1", "--init", str(init), "--lr", "1e-4"]
+    assert defences.main([*runs, "--train-only"]) == 0  # e.g. on a GPU machine; then detect where the data is
+    assert (out / "models" / "cutout@0" / "model.onnx").is_file() and not (out / "pred").exists()
+    assert defences.main([*runs, "--bench", str(bench / "test")]) == 0
     for name in ("none@0", "cutout@0"):
         summary = json.loads((out / "models" / name / "training.json").read_text())
         assert summary["init"] == init.name and summary["lr"] == pytest.approx(1e-4)
