@@ -13,6 +13,9 @@ LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 FOOTPRINT_TAPS = 4  # most shadow lookups along each side of a pixel's footprint (photographed frames)
+# Texels between two footprint taps at most: each tap's soft edge already reads a window over 2 texels wide
+# (``_visibility_at``'s radius is at least 0.7 texel), so a footprint under 2 texels needs one tap.
+FOOTPRINT_TAP_TEXELS = 2.0
 # Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
 NEAR_AROUND, FAR_AROUND = range(2)
 
@@ -213,7 +216,7 @@ def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, n
     the surface; zero steps read the point alone, as ``sun_visibility`` does).
 
     ``offset`` (m, along the normal) and ``bias_texels`` are the face's ``face_sun_terms``. Each side is read
-    once per shadow-map texel of its length on the surface, at most FOOTPRINT_TAPS, all in the cascade that holds
+    once per FOOTPRINT_TAP_TEXELS of its length on the surface, at most FOOTPRINT_TAPS, all in the cascade that holds
     p: shadows finer than a pixel (a slatted fence's far off) average to their share of shade instead of beating
     with the pixel grid (moire). When the coarse cells under the whole footprint agree, no tap is read.
     """
@@ -223,8 +226,9 @@ def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, n
     lit = 1.0
     if c < maps.shape[0]:
         bias = bias_texels / scale
-        n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * scale) + 1, FOOTPRINT_TAPS)
-        n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * scale) + 1, FOOTPRINT_TAPS)
+        per_tap = scale / FOOTPRINT_TAP_TEXELS
+        n_u = min(int(np.sqrt(du[0] * du[0] + du[1] * du[1] + du[2] * du[2]) * per_tap) + 1, FOOTPRINT_TAPS)
+        n_v = min(int(np.sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) * per_tap) + 1, FOOTPRINT_TAPS)
         lo, hi = 2.0, size - 2.0
         ux = uy = ud = vx = vy = vd = 0.0  # the footprint's sides in the map (texels) and in light depth (m)
         lit = -1.0

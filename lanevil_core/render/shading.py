@@ -25,6 +25,7 @@ from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
 from .lighting import (
+    FOOTPRINT_TAP_TEXELS,
     SUN_BIAS,
     SUN_OFFSET,
     SUN_SCALE,
@@ -555,8 +556,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if sun_i > 0.0 and n_dot_l > 0.0:
             # The ideal render reads the point; a photograph filters over the pixel's footprint, unless no side of
-            # it can reach a texel of the finest cascade (|du| <= depth / fx * (1 + 1 / n.v), |dv| likewise).
-            if detail > 0.0 and depth * max(1.0 / fx, 1.0 / fy) * (1.0 + 1.0 / max(n_dot_v, 1e-4)) * finest >= 1.0:
+            # it can reach a second tap in the finest cascade (|du| <= depth / fx * (1 + 1 / n.v), |dv| likewise,
+            # under FOOTPRINT_TAP_TEXELS texels): one lookup is then its filter.
+            if detail > 0.0 and depth * max(1.0 / fx, 1.0 / fy) * (1.0 + 1.0 / max(n_dot_v, 1e-4)) * finest >= \
+                    FOOTPRINT_TAP_TEXELS:
                 du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
                 vis = sun_visibility_over(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS],
                                           maps, cells, shadow_params, R_light, penumbra, du, dv)
