@@ -174,6 +174,11 @@ def test_training_samples_reuse_their_targets_and_match_a_fresh_encoding(tiny_da
     assert len(frames._targets) <= 2 * len(frames)
 
 
+def test_patience_without_validation_frames_exits_2(tiny_dataset, tmp_path, capsys):
+    assert _train(tiny_dataset, tmp_path, "seg", "--val", "0", "--patience", "2") == 2
+    assert "--patience" in capsys.readouterr().err
+
+
 def test_init_copies_a_trained_model_heads_included_or_a_backbone(tmp_path):
     from lanevil_core.learn.backbone import load_init
     from lanevil_core.learn.models import build_model
