@@ -139,6 +139,11 @@ def _lr_at(step: int, total: int, base: float) -> float:
 Progress = Callable[[str], None]
 
 
+def _patience_spent(best: dict[str, Any] | None, epochs_done: int, patience: int | None) -> bool:
+    """Whether ``patience`` epochs have passed without gain since the best one (``--patience``)."""
+    return best is not None and patience is not None and epochs_done - best["epoch"] >= patience
+
+
 def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, Any]], data_sha: str) -> list:
     """The AAM bank of this run (rendered once, kept in the model folder for ``--resume``)."""
     path = settings.out / AAM_BANK_FILE
@@ -233,7 +238,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
 
     model.train()
     for epoch in range(start_epoch, settings.epochs):
-        if best is not None and settings.patience is not None and epoch + 1 - best["epoch"] > settings.patience:
+        if _patience_spent(best, epoch, settings.patience):
             break  # a resumed run that had already stopped
         if bank and epoch >= 1:  # the model's attention means something after one epoch
             scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
@@ -279,9 +284,9 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
             best = {"epoch": epoch + 1, "model": {k: v.detach().cpu().clone() for k, v in model.state_dict().items()}}
         _save({"model": model.state_dict(), "optimizer": optimizer.state_dict(), "epoch": epoch,
                "history": history, "data_sha256": data_sha, "spec": asdict(spec), "best": best}, checkpoint_path)
-        if best is not None and settings.patience is not None and epoch + 1 - best["epoch"] >= settings.patience:
+        if _patience_spent(best, epoch + 1, settings.patience):
             if show_progress:
-                print(f"no gain for {settings.patience} epochs: keeping epoch {best['epoch']}", flush=True)
+                print(f"no gain for {settings.patience} epochs: keeping the best epoch", flush=True)
             break
 
     if best is not None:
