@@ -2,16 +2,20 @@
 turns linear radiance into sRGB bytes (exposure, vignetting, white balance, shot and read noise, clipping,
 saturation, the filmic curve). The numbers come from ``camera.sensor.development``; noise is a counter-based hash
 of (seed, pixel) that picks each channel's draw from a fixed table of normal deviates, so it is the same for any
-thread count and any run."""
+thread count and any run. Through a plain pinhole the sensor kernel also blurs and antialiases object edges as it
+reads each pixel, so the frame's radiance is read once and never copied."""
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
+from ..typed import Float32Array
 from ._jit import kernel
 from .bands import band_rows, run_bands
+from .post import edge_blend, row_edges
 
 
 @kernel(inline="always")
@@ -28,74 +32,52 @@ NOISE_TABLE_BITS = 12
 NOISE_TABLE = np.random.default_rng(0x5E45).standard_normal(1 << NOISE_TABLE_BITS)
 
 
-@kernel
-def _develop_rows(hdr: np.ndarray, gain: float, channel_gain: np.ndarray, vignetting: float, cx: float, cy: float,
-                  shot: float, read: float, saturation: float, seed: np.uint64, lut: np.ndarray, normals: np.ndarray,
-                  out: np.ndarray, band: int, bands: int) -> None:
-    height, width, _ = hdr.shape
-    top = lut.size - 1
-    inv_r2 = 1.0 / (cx * cx + cy * cy)
-    g0, g1, g2 = channel_gain[0], channel_gain[1], channel_gain[2]
-    read2 = read * read
-    mask = np.uint64(normals.size - 1)
-    bits = np.uint64(NOISE_TABLE_BITS)
-    for row in band_rows(height, band, bands):
-        dy = row + 0.5 - cy
-        for col in range(width):
-            dx = col + 0.5 - cx
-            r2 = (dx * dx + dy * dy) * inv_r2
-            fall = gain * (1.0 - vignetting * r2 * (1.2 - 0.2 * r2))
-            h = _hash(seed + np.uint64(row * width + col) * np.uint64(0x9E3779B97F4A7C15))
-            x0 = max(hdr[row, col, 0] * fall * g0, 0.0)
-            x1 = max(hdr[row, col, 1] * fall * g1, 0.0)
-            x2 = max(hdr[row, col, 2] * fall * g2, 0.0)
-            x0 = min(max(x0 + math.sqrt(x0 * shot + read2) * normals[h & mask], 0.0), 1.0)
-            x1 = min(max(x1 + math.sqrt(x1 * shot + read2) * normals[(h >> bits) & mask], 0.0), 1.0)
-            x2 = min(max(x2 + math.sqrt(x2 * shot + read2) * normals[(h >> (bits + bits)) & mask], 0.0), 1.0)
-            y = 0.2126 * x0 + 0.7152 * x1 + 0.0722 * x2
-            v = min(max(y + saturation * (x0 - y), 0.0), 1.0)
-            out[row, col, 0] = lut[int(v * top + 0.5)]
-            v = min(max(y + saturation * (x1 - y), 0.0), 1.0)
-            out[row, col, 1] = lut[int(v * top + 0.5)]
-            v = min(max(y + saturation * (x2 - y), 0.0), 1.0)
-            out[row, col, 2] = lut[int(v * top + 0.5)]
+class Streaks(NamedTuple):
+    """Motion blur of a pinhole image while the camera moves ``travel`` m along its optical axis: the image's depth
+    (H, W) and its principal point (px). ``travel`` 0: none."""
+
+    depth: Float32Array
+    cx: float
+    cy: float
+    travel: float
 
 
-def develop(hdr: np.ndarray, gain: float, channel_gain: np.ndarray, vignetting: float, center: tuple[float, float],
-            shot: float, read: float, saturation: float, seed: int, lut: np.ndarray, out: np.ndarray,
-            threads: int = 1) -> None:
-    """(H, W, 3) float32 linear radiance to sRGB bytes in ``out`` (H, W, 3) uint8; ``center`` is the optical
-    centre (px) the vignetting falls off from."""
-    hdr = np.ascontiguousarray(hdr)
-    cg = np.asarray(channel_gain, np.float64)
-    run_bands(lambda band, bands: _develop_rows(hdr, gain, cg, vignetting, center[0], center[1], shot, read,
-                                                saturation, np.uint64(seed), lut, NOISE_TABLE, out, band, bands),
-              threads)
+NO_STREAKS = Streaks(np.full((1, 1), np.inf, np.float32), 0.0, 0.0, 0.0)
+MIN_STREAK_PX = 0.75  # pixels whose streak is shorter stay sharp
+MAX_STREAK_TAPS = 24
 
 
-@kernel
-def _motion_blur_rows(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, travel: float, out: np.ndarray,
-                      band: int, bands: int) -> None:
-    """Blurs into ``out`` (a copy of ``src``) the pixels whose streak is at least 0.75 px long."""
+@kernel(inline="always")
+def _streak(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, travel: float, row: int,
+            col: int) -> tuple[np.float32, np.float32, np.float32, bool]:
+    """(r, g, b, blurred): the mean of ``src`` along the pixel's streak, when it is at least MIN_STREAK_PX long.
+
+    Over the exposure the camera moves ``travel`` m forward: a point at depth z slides away from the centre of
+    expansion by (p - c) * travel / (z - travel); the streak is centred on the mid-exposure point."""
     height, width, _ = src.shape
-    for row in band_rows(height, band, bands):
-        py = row + 0.5 - cy
-        for col in range(width):
-            z = depth[row, col]
-            if not z < np.inf or z <= travel * 2.0:
-                continue
-            # Over the exposure the camera moves ``travel`` m forward: the pixel slides away from the centre of
-            # expansion by (p - c) * travel / (z - travel); average the streak centred on the mid-exposure point.
-            k = travel / (z - travel)
-            fx = (col + 0.5 - cx) * k
-            fy = py * k
-            length2 = fx * fx + fy * fy
-            if length2 < 0.5625:
-                continue
-            taps = min(int(math.sqrt(length2)) + 2, 24)
-            step_x, step_y = fx / (taps - 1), fy / (taps - 1)
-            x, y = col + 0.5 - 0.5 * fx, row + 0.5 - 0.5 * fy
-            a0 = a1 = a2 = 0.0
+    z = depth[row, col]
+    taps = 0
+    fx = fy = 0.0
+    if travel > 0.0 and z < np.inf and z > travel * 2.0:
+        k = travel / (z - travel)
+        fx = (col + 0.5 - cx) * k
+        fy = (row + 0.5 - cy) * k
+        length2 = fx * fx + fy * fy
+        if length2 >= MIN_STREAK_PX * MIN_STREAK_PX:
+            taps = min(int(math.sqrt(length2)) + 2, MAX_STREAK_TAPS)
+    a0 = a1 = a2 = np.float32(0.0)  # the image's own precision: no conversion per tap
+    if taps > 0:
+        step_x, step_y = fx / (taps - 1), fy / (taps - 1)
+        x, y = col + 0.5 - 0.5 * fx, row + 0.5 - 0.5 * fy
+        if min(x, x + fx) >= 0.0 and max(x, x + fx) < width and min(y, y + fy) >= 0.0 and max(y, y + fy) < height:
+            for _ in range(taps):  # the whole streak is inside the image (most are): no clamping
+                sc, sr = int(x), int(y)
+                a0 += src[sr, sc, 0]
+                a1 += src[sr, sc, 1]
+                a2 += src[sr, sc, 2]
+                x += step_x
+                y += step_y
+        else:
             for _ in range(taps):
                 sc = min(max(int(x), 0), width - 1)
                 sr = min(max(int(y), 0), height - 1)
@@ -104,16 +86,106 @@ def _motion_blur_rows(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, 
                 a2 += src[sr, sc, 2]
                 x += step_x
                 y += step_y
-            out[row, col, 0] = a0 / taps
-            out[row, col, 1] = a1 / taps
-            out[row, col, 2] = a2 / taps
+        inv = np.float32(1.0 / taps)
+        a0, a1, a2 = a0 * inv, a1 * inv, a2 * inv
+    # One exit, on a use of both arrays, so numba releases them in one place (see ``_jit``).
+    return (a0, a1, a2, taps > 0) if src.shape[0] == depth.shape[0] else (a0, a1, a2, taps > 0)
+
+
+@kernel
+def _motion_blur_rows(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, travel: float, out: np.ndarray,
+                      band: int, bands: int) -> None:
+    """The rows of one band of ``out``: each pixel's streak mean, or its own value when the streak is shorter
+    than MIN_STREAK_PX."""
+    height, width, _ = src.shape
+    for row in band_rows(height, band, bands):
+        for col in range(width):
+            r, g, b, blurred = _streak(src, depth, cx, cy, travel, row, col)
+            out[row, col, 0] = r if blurred else src[row, col, 0]
+            out[row, col, 1] = g if blurred else src[row, col, 1]
+            out[row, col, 2] = b if blurred else src[row, col, 2]
 
 
 def motion_blur(hdr: np.ndarray, depth: np.ndarray, center: tuple[float, float], travel: float,
                 threads: int = 1) -> np.ndarray:
     """(H, W, 3) float32 radiance blurred along each pixel's image motion while the camera moves ``travel`` m
     along its optical axis (a pinhole image; ``center`` is its principal point). Sky pixels stay sharp."""
-    out = hdr.copy()
+    out = np.empty_like(hdr)
     run_bands(lambda band, bands: _motion_blur_rows(hdr, depth, center[0], center[1], travel, out, band, bands),
               threads)
     return out
+
+
+@kernel
+def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: float, channel_gain: np.ndarray,
+                  vignetting: float, cx: float, cy: float, shot: float, read: float, saturation: float,
+                  seed: np.uint64, lut: np.ndarray, normals: np.ndarray, out: np.ndarray, band: int,
+                  bands: int) -> None:
+    """Develops the rows of one band in three sweeps of a row: each pixel's radiance (its streak's mean, else
+    blended with its neighbours on an object edge, else its own); the sensor's arithmetic on whole vectors of
+    pixels; the tone curve's table reads."""
+    height, width, _ = hdr.shape
+    depth, blur_cx, blur_cy, travel = streaks
+    top = lut.size - 1
+    inv_r2 = 1.0 / (cx * cx + cy * cy)
+    g0, g1, g2 = channel_gain[0], channel_gain[1], channel_gain[2]
+    read2 = read * read
+    mask = np.uint64(normals.size - 1)
+    bits = np.uint64(NOISE_TABLE_BITS)
+    radiance = np.empty(width * 3, np.float64)
+    noise = np.empty(width * 3, np.float64)
+    index = np.empty(width * 3, np.uint16)  # unsigned: the table reads need no check for negative indices
+    on_edge = np.zeros(width, np.bool_)
+    for row in band_rows(height, band, bands):
+        if ids.shape[0] == height:
+            row_edges(ids, row, on_edge)
+        for col in range(width):
+            r, g, b, blurred = _streak(hdr, depth, blur_cx, blur_cy, travel, row, col)
+            if not blurred:
+                if on_edge[col]:
+                    r, g, b = edge_blend(hdr, row, col, 0), edge_blend(hdr, row, col, 1), \
+                        edge_blend(hdr, row, col, 2)
+                else:
+                    r, g, b = hdr[row, col, 0], hdr[row, col, 1], hdr[row, col, 2]
+            radiance[3 * col] = r
+            radiance[3 * col + 1] = g
+            radiance[3 * col + 2] = b
+        pixel = np.uint64(row * width)
+        for col in range(width):  # three table reads per pixel from one hash
+            h = _hash(seed + (pixel + np.uint64(col)) * np.uint64(0x9E3779B97F4A7C15))
+            noise[3 * col] = normals[h & mask]
+            noise[3 * col + 1] = normals[(h >> bits) & mask]
+            noise[3 * col + 2] = normals[(h >> (bits + bits)) & mask]
+        dy = row + 0.5 - cy
+        for col in range(width):  # arithmetic only: it runs on whole vectors of pixels
+            dx = col + 0.5 - cx
+            r2 = (dx * dx + dy * dy) * inv_r2
+            fall = gain * (1.0 - vignetting * r2 * (1.2 - 0.2 * r2))
+            x0 = max(radiance[3 * col] * fall * g0, 0.0)
+            x1 = max(radiance[3 * col + 1] * fall * g1, 0.0)
+            x2 = max(radiance[3 * col + 2] * fall * g2, 0.0)
+            x0 = min(max(x0 + math.sqrt(x0 * shot + read2) * noise[3 * col], 0.0), 1.0)
+            x1 = min(max(x1 + math.sqrt(x1 * shot + read2) * noise[3 * col + 1], 0.0), 1.0)
+            x2 = min(max(x2 + math.sqrt(x2 * shot + read2) * noise[3 * col + 2], 0.0), 1.0)
+            y = 0.2126 * x0 + 0.7152 * x1 + 0.0722 * x2
+            index[3 * col] = np.uint16(min(max(y + saturation * (x0 - y), 0.0), 1.0) * top + 0.5)
+            index[3 * col + 1] = np.uint16(min(max(y + saturation * (x1 - y), 0.0), 1.0) * top + 0.5)
+            index[3 * col + 2] = np.uint16(min(max(y + saturation * (x2 - y), 0.0), 1.0) * top + 0.5)
+        encoded = out[row].reshape(width * 3)
+        for k in range(width * 3):
+            encoded[k] = lut[index[k]]
+
+
+def develop(hdr: np.ndarray, gain: float, channel_gain: np.ndarray, vignetting: float, center: tuple[float, float],
+            shot: float, read: float, saturation: float, seed: int, lut: np.ndarray, out: np.ndarray,
+            threads: int = 1, ids: np.ndarray | None = None, streaks: Streaks = NO_STREAKS) -> None:
+    """(H, W, 3) float32 linear radiance to sRGB bytes in ``out`` (H, W, 3) uint8; ``center`` is the optical
+    centre (px) the vignetting falls off from. With the object ids ``ids`` (H, W), pixels on an object's edge are
+    first blended with their neighbours (as ``post.finish`` does); with ``streaks``, pixels are first blurred
+    along their motion (``motion_blur`` in the same pass)."""
+    hdr = np.ascontiguousarray(hdr)
+    cg = np.asarray(channel_gain, np.float64)
+    id_map = np.zeros((0, 0), np.int32) if ids is None else ids
+    run_bands(lambda band, bands: _develop_rows(hdr, id_map, streaks, gain, cg, vignetting, center[0], center[1],
+                                                shot, read, saturation, np.uint64(seed), lut, NOISE_TABLE, out,
+                                                band, bands), threads)

@@ -13,9 +13,11 @@ LOBE_FLOOR = 1e-3
 PCF_MAX_TEXELS = 6.0  # widest soft edge, in texels of the cascade (the coarse test must cover it)
 COARSE_SHIFT = 3  # shadow-map texels per coarse cell = 2 ** COARSE_SHIFT
 FOOTPRINT_TAPS = 4  # most shadow lookups along each side of a pixel's footprint (photographed frames)
-# Texels between two footprint taps at most: each tap's soft edge already reads a window over 2 texels wide
-# (``_visibility_at``'s radius is at least 0.7 texel), so a footprint under 2 texels needs one tap.
-FOOTPRINT_TAP_TEXELS = 2.0
+# Texels between two footprint taps at most: each tap is itself a soft lookup over a window at least 2.4 texels wide
+# (``_visibility_at``'s radius is at least 0.7 texel, its bilinear taps reach half a texel further), so a
+# footprint under 3 texels needs one tap; against taps every half texel (docs/performance.md) frames differ by
+# 0.005-0.04 levels on average.
+FOOTPRINT_TAP_TEXELS = 3.0
 # Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
 NEAR_AROUND, FAR_AROUND = range(2)
 

@@ -37,7 +37,7 @@ def _differs(ids: np.ndarray, row: int, col: int, above: int, below: int, left: 
 
 
 @kernel(inline="always")
-def _edges(ids: np.ndarray, row: int, on_edge: np.ndarray) -> None:
+def row_edges(ids: np.ndarray, row: int, on_edge: np.ndarray) -> None:
     """Per column of ``row``: whether the pixel's object id differs from one of its 4-neighbours' (a neighbour
     off the image is the pixel itself). Branch-free inside the row, so that loop runs on whole vectors of columns."""
     height, width = ids.shape
@@ -49,7 +49,7 @@ def _edges(ids: np.ndarray, row: int, on_edge: np.ndarray) -> None:
 
 
 @kernel(inline="always")
-def _edge_blend(hdr: np.ndarray, row: int, col: int, c: int) -> float:
+def edge_blend(hdr: np.ndarray, row: int, col: int, c: int) -> float:
     """Half the pixel's clamped radiance plus half its 4-neighbourhood's mean."""
     height, width, _ = hdr.shape
     acc = 0.0
@@ -86,11 +86,11 @@ def _finish_rows(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndar
         encoded = out[row].reshape(width * 3)
         for k in range(width * 3):
             encoded[k] = lut[index[k]]
-        _edges(ids, row, on_edge)
+        row_edges(ids, row, on_edge)
         for col in range(width):
             if on_edge[col]:
                 for c in range(3):
-                    out[row, col, c] = lut[_lut_index(_edge_blend(hdr, row, col, c) * exposure, inv_w2, top)]
+                    out[row, col, c] = lut[_lut_index(edge_blend(hdr, row, col, c) * exposure, inv_w2, top)]
 
 
 def finish(hdr: np.ndarray, ids: np.ndarray, exposure: float, lut: np.ndarray, out: np.ndarray,
@@ -141,23 +141,3 @@ def blur_columns(img: np.ndarray, depth: np.ndarray, radius: int, threads: int =
     """Box-blur a mirror image along columns in place (wet roads smear reflections vertically); the bands of
     ``threads`` split the columns."""
     run_bands(lambda band, bands: _blur_column_band(img, depth, radius, band, bands), threads)
-
-
-@kernel
-def _blend_edge_rows(hdr: np.ndarray, ids: np.ndarray, out: np.ndarray, band: int, bands: int) -> None:
-    height, width, _ = hdr.shape
-    on_edge = np.empty(width, np.bool_)
-    for row in band_rows(height, band, bands):
-        _edges(ids, row, on_edge)
-        for col in range(width):
-            for c in range(3):
-                out[row, col, c] = _edge_blend(hdr, row, col, c) if on_edge[col] else hdr[row, col, c]
-
-
-def blend_edges(hdr: np.ndarray, ids: np.ndarray, threads: int = 1) -> np.ndarray:
-    """(H, W, 3) float32 radiance with the pixels on an object-id boundary blended with their 4-neighbourhood, as
-    ``finish`` does before its tone curve (for the camera pipeline, which develops the radiance itself)."""
-    hdr = np.ascontiguousarray(hdr)
-    out = np.empty_like(hdr)
-    run_bands(lambda band, bands: _blend_edge_rows(hdr, ids, out, band, bands), threads)
-    return out

@@ -18,10 +18,10 @@ from ..typed import Float32Array, IntArray, UInt8Array
 from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
-from .develop import develop, motion_blur
+from .develop import NO_STREAKS, Streaks, develop, motion_blur
 from .lighting import face_sun_terms
 from .packed import PackedScene, pack_scene
-from .post import SRGB_LUT, blend_edges, blur_columns, finish
+from .post import SRGB_LUT, blur_columns, finish
 from .raster import per_pixel, rasterize_perspective
 from .shading import (
     Geometry,
@@ -252,9 +252,16 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
     render_camera = camera if camera.pinhole else cover_camera(camera)
     hdr, depth, object_id = _radiance(scene, render_camera, threads, lap)
     travel = scene.ego.speed * sensor.shutter if sensor is not None else 0.0
+    rk = render_camera.intrinsics
+    streaks = NO_STREAKS
     if travel > 0.0:
-        rk = render_camera.intrinsics
-        hdr = motion_blur(hdr, depth, (rk.cx, rk.cy), travel, threads)
+        # Through a plain pinhole without a bonnet the sensor blurs as it develops, in one pass; otherwise the
+        # streaks are those of the pinhole image, before the lens resamples it and the bonnet (which moves with
+        # the camera) covers it.
+        if camera.pinhole and mount.bonnet is None:
+            streaks = Streaks(depth, rk.cx, rk.cy, travel)
+        else:
+            hdr = motion_blur(hdr, depth, (rk.cx, rk.cy), travel, threads)
     if not camera.pinhole:
         map_u, map_v = cover_maps(camera)
         hdr = np.asarray(cv2.remap(hdr, map_u, map_v, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE), np.float32)
@@ -274,10 +281,9 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
     if sensor is None:
         finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
     else:
-        hdr = blend_edges(hdr, object_id, threads)
         dev = development(hdr, sensor)
         develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
-                sensor.saturation, _noise_seed(scene.case.seed, frame), dev.lut, rgb, threads)
+                sensor.saturation, _noise_seed(scene.case.seed, frame), dev.lut, rgb, threads, object_id, streaks)
         if sensor.sharpen > 0.0:
             soft = cv2.GaussianBlur(rgb, (0, 0), 1.0)
             rgb = np.asarray(cv2.addWeighted(rgb, 1.0 + sensor.sharpen, soft, -sensor.sharpen, 0.0), np.uint8)

@@ -253,3 +253,66 @@ def test_a_lens_that_turns_back_inside_the_image_is_refused_and_drawn_lenses_cov
         camera = Camera.model_validate(random_camera(np.random.default_rng([7, index])))
         cover = cover_camera(mounted_camera(camera, np.eye(4), (320, 180))).intrinsics
         assert cover.width * cover.height < 4 * 320 * 180
+
+
+def _ramp_scene(height: int = 120, width: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """Radiance with sharp vertical stripes and a road-like depth that falls towards the bottom rows (sky above)."""
+    rng = np.random.default_rng(3)
+    hdr = np.repeat(rng.uniform(0.05, 0.6, (1, width, 3)), height, axis=0).astype(np.float32)
+    rows = np.arange(height)[:, None] + 0.5 - height / 2
+    depth = np.where(rows > 2, 1.5 * (width / 2) / np.maximum(rows, 1e-3), np.inf) * np.ones((1, width))
+    return hdr, depth.astype(np.float32)
+
+
+def test_motion_blur_streaks_grow_towards_the_frame_edges_and_leave_the_sky_sharp() -> None:
+    from lanevil_core.render.develop import motion_blur
+
+    hdr, depth = _ramp_scene()
+    center = (100.0, 60.0)
+    blurred = motion_blur(hdr, depth, center, travel=0.05)
+    changed = np.abs(blurred - hdr).max(axis=-1) > 1e-6
+    assert not changed[:60].any()  # the sky and the rows near the horizon stay sharp
+    assert changed[-1].sum() > changed[100].sum() > 0  # nearer (lower) rows streak more
+    # The streaks point away from the principal point: near its column, vertical stripes blur less.
+    assert changed[-1, :40].mean() > changed[-1, 95:105].mean()
+    assert np.array_equal(motion_blur(hdr, depth, center, travel=0.0), hdr)
+    longer = motion_blur(hdr, depth, center, travel=0.1)
+    assert (np.abs(longer - hdr).max(axis=-1) > 1e-6).sum() > changed.sum()
+
+
+def test_developing_with_streaks_is_blurring_then_developing() -> None:
+    """The one-pass path (blur as the sensor reads a pixel) gives the bytes of the two-pass one, and object ids
+    that never change leave the frame as it was (no edge to blend); any thread count, same bytes."""
+    from lanevil_core.camera.sensor import tone_lut
+    from lanevil_core.render.develop import Streaks, develop, motion_blur
+
+    hdr, depth = _ramp_scene()
+    center, travel = (100.0, 60.0), 0.05
+    lut = tone_lut(1.0)
+    args = (1.5, np.array([1.1, 1.0, 0.9]), 0.3, center, 2e-3, 5e-3, 1.2, 17, lut)
+    two_pass = np.empty(hdr.shape, np.uint8)
+    develop(motion_blur(hdr, depth, center, travel), *args, two_pass)
+    one_pass = np.empty_like(two_pass)
+    develop(hdr, *args, one_pass, 2, np.zeros(depth.shape, np.int32), Streaks(depth, *center, travel))
+    assert np.array_equal(one_pass, two_pass)
+    plain = np.empty_like(two_pass)
+    develop(hdr, *args, plain)
+    assert not np.array_equal(plain, two_pass)
+
+
+def test_developing_blends_object_edges_only() -> None:
+    from lanevil_core.camera.sensor import tone_lut
+    from lanevil_core.render.develop import develop
+
+    hdr = np.full((40, 60, 3), 0.05, np.float32)
+    hdr[:, 30:] = 0.6
+    ids = np.zeros((40, 60), np.int32)
+    ids[:, 30:] = 7
+    args = (1.0, np.ones(3), 0.0, (30.0, 20.0), 0.0, 0.0, 1.0, 5, tone_lut(1.0))
+    sharp, soft = np.empty(hdr.shape, np.uint8), np.empty(hdr.shape, np.uint8)
+    develop(hdr, *args, sharp)
+    develop(hdr, *args, soft, 1, ids)
+    differs = np.any(sharp != soft, axis=-1)
+    assert differs[:, 29].all() and differs[:, 30].all()  # the two columns on the edge
+    assert not differs[:, :29].any() and not differs[:, 31:].any()
+    assert sharp[0, 29, 0] < soft[0, 29, 0] and soft[0, 30, 0] < sharp[0, 30, 0]
