@@ -121,9 +121,9 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
                   vignetting: float, cx: float, cy: float, shot: float, read: float, saturation: float,
                   seed: np.uint64, lut: np.ndarray, normals: np.ndarray, out: np.ndarray, band: int,
                   bands: int) -> None:
-    """Develops the rows of one band in three sweeps of a row: each pixel's radiance (its streak's mean, else
-    blended with its neighbours on an object edge, else its own); the sensor's arithmetic on whole vectors of
-    pixels; the tone curve's table reads."""
+    """Develops the rows of one band in four sweeps of a row: each pixel's radiance (its streak's mean, else
+    blended with its neighbours on an object edge, else its own); its noise deviates; the sensor's arithmetic, on
+    whole vectors of pixels; the tone curve's table reads."""
     height, width, _ = hdr.shape
     depth, blur_cx, blur_cy, travel = streaks
     top = lut.size - 1
