@@ -28,13 +28,11 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from lanevil_core.cli.base import UsageError
+
 ROOT = Path(__file__).resolve().parent.parent
 WORKTREE = "worktree"
 TREE_PARTS = ("lanevil_core", "app", "scenes")
-
-
-class UsageError(Exception):
-    """Bad command-line input (exit status 2, one line)."""
 
 
 def extract(revision: str, into: Path) -> Path:
@@ -125,14 +123,13 @@ def main(argv: list[str] | None = None) -> int:
             runs: dict[str, list[dict[str, float]]] = {rev: [] for rev in trees}
             for round_index in range(args.rounds):
                 for rev, tree in trees.items():
-                    # An older bench may not know --camera: it is then timed without it.
                     bench_args = ["--frames-per-case", str(args.frames_per_case)]
                     try:
                         result = bench_once(tree, bench_args + (["--camera", *args.camera] if args.camera else []))
-                    except UsageError:
-                        if not args.camera:
+                    except UsageError as error:
+                        if not args.camera or "--camera" not in str(error):
                             raise
-                        result = bench_once(tree, bench_args)
+                        result = bench_once(tree, bench_args)  # an older bench without --camera: timed plain
                     runs[rev].append(row_medians(result))
                     print(f"round {round_index + 1}: {rev} done", file=sys.stderr)
         table = summarise(runs, args.first, args.second)

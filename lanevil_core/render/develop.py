@@ -69,23 +69,14 @@ def _streak(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, travel: fl
     if taps > 0:
         step_x, step_y = fx / (taps - 1), fy / (taps - 1)
         x, y = col + 0.5 - 0.5 * fx, row + 0.5 - 0.5 * fy
-        if min(x, x + fx) >= 0.0 and max(x, x + fx) < width and min(y, y + fy) >= 0.0 and max(y, y + fy) < height:
-            for _ in range(taps):  # the whole streak is inside the image (most are): no clamping
-                sc, sr = int(x), int(y)
-                a0 += src[sr, sc, 0]
-                a1 += src[sr, sc, 1]
-                a2 += src[sr, sc, 2]
-                x += step_x
-                y += step_y
-        else:
-            for _ in range(taps):
-                sc = min(max(int(x), 0), width - 1)
-                sr = min(max(int(y), 0), height - 1)
-                a0 += src[sr, sc, 0]
-                a1 += src[sr, sc, 1]
-                a2 += src[sr, sc, 2]
-                x += step_x
-                y += step_y
+        for _ in range(taps):
+            sc = min(max(int(x), 0), width - 1)
+            sr = min(max(int(y), 0), height - 1)
+            a0 += src[sr, sc, 0]
+            a1 += src[sr, sc, 1]
+            a2 += src[sr, sc, 2]
+            x += step_x
+            y += step_y
         inv = np.float32(1.0 / taps)
         a0, a1, a2 = a0 * inv, a1 * inv, a2 * inv
     # One exit, on a use of both arrays, so numba releases them in one place (see ``_jit``).
