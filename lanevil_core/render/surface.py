@@ -10,6 +10,7 @@ import numpy as np
 
 from ..world.paint import PAINT_WEAR
 from ._jit import kernel
+from .textures import NOISE_LEVELS, NOISE_SIZE, level_offset
 
 MAX_ANISO = 6
 # Worn paint: the share left where the chip noise is n is 1 - wear (1 + CHIP_CONTRAST n), so chips come and go along
@@ -43,12 +44,13 @@ def dash_coverage(s: float, width: float, on: float, period: float) -> float:
 
 
 @kernel(inline="always")
-def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprint_m: float) -> float:
-    """Bilinear sample of a tiled mip stack (levels, n, n) at road position (s, t)."""
-    levels, n = stack.shape[0], stack.shape[1]
+def sample_noise(pyramid: np.ndarray, texel_m: float, s: float, t: float, footprint_m: float) -> float:
+    """Bilinear sample of a tiled mip pyramid (``textures.noise_textures``) at road position (s, t), in the level
+    whose texel covers the footprint. Weights and texel indices are those of level 0; each index is read in the
+    level at index >> level, so a coarse level is sampled as blocks of 2^level texels with bilinear seams."""
     level = 0
     ratio = footprint_m / texel_m
-    while ratio > 1.0 and level < levels - 1:
+    while ratio > 1.0 and level < NOISE_LEVELS - 1:
         ratio *= 0.5
         level += 1
     x = s / texel_m
@@ -57,13 +59,17 @@ def sample_noise(stack: np.ndarray, texel_m: float, s: float, t: float, footprin
     y0 = np.floor(y)
     fx = x - x0
     fy = y - y0
-    mask = n - 1  # n is a power of two, so wrapping is a bit mask even for negative coordinates
+    mask = NOISE_SIZE - 1  # a power of two, so wrapping is a bit mask even for negative coordinates
     i0 = int(x0) & mask
     j0 = int(y0) & mask
-    i1 = (i0 + 1) & mask
-    j1 = (j0 + 1) & mask
-    a = stack[level, i0, j0] * (1 - fy) + stack[level, i0, j1] * fy
-    b = stack[level, i1, j0] * (1 - fy) + stack[level, i1, j1] * fy
+    i1 = ((i0 + 1) & mask) >> level
+    j1 = ((j0 + 1) & mask) >> level
+    i0 >>= level
+    j0 >>= level
+    side = NOISE_SIZE >> level
+    base = level_offset(level)
+    a = pyramid[base + i0 * side + j0] * (1 - fy) + pyramid[base + i0 * side + j1] * fy
+    b = pyramid[base + i1 * side + j0] * (1 - fy) + pyramid[base + i1 * side + j1] * fy
     return a * (1 - fx) + b * fx
 
 
