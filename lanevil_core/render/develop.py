@@ -50,39 +50,46 @@ MAX_STREAK_TAPS = 24
 
 
 @kernel(inline="always")
-def _streak(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, travel: float, row: int,
-            col: int) -> tuple[np.float32, np.float32, np.float32, bool]:
-    """(r, g, b, blurred): the mean of ``src`` along the pixel's streak, when it is at least MIN_STREAK_PX long.
+def _streak_row(depth: np.ndarray, cx: float, cy: float, travel: float, row: int, taps: np.ndarray,
+                start_x: np.ndarray, start_y: np.ndarray, step_x: np.ndarray, step_y: np.ndarray) -> None:
+    """Each pixel's streak in ``row``: its tap count (0 when the streak is shorter than MIN_STREAK_PX and the
+    pixel stays sharp), its first tap and the step between taps (px).
 
     Over the exposure the camera moves ``travel`` m forward: a point at depth z slides away from the centre of
-    expansion by (p - c) * travel / (z - travel); the streak is centred on the mid-exposure point."""
-    height, width, _ = src.shape
-    z = depth[row, col]
-    taps = 0
-    fx = fy = 0.0
-    if travel > 0.0 and z < np.inf and z > travel * 2.0:
-        k = travel / (z - travel)
+    expansion by (p - c) * travel / (z - travel); the streak is centred on the mid-exposure point. Arithmetic
+    only, without branches, so it runs on whole vectors of pixels."""
+    for col in range(depth.shape[1]):
+        z = depth[row, col]
+        moving = (z < np.inf) & (z > travel * 2.0)
+        k = travel / (z - travel) if moving else 0.0
         fx = (col + 0.5 - cx) * k
         fy = (row + 0.5 - cy) * k
         length2 = fx * fx + fy * fy
-        if length2 >= MIN_STREAK_PX * MIN_STREAK_PX:
-            taps = min(int(math.sqrt(length2)) + 2, MAX_STREAK_TAPS)
+        n = min(int(math.sqrt(length2)) + 2, MAX_STREAK_TAPS) if length2 >= MIN_STREAK_PX * MIN_STREAK_PX else 0
+        taps[col] = n
+        step_x[col] = fx / max(n - 1, 1)
+        step_y[col] = fy / max(n - 1, 1)
+        start_x[col] = col + 0.5 - 0.5 * fx
+        start_y[col] = row + 0.5 - 0.5 * fy
+
+
+@kernel(inline="always")
+def _streak_mean(src: np.ndarray, taps: int, x: float, y: float, step_x: float,
+                 step_y: float) -> tuple[np.float32, np.float32, np.float32]:
+    """The mean of ``src`` (H, W, 3) over ``taps`` (at least 1) nearest-pixel taps from (x, y) by (step_x,
+    step_y)."""
+    height, width, _ = src.shape
     a0 = a1 = a2 = np.float32(0.0)  # the image's own precision: no conversion per tap
-    if taps > 0:
-        step_x, step_y = fx / (taps - 1), fy / (taps - 1)
-        x, y = col + 0.5 - 0.5 * fx, row + 0.5 - 0.5 * fy
-        for _ in range(taps):
-            sc = min(max(int(x), 0), width - 1)
-            sr = min(max(int(y), 0), height - 1)
-            a0 += src[sr, sc, 0]
-            a1 += src[sr, sc, 1]
-            a2 += src[sr, sc, 2]
-            x += step_x
-            y += step_y
-        inv = np.float32(1.0 / taps)
-        a0, a1, a2 = a0 * inv, a1 * inv, a2 * inv
-    # One exit, on a use of both arrays, so numba releases them in one place (see ``_jit``).
-    return (a0, a1, a2, taps > 0) if src.shape[0] == depth.shape[0] else (a0, a1, a2, taps > 0)
+    for _ in range(taps):
+        sc = min(max(int(x), 0), width - 1)
+        sr = min(max(int(y), 0), height - 1)
+        a0 += src[sr, sc, 0]
+        a1 += src[sr, sc, 1]
+        a2 += src[sr, sc, 2]
+        x += step_x
+        y += step_y
+    inv = np.float32(1.0 / taps)
+    return a0 * inv, a1 * inv, a2 * inv
 
 
 @kernel
@@ -91,12 +98,20 @@ def _motion_blur_rows(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, 
     """The rows of one band of ``out``: each pixel's streak mean, or its own value when the streak is shorter
     than MIN_STREAK_PX."""
     height, width, _ = src.shape
+    taps = np.zeros(width, np.int64)
+    start_x, start_y, step_x, step_y = (np.empty(width), np.empty(width), np.empty(width), np.empty(width))
     for row in band_rows(height, band, bands):
+        _streak_row(depth, cx, cy, travel, row, taps, start_x, start_y, step_x, step_y)
         for col in range(width):
-            r, g, b, blurred = _streak(src, depth, cx, cy, travel, row, col)
-            out[row, col, 0] = r if blurred else src[row, col, 0]
-            out[row, col, 1] = g if blurred else src[row, col, 1]
-            out[row, col, 2] = b if blurred else src[row, col, 2]
+            if taps[col] > 0:
+                r, g, b = _streak_mean(src, taps[col], start_x[col], start_y[col], step_x[col], step_y[col])
+                out[row, col, 0] = r
+                out[row, col, 1] = g
+                out[row, col, 2] = b
+            else:
+                out[row, col, 0] = src[row, col, 0]
+                out[row, col, 1] = src[row, col, 1]
+                out[row, col, 2] = src[row, col, 2]
 
 
 def motion_blur(hdr: np.ndarray, depth: np.ndarray, center: tuple[float, float], travel: float,
@@ -114,9 +129,10 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
                   vignetting: float, cx: float, cy: float, shot: float, read: float, saturation: float,
                   seed: np.uint64, lut: np.ndarray, normals: np.ndarray, out: np.ndarray, band: int,
                   bands: int) -> None:
-    """Develops the rows of one band in four sweeps of a row: each pixel's radiance (its streak's mean, else
-    blended with its neighbours on an object edge, else its own); its noise deviates; the sensor's arithmetic, on
-    whole vectors of pixels; the tone curve's table reads."""
+    """Develops the rows of one band in five sweeps of a row: each pixel's streak (``_streak_row``, on whole
+    vectors of pixels); its radiance (its streak's mean, else blended with its neighbours on an object edge, else
+    its own); its noise deviates; the sensor's arithmetic, on whole vectors of pixels; the tone curve's table
+    reads."""
     height, width, _ = hdr.shape
     depth, blur_cx, blur_cy, travel = streaks
     top = lut.size - 1
@@ -129,17 +145,20 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
     noise = np.empty(width * 3, np.float64)
     index = np.empty(width * 3, np.uint16)  # unsigned: the table reads need no check for negative indices
     on_edge = np.zeros(width, np.bool_)
+    taps = np.zeros(width, np.int64)  # no streaks: every pixel stays sharp
+    start_x, start_y, step_x, step_y = (np.empty(width), np.empty(width), np.empty(width), np.empty(width))
     for row in band_rows(height, band, bands):
         if ids.shape[0] == height:
             row_edges(ids, row, on_edge)
+        if travel > 0.0:
+            _streak_row(depth, blur_cx, blur_cy, travel, row, taps, start_x, start_y, step_x, step_y)
         for col in range(width):
-            r, g, b, blurred = _streak(hdr, depth, blur_cx, blur_cy, travel, row, col)
-            if not blurred:
-                if on_edge[col]:
-                    r, g, b = edge_blend(hdr, row, col, 0), edge_blend(hdr, row, col, 1), \
-                        edge_blend(hdr, row, col, 2)
-                else:
-                    r, g, b = hdr[row, col, 0], hdr[row, col, 1], hdr[row, col, 2]
+            if taps[col] > 0:
+                r, g, b = _streak_mean(hdr, taps[col], start_x[col], start_y[col], step_x[col], step_y[col])
+            elif on_edge[col]:
+                r, g, b = edge_blend(hdr, row, col, 0), edge_blend(hdr, row, col, 1), edge_blend(hdr, row, col, 2)
+            else:
+                r, g, b = hdr[row, col, 0], hdr[row, col, 1], hdr[row, col, 2]
             radiance[3 * col] = r
             radiance[3 * col + 1] = g
             radiance[3 * col + 2] = b
