@@ -74,6 +74,13 @@ def _streak_row(depth: np.ndarray, cx: float, cy: float, travel: float, row: int
 
 
 @kernel(inline="always")
+def _streak_buffers(width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A row's worth of ``_streak_row`` output: tap counts (all 0, so every pixel starts sharp), first taps and
+    steps."""
+    return np.zeros(width, np.int64), np.empty(width), np.empty(width), np.empty(width), np.empty(width)
+
+
+@kernel(inline="always")
 def _streak_mean(src: np.ndarray, taps: int, x: float, y: float, step_x: float,
                  step_y: float) -> tuple[np.float32, np.float32, np.float32]:
     """The mean of ``src`` (H, W, 3) over ``taps`` (at least 1) nearest-pixel taps from (x, y) by (step_x,
@@ -98,8 +105,7 @@ def _motion_blur_rows(src: np.ndarray, depth: np.ndarray, cx: float, cy: float, 
     """The rows of one band of ``out``: each pixel's streak mean, or its own value when the streak is shorter
     than MIN_STREAK_PX."""
     height, width, _ = src.shape
-    taps = np.zeros(width, np.int64)
-    start_x, start_y, step_x, step_y = (np.empty(width), np.empty(width), np.empty(width), np.empty(width))
+    taps, start_x, start_y, step_x, step_y = _streak_buffers(width)
     for row in band_rows(height, band, bands):
         _streak_row(depth, cx, cy, travel, row, taps, start_x, start_y, step_x, step_y)
         for col in range(width):
@@ -145,8 +151,7 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
     noise = np.empty(width * 3, np.float64)
     index = np.empty(width * 3, np.uint16)  # unsigned: the table reads need no check for negative indices
     on_edge = np.zeros(width, np.bool_)
-    taps = np.zeros(width, np.int64)  # no streaks: every pixel stays sharp
-    start_x, start_y, step_x, step_y = (np.empty(width), np.empty(width), np.empty(width), np.empty(width))
+    taps, start_x, start_y, step_x, step_y = _streak_buffers(width)  # no streaks: every pixel stays sharp
     for row in band_rows(height, band, bands):
         if ids.shape[0] == height:
             row_edges(ids, row, on_edge)
