@@ -56,30 +56,38 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
                                                  "images; a dataset folder stands for its test split")
     from ..detect.split import METHODS
 
-    parser.add_argument("--method", choices=METHODS, required=True,
+    parser.add_argument("--method", choices=METHODS, required=True, action="append",
                         help="learned (ufld: row anchors, seg: segmentation, laneatt: line anchors, bezier: "
                              "Bézier curves, ganet: keypoints, scnn: message-passing segmentation; ONNX) or "
-                             "classical baseline")
+                             "classical baseline; repeat to run several over one reading of the images")
     parser.add_argument("--weights", type=Path, default=None,
-                        help="model folder of a learned method (default: the model shipped with lanevil)")
-    parser.add_argument("--out", type=Path, required=True, help="predictions file (TuSimple JSON lines)")
+                        help="model folder of a learned method (default: the model shipped with lanevil); "
+                             "only with a single --method")
+    parser.add_argument("--out", type=Path, required=True,
+                        help="predictions file (TuSimple JSON lines); with several --method a folder that gets "
+                             "one METHOD.json each")
     parser.add_argument("--fixed-run-time", type=float, default=None, metavar="MS",
                         help="write this run_time instead of the measured one (byte-reproducible output)")
 
 
 def _run_detect(args: argparse.Namespace) -> int:
-    from ..detect import detect_split
+    from ..detect import detect_split_methods
 
     def progress(done: int, total: int) -> None:
         if done % 50 == 0 or done == total:
             print(f"\rimage {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
+    several = len(args.method) > 1
+    if several and args.out.exists() and not args.out.is_dir():
+        raise UsageError(f"--out {args.out}: with several --method, a folder (it is a file)")
     try:
-        records = detect_split(args.split, args.method, progress, args.fixed_run_time, args.weights)
+        by_method = detect_split_methods(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:
         raise UsageError(str(error)) from None
-    write_atomic(args.out, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
-    print(f"{len(records)} predictions in {args.out}")
+    for method, records in by_method.items():
+        path = args.out / f"{method}.json" if several else args.out
+        write_atomic(path, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
+        print(f"{len(records)} predictions in {path}")
     return 0
 
 

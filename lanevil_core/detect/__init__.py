@@ -3,7 +3,7 @@
 from .birdseye import BirdseyeParams, detect_birdseye
 from .common import GroundCamera
 from .hough import HoughParams, detect_hough
-from .split import DETECTORS, detect_split
+from .split import DETECTORS, detect_split, detect_split_methods
 
 __all__ = [
     "DETECTORS",
@@ -13,4 +13,5 @@ __all__ = [
     "detect_birdseye",
     "detect_hough",
     "detect_split",
+    "detect_split_methods",
 ]

@@ -80,14 +80,20 @@ def test_detectors_are_deterministic_and_find_nothing_on_a_blank_image(clean_fra
     assert detector(np.full_like(rgb, 90), record["h_samples"]) == []
 
 
-def test_detect_command_over_a_split(clean_frames, tmp_path, capsys):
-    split = tmp_path / "test"
+def _write_split(split: Path, frames) -> list[str]:
+    """A split folder of PNG frames and their label file; returns the label lines."""
     lines = []
-    for rgb, record in clean_frames[:2]:
+    for rgb, record in frames:
         (split / record["raw_file"]).parent.mkdir(parents=True, exist_ok=True)
         (split / record["raw_file"]).write_bytes(png_bytes(rgb))
         lines.append(json.dumps(record))
     (split / "test_label.json").write_text("\n".join(lines) + "\n")
+    return lines
+
+
+def test_detect_command_over_a_split(clean_frames, tmp_path, capsys):
+    split = tmp_path / "test"
+    lines = _write_split(split, clean_frames[:2])
     out = tmp_path / "preds.json"
     assert main(["detect", str(split), "--method", "birdseye", "--out", str(out), "--fixed-run-time", "1"]) == 0
     first = out.read_bytes()
@@ -101,3 +107,25 @@ def test_detect_command_over_a_split(clean_frames, tmp_path, capsys):
     capsys.readouterr()
     assert main(["detect", str(tmp_path / "missing"), "--method", "hough", "--out", str(out)]) == 2
     assert "not a split folder" in capsys.readouterr().err
+
+
+def test_detect_several_methods_reads_each_image_once_and_writes_what_single_runs_write(tmp_path, clean_frames,
+                                                                                        capsys):
+    split = tmp_path / "split"
+    _write_split(split, clean_frames[:2])
+    fixed = ["--fixed-run-time", "1"]
+    for method in ("hough", "birdseye"):
+        assert main(["detect", str(split), "--method", method, "--out", str(tmp_path / f"{method}.json"), *fixed]) == 0
+    both = tmp_path / "both"
+    assert main(["detect", str(split), "--method", "hough", "--method", "birdseye", "--out", str(both), *fixed]) == 0
+    for method in ("hough", "birdseye"):
+        assert (both / f"{method}.json").read_bytes() == (tmp_path / f"{method}.json").read_bytes()
+    capsys.readouterr()
+    assert main(["detect", str(split), "--method", "hough", "--method", "hough", "--out", str(both)]) == 2
+    assert "named twice" in capsys.readouterr().err
+    assert main(["detect", str(split), "--method", "hough", "--method", "birdseye", "--weights", str(tmp_path),
+                 "--out", str(both)]) == 2
+    assert "--weights" in capsys.readouterr().err
+    assert main(["detect", str(split), "--method", "hough", "--method", "birdseye",
+                 "--out", str(tmp_path / "hough.json")]) == 2
+    assert "a folder" in capsys.readouterr().err
