@@ -78,8 +78,11 @@ def _run_detect(args: argparse.Namespace) -> int:
             print(f"\rimage {done}/{total}", end="" if done < total else "\n", file=sys.stderr, flush=True)
 
     several = len(args.method) > 1
+    # Checked before the images are read: a full split takes most of an hour.
     if several and args.out.exists() and not args.out.is_dir():
         raise UsageError(f"--out {args.out}: with several --method, a folder (it is a file)")
+    if not several and args.out.is_dir():
+        raise UsageError(f"--out {args.out}: with one --method, a predictions file (it is a folder)")
     try:
         by_method = detect_split_methods(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:

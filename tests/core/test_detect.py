@@ -129,3 +129,5 @@ def test_detect_several_methods_reads_each_image_once_and_writes_what_single_run
     assert main(["detect", str(split), "--method", "hough", "--method", "birdseye",
                  "--out", str(tmp_path / "hough.json")]) == 2
     assert "a folder" in capsys.readouterr().err
+    assert main(["detect", str(split), "--method", "hough", "--out", str(both)]) == 2
+    assert "a predictions file (it is a folder)" in capsys.readouterr().err
