@@ -53,7 +53,8 @@ def main() -> None:
     missing = [method for method in methods if not (out / "pred" / f"{method}.json").exists()]
     if missing:  # one `lanevil detect` for all of them: each image is read once
         started = time.perf_counter()
-        target = out / "pred" / (f"{missing[0]}.json" if len(missing) == 1 else "")
+        # One method writes a predictions file; several write a folder of METHOD.json.
+        target = out / "pred" / f"{missing[0]}.json" if len(missing) == 1 else out / "pred"
         method_args = (arg for method in missing for arg in ("--method", method))
         lanevil("detect", args.bench, *method_args, "--out", str(target))
         seconds = time.perf_counter() - started
