@@ -47,7 +47,7 @@ class LocalPool:
         else to do); on threads here when no worker was started."""
         if self._pool is None:
             return threads_map(fn, items)
-        return list(self._pool.map(fn, items))
+        return self._pool.map(fn, items)  # in order, each result as soon as it and those before it are done
 
     def close(self) -> None:
         """Stop workers that ``start()`` spawned and no call used (a run that failed while planning)."""

@@ -18,7 +18,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path, PurePosixPath
@@ -225,10 +225,11 @@ SAMPLINGS = ("in_view", "even")
 Mapper = Callable[[Callable[[Any], Any], list[Any]], Iterable[Any]]  # like the builtin map, over a list
 
 
-def threads_map(fn: Callable[[Any], Any], items: list[Any]) -> Iterable[Any]:
-    """``map`` on one thread per core: the planner's small renders spend their time in GIL-free kernels."""
+def threads_map(fn: Callable[[Any], Any], items: list[Any]) -> Iterator[Any]:
+    """``map`` on one thread per core: the planner's small renders spend their time in GIL-free kernels. Results
+    come in order, each as soon as it and those before it are done."""
     with ThreadPoolExecutor(max_workers=max(min(len(items), os.cpu_count() or 1), 1)) as pool:
-        return list(pool.map(fn, items))
+        yield from pool.map(fn, items)
 
 
 def _in_view(job: tuple[Case, int]) -> tuple[int, ...]:

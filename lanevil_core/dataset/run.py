@@ -17,6 +17,7 @@ from .manifest import build_manifest, frame_key, software_versions, source_diges
 from .plan import (
     SPLIT_LABELS,
     DatasetPlan,
+    Mapper,
     PlannedCase,
     RenderTask,
     Settings,
@@ -25,7 +26,7 @@ from .plan import (
     render_tasks,
     threads_map,
 )
-from .progress import progress_bar
+from .progress import planning_bar, progress_bar
 from .worker import FrameResult, TaskDone
 from .writer import DatasetFolder
 
@@ -112,13 +113,28 @@ def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versi
     folder.write_manifest(build_manifest(plan, versions, code_sha256, hashes))
 
 
+def counted(mapper: Mapper, enabled: bool) -> Mapper:
+    """``mapper`` with the planning bar: one step per case folder whose in-view frames are found."""
+
+    def mapped(fn: Callable[[Any], Any], items: list[Any]) -> list[Any]:
+        results = []
+        with planning_bar(len(items), enabled) as bar:
+            for result in mapper(fn, items):
+                results.append(result)
+                bar.update(1)
+        return results
+
+    return mapped
+
+
 def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executor: Executor,
                      show_progress: bool = True) -> RunSummary:
     """Render the dataset of the cases under ``cases_dir`` into ``out_dir``; frames verified on disk are kept."""
     start = time.perf_counter()
     getattr(executor, "start", lambda: None)()  # e.g. LocalPool: workers start up while the plan is made
     try:
-        plan = build_plan(discover_cases(cases_dir), settings, getattr(executor, "map", threads_map))
+        mapper = counted(getattr(executor, "map", threads_map), show_progress)
+        plan = build_plan(discover_cases(cases_dir), settings, mapper)
         versions = software_versions()
         code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
         folder = DatasetFolder(out_dir, settings.suffix)

@@ -302,3 +302,17 @@ def test_dask_cluster_writes_the_same_bytes_as_the_local_run(dataset: Path, case
         assert run_cli("--cases", str(cases_dir), "--out", str(out), "--scheduler", cluster.scheduler_address,
                        *ARGS) == 0
     assert tree(out) == tree(dataset)
+
+
+def test_planning_shows_a_bar_over_the_case_folders(cases_dir: Path, tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """The in-view search renders a few small frames per case folder (minutes for the whole library) before the
+    first frame is rendered: a bar counts the folders, so a long planning does not look like a hang."""
+    settings = Settings(size=(160, 90), frames_per_case=1, train_frames=0)
+    generate_dataset(cases_dir, tmp_path / "out", settings, functools.partial(run_local, workers=1))
+    err = capsys.readouterr().err
+    assert "planning: 100%" in err
+    assert "2/2 [" in err  # the fence shadow's folder and the road crack's
+    generate_dataset(cases_dir, tmp_path / "quiet", settings, functools.partial(run_local, workers=1),
+                     show_progress=False)
+    assert "planning" not in capsys.readouterr().err
