@@ -10,8 +10,11 @@ Usage::
     lanevil dataset --cases scenes/00_clean --out data/train2k --train-frames 2000 --size 640x360
     lanevil dataset --cases scenes --out data/bench --frames-per-case 10 --train-frames 0 --no-paint
     python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
-        [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd] [--seeds 0,1,2] [--jobs 2] \\
+        [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd,aam_keep_paint] \\
+        [--seeds 0,1,2] [--jobs 2] \\
         [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3] [--patience 4] [--train-only]
+
+``aam_keep_paint`` is AAM with ``lanevil train --aam-keep-paint`` (each image's own lane markings left unmixed).
 
 ``--patience`` trains each run until its validation accuracy stops improving (``--epochs`` is then the most) and
 keeps the best epoch. ``--train-only`` stops after training: run the same command without it (on another machine,
@@ -33,6 +36,8 @@ from pathlib import Path
 from lanevil_core.detect.model_spec import FAMILIES
 
 AUGMENTS = ("none", "aam", "cutout", "copy_paste", "hsv", "mixup", "pgd")
+# runs of one augment with other settings: name -> (--augment, extra lanevil train arguments)
+VARIANTS = {"aam_keep_paint": ("aam", ("--aam-keep-paint",))}
 
 
 def lanevil(*args: str) -> None:
@@ -53,9 +58,10 @@ def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
         extra += ["--init", str(args.init)] if args.init else []
         extra += ["--lr", str(args.lr)] if args.lr else []
         extra += ["--patience", str(args.patience)] if args.patience else []
+        augment, settings = VARIANTS.get(augment, (augment, ()))
         lanevil("train", "--data", str(args.data), "--out", str(model_dir), "--model", args.family,
                 "--epochs", str(args.epochs), "--augment", augment, "--seed", seed, "--threads", "1", "--quiet",
-                *extra)
+                *settings, *extra)
     if not pred.is_file() and not args.train_only:
         pred.parent.mkdir(parents=True, exist_ok=True)
         lanevil("detect", str(args.bench), "--method", args.family, "--weights", str(model_dir), "--out", str(pred))
@@ -85,10 +91,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.bench is None and not args.train_only:
         parser.error("--bench: the test split to score on is needed (or --train-only)")
     augments = [a for a in args.augments.split(",") if a]
-    unknown = sorted(set(augments) - set(AUGMENTS))
+    unknown = sorted(set(augments) - set(AUGMENTS) - set(VARIANTS))
     if unknown or "none" not in augments:
         parser.error(f"--augments: {', '.join(unknown) or 'none'} {'unknown' if unknown else 'is needed'}"
-                     f" (choose from {', '.join(AUGMENTS)}; 'none' is the baseline)")
+                     f" (choose from {', '.join(AUGMENTS + tuple(VARIANTS))}; 'none' is the baseline)")
     names = [f"{augment}@{seed}" for seed in args.seeds.split(",") for augment in augments]
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         for name, seconds in pool.map(lambda n: run_one(args, n), names):

@@ -32,6 +32,9 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
                         help="training augmentation / defence: the paper's baselines, aam (Attention Area Mixing "
                              "with hard examples rendered from training variations) or pgd (adversarial training) "
                              "(default none)")
+    parser.add_argument("--aam-keep-paint", action="store_true",
+                        help="with --augment aam: leave each image's own lane markings unmixed, so an illusion lies "
+                             "around the lines the labels describe but never erases them")
     parser.add_argument("--affine", action="store_true",
                         help="UFLD's geometric augmentation: every training sample rotated by up to 6 degrees and "
                              "shifted by up to 14 %% of the height and 16 %% of the width, labels with it")
@@ -59,12 +62,15 @@ def _run_train(args: argparse.Namespace) -> int:
     except ImportError:
         raise UsageError("lanevil train needs PyTorch: pip install -e '.[learn]'") from None
     from ..detect.model_spec import ModelSpec, ModelSpecError
+    from ..learn.aam import AamSettings
     from ..learn.train import TrainError, TrainSettings, train
 
     if not args.data.is_dir():
         raise UsageError(f"--data {args.data}: no such folder")
     if args.init is not None and not args.init.is_file():
         raise UsageError(f"--init {args.init}: no such file")
+    if args.aam_keep_paint and args.augment != "aam":
+        raise UsageError(f"--aam-keep-paint: only with --augment aam (not {args.augment})")
     if not 0.0 <= args.val_fraction < 1.0:
         raise UsageError(f"--val {args.val_fraction}: must lie in [0, 1)")
     try:
@@ -73,7 +79,8 @@ def _run_train(args: argparse.Namespace) -> int:
                                  lr=args.lr, augment=args.augment, affine=args.affine, device=args.device,
                                  seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
-                                 max_steps=args.max_steps, threads=args.threads, patience=args.patience)
+                                 max_steps=args.max_steps, threads=args.threads, patience=args.patience,
+                                 aam=AamSettings(keep_paint=args.aam_keep_paint))
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:
         raise UsageError(str(error)) from None

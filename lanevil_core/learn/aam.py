@@ -25,6 +25,8 @@
    ``mismatch_threshold = None`` the high-attention areas are left out (``W = A * M``). With ``relight`` the
    mixed-in pixels are ``h`` only where the illusion's meshes are and elsewhere ``x`` relit by the illusion,
    ``x * g`` with ``g`` the perturbed over the clean bank render, so the illusion falls on this image's own road.
+   With ``keep_paint`` the image's own lane markings (its lane-mask target, grown by a pixel) are left out of ``W``:
+   the illusion lies around the lines but never erases the paint the labels describe.
 
 Attention maps are taken with batch norm on its running statistics (``models.running_statistics``), so these
 extra forward passes do not count as training data.
@@ -72,6 +74,7 @@ class AamSettings:
     mismatch_grow_px: int = 3  # the mismatch regions grown by this radius (input pixels)
     lane_band_px: int = 2  # half width of a ground-truth lane at the input size
     relight: bool = False  # mix the illusion's light change into the image's own road instead of its pixels
+    keep_paint: bool = False  # leave the image's own lane markings (its lane-mask target) unmixed
 
 
 @dataclass
@@ -213,18 +216,31 @@ def attention(out: dict[str, torch.Tensor], size: tuple[int, int], spread_px: in
     return lanes / peak[:, None, None]
 
 
+def paint_area(lane_masks: torch.Tensor, size: tuple[int, int], grow_px: int = 1) -> torch.Tensor:
+    """(N, H, W) float 0/1 at the input ``size``: the images' lanes from their lane-mask targets ((N, h, w) slot
+    ids, 0 = background, at the mask stride), grown by ``grow_px`` input pixels: where an image's paint is."""
+    lanes = (lane_masks > 0).float()[:, None]
+    lanes = F.interpolate(lanes, size=(size[1], size[0]), mode="nearest")
+    if grow_px > 0:
+        lanes = F.max_pool2d(lanes, 2 * grow_px + 1, stride=1, padding=grow_px)
+    return lanes[:, 0]
+
+
 def mix(images: torch.Tensor, attention_map: torch.Tensor, patches: torch.Tensor,
         masks: torch.Tensor, areas: torch.Tensor | None = None, gains: torch.Tensor | None = None,
-        objects: torch.Tensor | None = None) -> torch.Tensor:
+        objects: torch.Tensor | None = None, keep: torch.Tensor | None = None) -> torch.Tensor:
     """``x * (1 - W) + t * W`` with ``W = max(A * M, H)`` for images (N, 3, H, W), attention (N, H, W), patches
     (N, 3, H, W), masks (N, H, W) and high-attention areas (N, H, W; none: ``W = A * M``), all in 0..1.
 
     The mixed-in ``t`` is the patch itself, or with ``gains`` (N, 3, H, W) and ``objects`` (N, H, W) the patch
     where the illusion's meshes are and elsewhere the image relit by the illusion (``x * gain``): a shadow or a
-    streak then falls on this image's own paint instead of replacing it with another frame's road."""
+    streak then falls on this image's own paint instead of replacing it with another frame's road. ``keep``
+    (N, H, W) 0..1 is left unmixed (``W * (1 - keep)``: the image's own paint, ``paint_area``)."""
     weight = attention_map * masks
     if areas is not None:
         weight = torch.maximum(weight, areas)
+    if keep is not None:
+        weight = weight * (1.0 - keep)
     weight = weight[:, None]
     target = patches
     if gains is not None and objects is not None:

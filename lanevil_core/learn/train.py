@@ -35,6 +35,7 @@ from .aam import (
     hard_summary,
     lane_attention,
     mix,
+    paint_area,
     patch_tensors,
     update_attention_areas,
 )
@@ -164,8 +165,9 @@ def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, A
 
 
 def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainSettings, epoch: int,
-              step: int) -> torch.Tensor:
-    """The batch with AAM applied to a share of its images (chosen by seed, epoch and step)."""
+              step: int, lane_masks: torch.Tensor | None = None) -> torch.Tensor:
+    """The batch with AAM applied to a share of its images (chosen by seed, epoch and step); ``lane_masks``, the
+    batch's lane-mask targets, are kept unmixed with ``settings.aam.keep_paint``."""
     rng = np.random.default_rng([settings.seed, epoch, step, 7])
     chosen = np.flatnonzero(rng.random(len(images)) < settings.aam.probability)
     if not len(chosen):
@@ -173,9 +175,12 @@ def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainS
     device = next(model.parameters()).device
     attention_map = lane_attention(model, images[chosen].to(device), settings.aam.attention_spread_px).cpu()
     bank = patch_tensors([hard[int(i)] for i in rng.integers(0, len(hard), len(chosen))])
+    keep = None
+    if settings.aam.keep_paint and lane_masks is not None:
+        keep = paint_area(lane_masks[chosen], model.spec.input_size)
     images = images.clone()
     images[chosen] = mix(images[chosen], attention_map, bank.images, bank.masks, bank.areas, bank.gains,
-                         bank.objects)
+                         bank.objects, keep)
     return images
 
 
@@ -260,7 +265,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
             for group in optimizer.param_groups:
                 group["lr"] = _lr_at(epoch * steps_per_epoch + step, total_steps, settings.lr)
             if hard:
-                batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step)
+                batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step, batch["mask"])
             if settings.augment == "pgd":
                 batch["image"] = pgd_batch(model, spec.family, batch, settings.pgd, settings.seed, epoch, step)
             batch = {k: v.to(device) for k, v in batch.items()}
@@ -305,6 +310,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "batch": settings.batch,
         "lr": settings.lr,
         "augment": settings.augment,
+        **({"aam_settings": asdict(settings.aam)} if settings.augment == "aam" else {}),
         "affine": settings.affine,
         "seed": settings.seed,
         "device": device.type,

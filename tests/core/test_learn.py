@@ -199,6 +199,8 @@ def test_train_and_detect_errors_exit_2(tmp_path, capsys):
     assert "--data" in capsys.readouterr().err
     assert main(["train", "--data", str(tmp_path), "--out", str(tmp_path / "m"), "--quiet"]) == 2
     assert "label" in capsys.readouterr().err
+    assert main(["train", "--data", str(tmp_path), "--out", str(tmp_path / "m"), "--aam-keep-paint"]) == 2
+    assert "--aam-keep-paint: only with --augment aam" in capsys.readouterr().err
     (tmp_path / "split").mkdir()
     assert main(["detect", str(tmp_path / "split"), "--method", "ufld", "--weights", str(tmp_path / "nope"),
                  "--out", str(tmp_path / "p.json")]) == 2
@@ -326,17 +328,34 @@ def test_aam_bank_never_holds_a_test_case():
     assert {case.illusions[0].type for case in bank} == {path.name for path in SCENES.glob("[1-4]*/*/")}
 
 
-@pytest.mark.parametrize("relight", [False, True])
-def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path, relight):
+def test_aam_keep_paint_leaves_the_images_lanes_unmixed():
+    from lanevil_core.learn.aam import mix, paint_area
+
+    spec = ModelSpec(family="seg", **TINY_SPEC)
+    placed = assign_slots(lane_lines(straight_record()["lanes"], TUSIMPLE_H_SAMPLES, (1280, 720)), spec.slots)
+    lane_masks = torch.from_numpy(encode_lane_mask(placed, spec.mask_size))[None]
+    keep = paint_area(lane_masks, spec.input_size)
+    assert keep.shape == (1, spec.input_size[1], spec.input_size[0])
+    assert 0.0 < float(keep.mean()) < 0.3  # the lines and a pixel around them, not the road
+    images, patches = torch.full((1, 3, *keep.shape[1:]), 0.2), torch.full((1, 3, *keep.shape[1:]), 0.9)
+    ones = torch.ones_like(keep)
+    mixed = mix(images, ones, patches, ones, keep=keep)
+    assert torch.equal(mixed[:, :, keep[0] > 0], images[:, :, keep[0] > 0])  # the paint stays as it was
+    assert torch.allclose(mixed[:, :, keep[0] == 0], patches[:, :, keep[0] == 0])  # the rest is the patch
+
+
+@pytest.mark.parametrize(("relight", "keep_paint"), [(False, False), (True, False), (False, True)])
+def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path, relight, keep_paint):
     from lanevil_core.learn.aam import AamSettings
     from lanevil_core.learn.train import AAM_BANK_FILE, TrainSettings, train
 
     spec = ModelSpec(family="seg", **TINY_SPEC)
     settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=2, batch=2, augment="aam",
                              val_fraction=0.5, max_steps=2,
-                             aam=AamSettings(bank_cases=2, probability=1.0, relight=relight))
+                             aam=AamSettings(bank_cases=2, probability=1.0, relight=relight, keep_paint=keep_paint))
     summary = train(settings, show_progress=False)
     assert summary["augment"] == "aam" and len(summary["history"]) == 2
+    assert summary["aam_settings"]["keep_paint"] is keep_paint
     bank = torch.load(tmp_path / AAM_BANK_FILE, weights_only=False)["patches"]
     assert bank and all(0.0 <= p.mask.min() and p.mask.max() <= 1.0 for p in bank)
     assert all(p.mask.mean() > 0 for p in bank)
