@@ -23,6 +23,9 @@ CATEGORIES: tuple[Category, ...] = ("road_damage", "traffic", "shadow", "reflect
 
 # Where an illusion lands by default: this far ahead of the ego's start, so the first frames see it.
 DEFAULT_AHEAD_M = 22.0
+# Where an illusion that runs along the road ends by default: this far past the ego's last position, so the last
+# frames still see it ahead.
+BEYOND_DRIVE_M = 30.0
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ along the road, whose bright top edge and shadow run parallel to the lane lines.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
@@ -19,7 +20,7 @@ from ..world.environment import sun_direction
 from ..world.paint import MATERIAL_ALBEDO
 from ..world.scene import SurfaceLayer
 from ..world.structures import ground_height, guard_rail
-from .base import Category, CompileContext, EgoDrive, Illusion, Level, register
+from .base import BEYOND_DRIVE_M, Category, CompileContext, EgoDrive, Illusion, Level, register
 
 if TYPE_CHECKING:
     from ..typed import Float32Array
@@ -29,6 +30,8 @@ PAINT_CLEARANCE_M = 0.12  # lateral gap from a lane line's centre to damage that
 # Default start of surface damage ahead of the ego: the 1280x720, 90 deg camera 3 m up first sees the road ~6 m
 # ahead of the vehicle, so damage starting here is in view from the first frame.
 NEAR_AHEAD_M = 6.0
+COUNT_LENGTH_M = 80.0  # the length of road the damage counts of a severity table are for
+INCIDENT_SPACING_M = 40.0  # tyre marks: one incident's marks every this many metres along the stretch
 
 
 @dataclass(frozen=True)
@@ -51,18 +54,26 @@ class _SurfaceDamage(Illusion):
     CATEGORY: ClassVar[Category] = "road_damage"
     TEXEL: ClassVar[float] = 0.03
 
-    extent: StrictFloat = Field(80.0, gt=0, le=400, description="length along the road (m)")
+    extent: StrictFloat | None = Field(
+        None, gt=0, le=400,
+        description="length along the road (m); empty = to 30 m past the ego's last position (every frame sees it)"
+    )
     margin: StrictFloat = Field(0.5, ge=0, le=5, description="reach beyond each carriageway edge (m)")
 
     def start_s(self, drive: EgoDrive) -> float:
         """Where along the road the damage starts: by default where the ego camera's view of the road begins."""
         return self.s if self.s is not None else drive.start_s + NEAR_AHEAD_M
 
+    def end_s(self, drive: EgoDrive) -> float:
+        """Where the damage ends: ``extent`` past its start, by default ``BEYOND_DRIVE_M`` past the drive."""
+        s0 = self.start_s(drive)
+        return s0 + self.extent if self.extent is not None else max(drive.end_s + BEYOND_DRIVE_M, s0 + 1.0)
+
     def _area(self, ctx: CompileContext) -> _Area | None:
         """Where the texture lies, or None when nothing of the road is left past the start."""
         main = ctx.network.main
         s0 = self.start_s(ctx.drive)
-        s1 = min(s0 + self.extent, main.line.length)
+        s1 = min(self.end_s(ctx.drive), main.line.length)
         t0 = -main.half_width - self.margin
         rows = int(np.floor((s1 - s0) / self.TEXEL))
         cols = int(np.ceil(2 * (main.half_width + self.margin) / self.TEXEL))
@@ -223,7 +234,8 @@ class RoadRepair(_SurfaceDamage):
     sealant, some running along the lines, ghosts of old lane lines ground off when the lanes were moved, and at
     the higher levels fresh patches across the lines whose paint has not been restored yet."""
 
-    # patches: rectangles and pothole fills; parallel: sealant strips beside lane lines; trenches: long narrow
+    # patches: rectangles and pothole fills (patches, strips and unpainted count per COUNT_LENGTH_M of road, so a
+    # longer stretch has as many per metre); parallel: sealant strips beside lane lines; trenches: long narrow
     # reinstatements (joint inlays) along the lane lines nearest the ego, repainted: the line runs over them;
     # unpainted: patches laid across those lines after the paint, so the line breaks off there; size: patch
     # size scale; contrast: fresh-asphalt darkness and opacity; ghosts: old lane lines (the ego's first) ground
@@ -244,11 +256,15 @@ class RoadRepair(_SurfaceDamage):
     GHOST_SHIFT_LANES: ClassVar[float] = 0.4  # the old lanes lay this share of a lane width to the right
 
     type: Literal["road_repair"] = "road_repair"
-    patches: StrictInt | None = Field(None, ge=0, le=200, description="repair patches (rectangles and pothole fills)")
-    strips: StrictInt | None = Field(None, ge=0, le=200, description="free-running sealant strips")
+    patches: StrictInt | None = Field(
+        None, ge=0, le=200, description="repair patches (rectangles and pothole fills) per 80 m"
+    )
+    strips: StrictInt | None = Field(None, ge=0, le=200, description="free-running sealant strips per 80 m")
     parallel: StrictInt | None = Field(None, ge=0, le=12, description="sealant strips right beside lane lines")
     trenches: StrictInt | None = Field(None, ge=0, le=8, description="long narrow trench patches along lane lines")
-    unpainted: StrictInt | None = Field(None, ge=0, le=12, description="patches across lane lines, paint not restored")
+    unpainted: StrictInt | None = Field(
+        None, ge=0, le=12, description="patches across lane lines, paint not restored, per 80 m"
+    )
     size: StrictFloat | None = Field(None, gt=0, le=4, description="patch size scale (1 = 0.8-4.4 m long)")
     contrast: StrictFloat | None = Field(None, ge=0, le=1, description="how much darker the fresh asphalt is")
     strip_width: StrictFloat | None = Field(None, ge=0.02, le=0.5, description="sealant strip width (m)")
@@ -274,6 +290,12 @@ class RoadRepair(_SurfaceDamage):
         swing = rng.uniform(-0.15, 0.15, size=8)  # a trench follows its line within a few centimetres
         lines = _lines_near_ego(ctx)
         trench_t = [area.local_t(lines[k % len(lines)] + float(swing[k % 8])) for k in range(v.trenches)]
+        per = area.shape[0] * area.texel / COUNT_LENGTH_M  # the counts are per COUNT_LENGTH_M of road
+
+        def scaled(count: int) -> int:  # at least one where the level has any
+            return max(min(count, 1), round(count * per))
+
+        v = replace(v, patches=scaled(v.patches), strips=scaled(v.strips), unpainted=scaled(v.unpainted))
         rectangles = (v.patches + 1) // 2 + v.patches // 4
         rgba, _ = tex.patches(patch_rng, area.shape, area.texel, rectangles=rectangles,
                               blobs=v.patches - rectangles, trench_t=trench_t, size_scale=v.size,
@@ -355,19 +377,28 @@ class TireMarks(_SurfaceDamage):
         center_t = ([lanes[k % len(lanes)] for k in range(straight - on_line)] + astride
                     + [lanes[k % len(lanes)] for k in range(swerve)]
                     + [lanes[(k + 1) % len(lanes)] for k in range(yaw)])
-        rgba, _ = tex.skid_marks(
-            ctx.rng(self.seed), area.shape, area.texel, straight=straight, swerve=swerve, yaw=yaw,
-            center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
-            length_m=(min(self.length_min, self.length_max), max(self.length_min, self.length_max)),
-            darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"),
-            start_m=self._starts(area, self.level().cluster))
+        rng = ctx.rng(self.seed)
+        length_m = area.shape[0] * area.texel
+        rgba = None
+        for site in range(max(1, math.ceil(length_m / INCIDENT_SPACING_M))):
+            lo, hi = self._starts(min(INCIDENT_SPACING_M, length_m), self.level().cluster)
+            marks, _ = tex.skid_marks(
+                rng if site == 0 else np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape,
+                area.texel, straight=straight, swerve=swerve, yaw=yaw,
+                center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
+                length_m=(min(self.length_min, self.length_max), max(self.length_min, self.length_max)),
+                darkness=_setting(self, "darkness"), track_width_m=_setting(self, "track_width"),
+                start_m=(lo + site * INCIDENT_SPACING_M, hi + site * INCIDENT_SPACING_M))
+            rgba = marks if rgba is None else tex.composite(marks, rgba)
+        assert rgba is not None
         self._emit(ctx, area, rgba, None, over_paint=True, name="tyre marks")
 
-    def _starts(self, area: _Area, cluster: float) -> tuple[float, float]:
-        """s range (m from the texture's start) of the marks' starts: the whole stretch at ``cluster`` 0,
-        shrinking and reaching back up to half the shortest mark before the stretch as ``cluster`` grows."""
+    def _starts(self, span_m: float, cluster: float) -> tuple[float, float]:
+        """s range (m from the incident's site) of one incident's mark starts: the whole ``span_m`` at
+        ``cluster`` 0, shrinking and reaching back up to half the shortest mark before the site as ``cluster``
+        grows."""
         lead = 0.5 * cluster * min(self.length_min, self.length_max)
-        return -lead, -lead + (1.0 - cluster) * area.shape[0] * area.texel
+        return -lead, -lead + (1.0 - cluster) * span_m
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -28,14 +28,13 @@ from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 from ..world import props
 from ..world.primitives import pose_on_road, rotation_z, to_mesh, transformed
 from ..world.scene import Mesh
-from .base import Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
+from .base import BEYOND_DRIVE_M, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
 
 if TYPE_CHECKING:
     from ..typed import FloatArray
 
 EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
 EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position
-BEYOND_DRIVE_M = 30.0  # groups spread up to this far past the ego's last position
 ROAD_END_MARGIN_M = 10.0
 NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, tried against crowding
 GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
@@ -266,14 +265,15 @@ class Pedestrian(TrafficIllusion):
 
     # count: people; group: people per crossing group; distance: first group ahead of the ego start (m);
     # on_lines: share of the people standing on a lane line. Every level is the first ``count`` people of the same
-    # crowd (groups of 11 from 14 m ahead, 80 % on the lines), so a level only adds people. Level 5 is a crowd
-    # crossing right in front of the ego, on both of its lane lines and the lines beyond.
+    # crowd (groups of 6 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only adds
+    # people, and every frame of the drive has a group ahead of it. Level 5 is a busy street: seven crossing
+    # groups over both of the ego's lane lines and the lines beyond, the next always within about 20 m.
     SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
-        CrowdLevel(count=2, group=11, distance=14.0, on_lines=0.8),  # two people on the ego's lines
-        CrowdLevel(count=5, group=11, distance=14.0, on_lines=0.8),  # a few, on the nearest lines
-        CrowdLevel(count=9, group=11, distance=14.0, on_lines=0.8),  # a group across the lanes
-        CrowdLevel(count=15, group=11, distance=14.0, on_lines=0.8),  # a crossing crowd and a second group
-        CrowdLevel(count=22, group=11, distance=14.0, on_lines=0.8),  # crowds over every line ahead
+        CrowdLevel(count=3, group=6, distance=14.0, on_lines=0.8),  # a few people on the ego's lines
+        CrowdLevel(count=8, group=6, distance=14.0, on_lines=0.8),  # one in every group
+        CrowdLevel(count=15, group=6, distance=14.0, on_lines=0.8),  # small groups across the lanes
+        CrowdLevel(count=25, group=6, distance=14.0, on_lines=0.8),  # crossing crowds all along the drive
+        CrowdLevel(count=40, group=6, distance=14.0, on_lines=0.8),  # crowds over every line, all along
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
@@ -311,14 +311,15 @@ class Bicycle(TrafficIllusion):
 
     # count: cyclists; group: cyclists side by side; distance: first group ahead of the ego start (m);
     # on_lines: share of cyclists riding on a lane line. Every level is the first ``count`` riders of the same
-    # club ride (groups of 10 from 14 m ahead, 80 % on the lines), so a level only adds riders. Level 5 is the
-    # whole ride spread over the road just ahead of the ego, most of it on the lane lines.
+    # club ride (groups of 6 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only
+    # adds riders, and every frame of the drive has riders ahead of it. Level 5 is the whole ride: seven groups
+    # over the road, most of it on the lane lines, the next always within about 20 m.
     SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
-        CrowdLevel(count=2, group=10, distance=14.0, on_lines=0.8),  # two riders on the ego's lines
-        CrowdLevel(count=4, group=10, distance=14.0, on_lines=0.8),  # a few, on the nearest lines
-        CrowdLevel(count=7, group=10, distance=14.0, on_lines=0.8),  # a bunch across the lanes
-        CrowdLevel(count=13, group=10, distance=14.0, on_lines=0.8),  # the front group and followers
-        CrowdLevel(count=20, group=10, distance=14.0, on_lines=0.8),  # the club ride over every line
+        CrowdLevel(count=3, group=6, distance=14.0, on_lines=0.8),  # a few riders on the ego's lines
+        CrowdLevel(count=8, group=6, distance=14.0, on_lines=0.8),  # one in every group
+        CrowdLevel(count=15, group=6, distance=14.0, on_lines=0.8),  # small bunches across the lanes
+        CrowdLevel(count=25, group=6, distance=14.0, on_lines=0.8),  # bunches all along the drive
+        CrowdLevel(count=40, group=6, distance=14.0, on_lines=0.8),  # the club ride over every line, all along
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")

@@ -91,14 +91,27 @@ SHARE_SIZE = (160, 90)  # renders that only locate an illusion are this small
 IN_VIEW_SHARE = 0.05  # a frame shows the illusion when it changes at least this share of the lane band
 
 
+def drive_changes(case: Case, step: int) -> tuple[list[int], list[BandChange]]:
+    """Every ``step``-th frame of the drive and the illusion's band change on it (renders at ``SHARE_SIZE``)."""
+    candidates = list(range(0, case.ego.frames, step))
+    return candidates, frame_changes(clean_of(case), case, candidates, SHARE_SIZE)
+
+
+def shown_share(case: Case, step: int = 5) -> float:
+    """Share of the drive's frames (every ``step``-th tried) on which the illusion is in view: it changes at least
+    ``IN_VIEW_SHARE`` of the lane band. A test case should show its illusion on most of its frames, since the
+    benchmark scores every one."""
+    _, changes = drive_changes(case, step)
+    return sum(change.share >= IN_VIEW_SHARE for change in changes) / max(len(changes), 1)
+
+
 def in_view_frames(case: Case, count: int, step: int = 2) -> tuple[int, ...]:
     """``count`` frames of the drive, evenly over those where the illusion changes at least ``IN_VIEW_SHARE``
     of the lane band (every ``step``-th frame tried at ``SHARE_SIZE``); the frames where it changes most when
     fewer show it; the evenly spaced frames of the whole drive when it never does."""
     from ..dataset.plan import evenly_spaced
 
-    candidates = list(range(0, case.ego.frames, step))
-    changes = frame_changes(clean_of(case), case, candidates, SHARE_SIZE)
+    candidates, changes = drive_changes(case, step)
     shown = [frame for frame, change in zip(candidates, changes, strict=True) if change.share >= IN_VIEW_SHARE]
     if not shown:
         return evenly_spaced(case.ego.frames, count)

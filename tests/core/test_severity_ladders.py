@@ -1,5 +1,6 @@
 """Severity means something: for every illusion type, on every one of its stock originals, the change of what a
-lane detector looks at (the local contrast of the lane band, ``illusion_effect``) rises strictly from level 1 to 5.
+lane detector looks at (the local contrast of the lane band, ``illusion_effect``) rises strictly from level 1 to 5,
+and level 5 stays in view over the drive.
 
 Rendering every original's ladder takes minutes, so the fast test takes a deterministic sample (one original per
 type, the types taking the originals in turn) and the ``slow`` test covers every original."""
@@ -10,8 +11,9 @@ import pytest
 
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.library.stock import ORIGINALS, original_case, original_id
-from lanevil_core.pipeline.illusion_effect import ladder, lane_band
+from lanevil_core.pipeline.illusion_effect import ladder, lane_band, shown_share, with_illusion
 
+SHOWN_SHARE_MIN = 0.25  # the level-5 illusion is in view on at least this share of its drive's frames
 FRAMES = (0, 6, 12)  # the illusions stand about 14-22 m ahead of the ego's start: in view and near
 SIZE = (256, 144)
 SAMPLE = [(name, position % len(ORIGINALS[name])) for position, name in enumerate(sorted(REGISTRY))]
@@ -44,3 +46,11 @@ def test_lane_band_effect_rises_with_the_level_on_a_sample(illusion_type, index)
 @pytest.mark.parametrize(("illusion_type", "index"), EVERY, ids=[f"{n}-{i}" for n, i in EVERY])
 def test_lane_band_effect_rises_with_the_level_on_every_original(illusion_type, index):
     _assert_rises(illusion_type, index)
+
+
+@pytest.mark.parametrize(("illusion_type", "index"), SAMPLE, ids=[f"{n}-{i}" for n, i in SAMPLE])
+def test_level5_is_in_view_over_the_drive(illusion_type, index):
+    """The full test split scores every frame of a case: crowds, cracks and tyre marks run on along the drive
+    instead of being passed in its first seconds (bench/in_view.py measures every original)."""
+    case = with_illusion(original_case(illusion_type, index), {"type": illusion_type, "severity": 5})
+    assert shown_share(case) >= SHOWN_SHARE_MIN, original_id(illusion_type, index)

@@ -79,7 +79,7 @@ def _patch_coverage(rng: np.random.Generator, shape: tuple[int, int], texel: flo
     if kind == "blob":
         sd = _blob_distance(rng, ds, dt, half)
     else:
-        angle = rng.normal(0.0, 0.02)
+        angle = rng.normal(0.0, 0.02) * (kind != "trench")  # a trench runs parallel to its line, however long
         ca, sa = np.cos(angle), np.sin(angle)
         radius = min(rng.uniform(0.02, 0.15), 0.5 * min(half))
         sd = _rounded_box_distance(ca * ds - sa * dt, sa * ds + ca * dt, half, radius)
