@@ -336,9 +336,10 @@ class TireMarks(_SurfaceDamage):
 
     TEXEL: ClassVar[float] = 0.04
     # on_line: straight marks of a vehicle braking astride a lane line, one track running along the paint;
-    # cluster: how tightly the marks of the incident bunch at the start of the marked stretch (0 = spread
-    # over it; 0.9 = all start within its first tenth, most of them already under way where it begins, so the
-    # rubber is at its darkest in the camera's first view).
+    # cluster: how tightly an incident's marks bunch at its site (0 = spread over the INCIDENT_SPACING_M after
+    # it; 0.9 = all start within its first tenth, most of them already under way there, so the rubber is at its
+    # darkest in the camera's first view). The level's marks repeat as one incident every INCIDENT_SPACING_M
+    # along the stretch, so every frame of the drive has some ahead.
     SEVERITY: ClassVar[tuple[TireMarksLevel, ...]] = (
         TireMarksLevel(straight=1, swerve=0, yaw=0, on_line=0, darkness=0.45, track_width=0.18,
                        cluster=0.0),
