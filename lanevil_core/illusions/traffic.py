@@ -126,7 +126,7 @@ class TrafficIllusion(Illusion):
 
     CATEGORY: ClassVar[Category] = "traffic"
 
-    count: StrictInt | None = Field(None, ge=1, le=40, description="number of participants; empty = severity table")
+    count: StrictInt | None = Field(None, ge=1, le=100, description="number of participants; empty = severity table")
     distance: StrictFloat | None = Field(
         None, ge=3, le=300, description="distance of the first one ahead of the ego start (m); empty = severity table"
     )
@@ -265,15 +265,15 @@ class Pedestrian(TrafficIllusion):
 
     # count: people; group: people per crossing group; distance: first group ahead of the ego start (m);
     # on_lines: share of the people standing on a lane line. Every level is the first ``count`` people of the same
-    # crowd (groups of 6 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only adds
+    # crowd (groups of 11 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only adds
     # people, and every frame of the drive has a group ahead of it. Level 5 is a busy street: seven crossing
-    # groups over both of the ego's lane lines and the lines beyond, the next always within about 20 m.
+    # crowds over both of the ego's lane lines and the lines beyond, the next always within about 20 m.
     SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
-        CrowdLevel(count=3, group=6, distance=14.0, on_lines=0.8),  # a few people on the ego's lines
-        CrowdLevel(count=8, group=6, distance=14.0, on_lines=0.8),  # one in every group
-        CrowdLevel(count=15, group=6, distance=14.0, on_lines=0.8),  # small groups across the lanes
-        CrowdLevel(count=25, group=6, distance=14.0, on_lines=0.8),  # crossing crowds all along the drive
-        CrowdLevel(count=40, group=6, distance=14.0, on_lines=0.8),  # crowds over every line, all along
+        CrowdLevel(count=4, group=11, distance=14.0, on_lines=0.8),  # a few people on the ego's lines
+        CrowdLevel(count=11, group=11, distance=14.0, on_lines=0.8),  # one or two in every group
+        CrowdLevel(count=22, group=11, distance=14.0, on_lines=0.8),  # small groups across the lanes
+        CrowdLevel(count=44, group=11, distance=14.0, on_lines=0.8),  # crossing crowds all along the drive
+        CrowdLevel(count=77, group=11, distance=14.0, on_lines=0.8),  # crowds over every line, all along
     )
     type: Literal["pedestrian"] = "pedestrian"
     motion: Literal["crossing", "standing"] = Field("crossing", description="walking across the road or standing")
@@ -311,15 +311,15 @@ class Bicycle(TrafficIllusion):
 
     # count: cyclists; group: cyclists side by side; distance: first group ahead of the ego start (m);
     # on_lines: share of cyclists riding on a lane line. Every level is the first ``count`` riders of the same
-    # club ride (groups of 6 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only
+    # club ride (groups of 10 from 14 m ahead, spread over the whole drive, 80 % on the lines), so a level only
     # adds riders, and every frame of the drive has riders ahead of it. Level 5 is the whole ride: seven groups
     # over the road, most of it on the lane lines, the next always within about 20 m.
     SEVERITY: ClassVar[tuple[CrowdLevel, ...]] = (
-        CrowdLevel(count=3, group=6, distance=14.0, on_lines=0.8),  # a few riders on the ego's lines
-        CrowdLevel(count=8, group=6, distance=14.0, on_lines=0.8),  # one in every group
-        CrowdLevel(count=15, group=6, distance=14.0, on_lines=0.8),  # small bunches across the lanes
-        CrowdLevel(count=25, group=6, distance=14.0, on_lines=0.8),  # bunches all along the drive
-        CrowdLevel(count=40, group=6, distance=14.0, on_lines=0.8),  # the club ride over every line, all along
+        CrowdLevel(count=4, group=10, distance=14.0, on_lines=0.8),  # a few riders on the ego's lines
+        CrowdLevel(count=10, group=10, distance=14.0, on_lines=0.8),  # one or two in every group
+        CrowdLevel(count=20, group=10, distance=14.0, on_lines=0.8),  # small bunches across the lanes
+        CrowdLevel(count=40, group=10, distance=14.0, on_lines=0.8),  # bunches all along the drive
+        CrowdLevel(count=70, group=10, distance=14.0, on_lines=0.8),  # the club ride over every line, all along
     )
     type: Literal["bicycle"] = "bicycle"
     motion: Literal["riding", "crossing"] = Field("riding", description="riding along the road or crossing it")
