@@ -43,6 +43,11 @@ class _Area:
     texel: float
     shape: tuple[int, int]
 
+    @property
+    def length_m(self) -> float:
+        """How far the texture runs along the road (m)."""
+        return self.shape[0] * self.texel
+
     def local_t(self, t_road: float) -> float:
         """Texture column coordinate (m from the texture corner) of road-frame ``t_road``."""
         return t_road - self.t0
@@ -290,7 +295,7 @@ class RoadRepair(_SurfaceDamage):
         swing = rng.uniform(-0.15, 0.15, size=8)  # a trench follows its line within a few centimetres
         lines = _lines_near_ego(ctx)
         trench_t = [area.local_t(lines[k % len(lines)] + float(swing[k % 8])) for k in range(v.trenches)]
-        per = area.shape[0] * area.texel / COUNT_LENGTH_M  # the counts are per COUNT_LENGTH_M of road
+        per = area.length_m / COUNT_LENGTH_M  # the counts are per COUNT_LENGTH_M of road
 
         def scaled(count: int) -> int:  # at least one where the level has any
             return max(min(count, 1), round(count * per))
@@ -379,10 +384,9 @@ class TireMarks(_SurfaceDamage):
                     + [lanes[k % len(lanes)] for k in range(swerve)]
                     + [lanes[(k + 1) % len(lanes)] for k in range(yaw)])
         rng = ctx.rng(self.seed)
-        length_m = area.shape[0] * area.texel
         rgba = None
-        for site in range(max(1, math.ceil(length_m / INCIDENT_SPACING_M))):
-            lo, hi = self._starts(min(INCIDENT_SPACING_M, length_m), self.level().cluster)
+        for site in range(max(1, math.ceil(area.length_m / INCIDENT_SPACING_M))):
+            lo, hi = self._starts(min(INCIDENT_SPACING_M, area.length_m), self.level().cluster)
             marks, _ = tex.skid_marks(
                 rng if site == 0 else np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape,
                 area.texel, straight=straight, swerve=swerve, yaw=yaw,

@@ -37,7 +37,8 @@ if TYPE_CHECKING:
 
 Side = Literal["left", "right"]
 Albedo = Annotated[float, Field(ge=0.0, le=1.0)]
-BEYOND_DRIVE_M = 40.0  # structures reach this far past the ego's last position
+STRUCTURES_BEYOND_DRIVE_M = 40.0  # structures reach this far past the ego's last position (the shadow types'
+# own reach; base.BEYOND_DRIVE_M is that of crowds and road damage)
 ROAD_END_MARGIN_M = 5.0
 MAX_AHEAD_DEG = 75.0  # the sun never stands further ahead than this when its azimuth is solved for
 UPRIGHT_KINDS = ("streetlight", "pole")  # props already standing beside the road that our posts must not hit
@@ -115,7 +116,7 @@ class SunShadowIllusion(Illusion):
     def extent(self, drive: EgoDrive, length: float | None) -> tuple[float, float]:
         """(s0, s1) along the main road: from ``start_s`` over ``length``, or to past the end of the drive."""
         s0 = self.start_s(drive)
-        s1 = s0 + length if length is not None else drive.end_s + BEYOND_DRIVE_M
+        s1 = s0 + length if length is not None else drive.end_s + STRUCTURES_BEYOND_DRIVE_M
         s1 = min(s1, drive.road_length - ROAD_END_MARGIN_M)
         return s0, max(s1, s0 + 1.0)
 
