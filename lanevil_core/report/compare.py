@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from itertools import combinations
 from pathlib import Path
+from typing import Any
 
 from ..case import write_atomic
 from ..export.encode import figure_png
@@ -356,6 +357,19 @@ def breakdown_csv(detectors: list[Detector]) -> str:
                                                           if ALL not in (row.category, row.type)]))
 
 
+PLOT_LEGEND_INSIDE_MAX = 6  # more detectors than this: the legend goes beside the axes, off the lines
+PLOT_COLORS = 10  # matplotlib's default colour cycle
+PLOT_MARKERS = ("o", "s", "^", "D", "v", "P")
+
+
+def line_style(index: int) -> dict[str, Any]:
+    """Colour, marker and dash of the ``index``-th detector's line: one colour each for the first ten, then the
+    colours again with another marker and dash, so no two of up to 60 lines look alike."""
+    turn = index // PLOT_COLORS
+    return {"color": f"C{index % PLOT_COLORS}", "marker": PLOT_MARKERS[turn % len(PLOT_MARKERS)],
+            "linestyle": "-" if turn % 2 == 0 else "--"}
+
+
 def comparison_plot(detectors: list[Detector]) -> bytes:
     """PNG: accuracy drop (percentage points) against severity over all categories, one line per detector."""
     import matplotlib
@@ -363,19 +377,24 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
-    for detector in detectors:
+    many = len(detectors) > PLOT_LEGEND_INSIDE_MAX
+    fig, ax = plt.subplots(figsize=(9.0 if many else 7.0, 4.2), dpi=120)
+    for index, detector in enumerate(detectors):
         row = category_rows(detector.report)[-1]
         points = [(level, -100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
         if points:
-            ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", linewidth=1.8, label=detector.name)
+            ax.plot([p[0] for p in points], [p[1] for p in points], linewidth=1.8, label=detector.name,
+                    **line_style(index))
     ax.axhline(0.0, color="grey", linewidth=0.8)
     ax.set_xticks(list(LEVELS))
     ax.set_xlabel("severity level")
     ax.set_ylabel("accuracy drop vs original (percentage points)")
     ax.set_title("Accuracy drop by severity, per detector")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    if many:
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), ncol=1 + len(detectors) // 16)
+    else:
+        ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     return figure_png(fig)
 

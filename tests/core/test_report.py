@@ -20,6 +20,7 @@ from lanevil_core.metrics.evaluate import ScoredImage, score_tusimple_files
 from lanevil_core.metrics.tusimple import ImageScore, f1_ganet
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
+from lanevil_core.report.compare import line_style
 from lanevil_core.report.robustness import ALL, build_report, markdown, severity_csv
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
@@ -288,3 +289,9 @@ def test_compare_says_which_detectors_are_separable():
     assert "Not separable on average (accuracy gap): strong and twin." in separability
     defences = text.split("## Defences")[1].split("##")[0]
     assert re.search(r"\| strong \| [\d.]+ \(\+18\.00 \[\+\d", defences) and "## Accuracy by type and level" in text
+
+
+def test_comparison_lines_stay_distinguishable() -> None:
+    """A defence study compares 18+ runs: no two of the first 60 lines share colour, marker and dash."""
+    styles = {tuple(sorted(line_style(index).items())) for index in range(60)}
+    assert len(styles) == 60
