@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 from ..case import write_atomic
-from ..export.encode import figure_png
 from .interval import Interval, Term, combination_interval
 from .robustness import (
     ALL,
@@ -32,6 +31,7 @@ from .robustness import (
     _csv,
     _number,
     _pct,
+    drop_figure_png,
     gap_cell,
     interval_numbers,
     with_interval,
@@ -385,18 +385,8 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
         if points:
             ax.plot([p[0] for p in points], [p[1] for p in points], linewidth=1.8, label=detector.name,
                     **line_style(index))
-    ax.axhline(0.0, color="grey", linewidth=0.8)
-    ax.set_xticks(list(LEVELS))
-    ax.set_xlabel("severity level")
-    ax.set_ylabel("accuracy drop vs original (percentage points)")
-    ax.set_title("Accuracy drop by severity, per detector")
-    ax.grid(True, alpha=0.3)
-    if many:
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), ncol=1 + len(detectors) // 16)
-    else:
-        ax.legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    return figure_png(fig)
+    return drop_figure_png(fig, ax, "Accuracy drop by severity, per detector", legend_beside=many,
+                           legend_columns=1 + len(detectors) // 16)
 
 
 def write_comparison(detectors: list[Detector], out_dir: str | Path, f1_variant: str,

@@ -22,6 +22,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from dataclasses import field as default_field
 from pathlib import Path
+from typing import Any
 
 from ..case import write_atomic
 from ..export.encode import figure_png
@@ -292,13 +293,22 @@ def severity_plot(report: Report) -> bytes:
             continue
         style = {"color": "black", "linestyle": "--", "linewidth": 2.2} if row.category == ALL else {"linewidth": 1.6}
         ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=row.category, **style)
+    return drop_figure_png(fig, ax, report.title or "Accuracy drop by severity")
+
+
+def drop_figure_png(fig: Any, ax: Any, title: str, legend_beside: bool = False, legend_columns: int = 1) -> bytes:
+    """Finish an accuracy-drop-by-severity plot (zero line, level ticks, labels, grid, legend) and encode it;
+    ``legend_beside`` puts the legend right of the axes, off the lines, for plots with many of them."""
     ax.axhline(0.0, color="grey", linewidth=0.8)
     ax.set_xticks(list(LEVELS))
     ax.set_xlabel("severity level")
     ax.set_ylabel("accuracy drop vs original (percentage points)")
-    ax.set_title(report.title or "Accuracy drop by severity")
+    ax.set_title(title)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    if legend_beside:
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), ncol=legend_columns)
+    else:
+        ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     return figure_png(fig)
 
