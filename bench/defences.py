@@ -12,7 +12,7 @@ Usage::
     python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
         [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd,aam_keep_paint] \\
         [--seeds 0,1,2] [--jobs 2] \\
-        [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3] [--patience 4] [--train-only]
+        [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3] [--patience 4 [--min-epochs 15]] [--train-only]
 
 ``aam_keep_paint`` is AAM with ``lanevil train --aam-keep-paint`` (each image's own lane markings left unmixed).
 
@@ -58,6 +58,7 @@ def run_one(args: argparse.Namespace, name: str) -> tuple[str, float]:
         extra += ["--init", str(args.init)] if args.init else []
         extra += ["--lr", str(args.lr)] if args.lr else []
         extra += ["--patience", str(args.patience)] if args.patience else []
+        extra += ["--min-epochs", str(args.min_epochs)] if args.min_epochs else []
         augment, settings = VARIANTS.get(augment, (augment, ()))
         lanevil("train", "--data", str(args.data), "--out", str(model_dir), "--model", args.family,
                 "--epochs", str(args.epochs), "--augment", augment, "--seed", seed, "--threads", "1", "--quiet",
@@ -86,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lr", type=float, default=None, help="peak learning rate (default: lanevil train's)")
     parser.add_argument("--patience", type=int, default=None,
                         help="train each run until validation accuracy has not improved for this many epochs")
+    parser.add_argument("--min-epochs", type=int, default=0,
+                        help="with --patience: no run stops before this many epochs")
     parser.add_argument("--train-only", action="store_true", help="train every run, then stop (no detection)")
     args = parser.parse_args(argv)
     if args.bench is None and not args.train_only:

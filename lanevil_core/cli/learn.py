@@ -53,6 +53,8 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--patience", type=count(1), default=None,
                         help="stop when validation accuracy has not improved for this many epochs and keep the best "
                              "epoch's weights (full-length training; --epochs is then the most)")
+    parser.add_argument("--min-epochs", type=count(0), default=0,
+                        help="with --patience: train at least this many epochs before it may stop (default 0)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -71,6 +73,10 @@ def _run_train(args: argparse.Namespace) -> int:
         raise UsageError(f"--init {args.init}: no such file")
     if args.aam_keep_paint and args.augment != "aam":
         raise UsageError(f"--aam-keep-paint: only with --augment aam (not {args.augment})")
+    if args.min_epochs and args.patience is None:
+        raise UsageError("--min-epochs: only with --patience")
+    if args.min_epochs > args.epochs:
+        raise UsageError(f"--min-epochs {args.min_epochs}: more than --epochs {args.epochs}")
     if not 0.0 <= args.val_fraction < 1.0:
         raise UsageError(f"--val {args.val_fraction}: must lie in [0, 1)")
     try:
@@ -80,6 +86,7 @@ def _run_train(args: argparse.Namespace) -> int:
                                  seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
                                  max_steps=args.max_steps, threads=args.threads, patience=args.patience,
+                                 min_epochs=args.min_epochs,
                                  aam=AamSettings(keep_paint=args.aam_keep_paint))
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:

@@ -76,6 +76,8 @@ class TrainSettings:
     # stop once validation accuracy has not improved for this many epochs, and keep the best epoch's weights
     # (``epochs`` is then the most there can be; the learning-rate schedule still spans it)
     patience: int | None = None
+    # with ``patience``: no stop before this many epochs (a plateau early in training is not the end of it)
+    min_epochs: int = 0
     aam: AamSettings = field(default_factory=AamSettings)
     pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
@@ -140,9 +142,12 @@ def _lr_at(step: int, total: int, base: float) -> float:
 Progress = Callable[[str], None]
 
 
-def _patience_spent(best: dict[str, Any] | None, epochs_done: int, patience: int | None) -> bool:
-    """Whether ``patience`` epochs have passed without gain since the best one (``--patience``)."""
-    return best is not None and patience is not None and epochs_done - best["epoch"] >= patience
+def _patience_spent(best: dict[str, Any] | None, epochs_done: int, patience: int | None,
+                    min_epochs: int = 0) -> bool:
+    """Whether ``patience`` epochs have passed without gain since the best one (``--patience``), once at least
+    ``min_epochs`` have run (``--min-epochs``)."""
+    return (best is not None and patience is not None and epochs_done >= min_epochs
+            and epochs_done - best["epoch"] >= patience)
 
 
 def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, Any]], data_sha: str) -> list:
@@ -243,7 +248,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
 
     model.train()
     for epoch in range(start_epoch, settings.epochs):
-        if _patience_spent(best, epoch, settings.patience):
+        if _patience_spent(best, epoch, settings.patience, settings.min_epochs):
             break  # a resumed run that had already stopped
         if bank and epoch >= 1:  # the model's attention means something after one epoch
             scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
@@ -289,7 +294,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
             best = {"epoch": epoch + 1, "model": {k: v.detach().cpu().clone() for k, v in model.state_dict().items()}}
         _save({"model": model.state_dict(), "optimizer": optimizer.state_dict(), "epoch": epoch,
                "history": history, "data_sha256": data_sha, "spec": asdict(spec), "best": best}, checkpoint_path)
-        if _patience_spent(best, epoch + 1, settings.patience):
+        if _patience_spent(best, epoch + 1, settings.patience, settings.min_epochs):
             if show_progress:
                 print(f"no gain for {settings.patience} epochs: keeping the best epoch", flush=True)
             break
@@ -321,6 +326,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "val_accuracy": (history[best["epoch"] - 1]["val_accuracy"] if best is not None
                          else history[-1]["val_accuracy"] if history else None),
         "patience": settings.patience,
+        "min_epochs": settings.min_epochs,
         "epochs_run": len(history),
         "kept_epoch": best["epoch"] if best is not None else len(history),
         "history": history,

@@ -158,6 +158,26 @@ def test_patience_stops_when_validation_stops_improving_and_keeps_the_best_epoch
     assert all(torch.equal(weights[k], v.half() if v.is_floating_point() else v) for k, v in best["model"].items())
 
 
+def test_min_epochs_holds_patience_back_until_they_have_run(tiny_dataset, tmp_path):
+    from lanevil_core.learn.train import _patience_spent
+
+    assert _patience_spent({"epoch": 1}, 3, patience=2) and not _patience_spent({"epoch": 1}, 3, 2, min_epochs=4)
+    assert _patience_spent({"epoch": 1}, 4, 2, min_epochs=4) and not _patience_spent(None, 9, 2, min_epochs=4)
+    most = 4
+    assert _train(tiny_dataset, tmp_path, "seg", "--epochs", str(most), "--patience", "1", "--min-epochs",
+                  str(most), "--lr", "3e-3") == 0
+    summary = json.loads((tmp_path / "training.json").read_text())
+    assert summary["epochs_run"] == most and summary["min_epochs"] == most
+    assert summary["kept_epoch"] == int(np.argmax([h["val_accuracy"] for h in summary["history"]])) + 1
+
+
+def test_min_epochs_needs_patience_and_fits_the_epochs(tiny_dataset, tmp_path, capsys):
+    assert _train(tiny_dataset, tmp_path, "seg", "--min-epochs", "2") == 2
+    assert "--min-epochs: only with --patience" in capsys.readouterr().err
+    assert _train(tiny_dataset, tmp_path, "seg", "--epochs", "2", "--patience", "1", "--min-epochs", "3") == 2
+    assert "--min-epochs 3: more than --epochs 2" in capsys.readouterr().err
+
+
 def test_training_samples_reuse_their_targets_and_match_a_fresh_encoding(tiny_dataset):
     from lanevil_core.learn.data import LabelledFrames, targets_for
 
