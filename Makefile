@@ -48,9 +48,9 @@ test-browser: $(STAMP)
 # trained at 320x180 on a diversified clean split seen through the paper's camera (4,000 frames at 640x360), then
 # fine-tuned from those models on a split whose cameras and sensors are drawn (--vary-camera, 2,000 frames; ufld
 # and seg 6 epochs from their backbones, ganet and laneatt 5 from the whole model at half the learning rate, then
-# laneatt 8 more); ufld and seg then 8 and 6 more epochs at half the rate on a second randomised split (4,000
-# frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere, 60 % of its cameras at car
-# heights). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The three splits
+# laneatt 8 more); ufld, seg and ganet then 8, 6 and 5 more epochs at half the rate on a second randomised split
+# (4,000 frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere, 60 % of its cameras at
+# car heights). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The three splits
 # render in about 3 + 3 + 13 min (the last measured with one worker beside two training runs); MODELS_DATA,
 # MODELS_DATA_VARIED and MODELS_DATA_VARIED2 keep the renders for reruns.
 MODELS_DATA ?= out/models-data
@@ -80,8 +80,10 @@ models: $(STAMP)
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier-base --model bezier --epochs 6
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 10 --lr 1e-3 \
 	  --threads 1 --init out/models/bezier-base/weights.pt
-	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet-v --model ganet --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/ganet-base/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED2) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
+	  --threads 1 --init out/models/ganet-v/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt-v --model laneatt --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/laneatt-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 8 --lr 1e-3 \
