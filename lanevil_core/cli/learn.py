@@ -13,8 +13,9 @@ from .base import Command, UsageError, count, parse_size
 def _train_arguments(parser: argparse.ArgumentParser) -> None:
     from ..detect.model_spec import BACKBONES, FAMILIES
 
-    parser.add_argument("--data", type=Path, required=True,
-                        help="dataset folder written by `lanevil dataset` (its train/ split and train_label.json)")
+    parser.add_argument("--data", type=Path, required=True, action="append",
+                        help="dataset folder written by `lanevil dataset` (its train/ split and train_label.json); "
+                             "repeat to train on several splits together (each case folder is held out whole)")
     parser.add_argument("--out", type=Path, required=True, help="model folder to write")
     parser.add_argument("--model", choices=FAMILIES, default="ufld",
                         help="detector family: ufld (row anchors), seg (segmentation), laneatt (line anchors + "
@@ -67,8 +68,11 @@ def _run_train(args: argparse.Namespace) -> int:
     from ..learn.aam import AamSettings
     from ..learn.train import TrainError, TrainSettings, train
 
-    if not args.data.is_dir():
-        raise UsageError(f"--data {args.data}: no such folder")
+    for data in args.data:
+        if not data.is_dir():
+            raise UsageError(f"--data {data}: no such folder")
+    if len(set(args.data)) < len(args.data):
+        raise UsageError("--data: the same folder given twice")
     if args.init is not None and not args.init.is_file():
         raise UsageError(f"--init {args.init}: no such file")
     if args.aam_keep_paint and args.augment != "aam":
@@ -81,7 +85,7 @@ def _run_train(args: argparse.Namespace) -> int:
         raise UsageError(f"--val {args.val_fraction}: must lie in [0, 1)")
     try:
         spec = ModelSpec(family=args.model, backbone=args.backbone, width=args.width, input_size=args.size)
-        settings = TrainSettings(data=args.data, out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,
+        settings = TrainSettings(data=tuple(args.data), out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,
                                  lr=args.lr, augment=args.augment, affine=args.affine, device=args.device,
                                  seed=args.seed,
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,

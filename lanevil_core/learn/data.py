@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections import OrderedDict
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -47,7 +48,7 @@ from .augment import AUGMENT_PROBABILITY, Augment
 
 @dataclass(frozen=True)
 class Targets:
-    """What a network learns from one frame: row-anchor classes ``(slots, anchors)``, lane mask ``(h, w)``, slot
+    """What a network learns from one frame: row-anchor classes ``(slots, anchors)``, lane mask ``(h, w)`` uint8, slot
     existence ``(slots,)`` and the family's own targets by batch key (``FAMILY_TARGETS``)."""
 
     rows: np.ndarray
@@ -88,8 +89,10 @@ def targets_for(record: dict[str, Any], frame_size: tuple[int, int], spec: Model
     if flip:
         placed = mirror_slots(placed)
     extra = FAMILY_TARGETS[spec.family](placed, spec) if spec.family in FAMILY_TARGETS else {}
+    # the mask kept as uint8 (slot + 1 <= 255): the targets of a 40,000-frame split are cached per frame and side,
+    # and at int64 its 160x90 masks alone would take 8 GB
     return Targets(encode_row_anchors(placed, spec.anchor_rows, spec.grid),
-                   encode_lane_mask(placed, spec.mask_size),
+                   encode_lane_mask(placed, spec.mask_size).astype(np.uint8),
                    np.array([line is not None for line in placed], np.float32), extra)
 
 
@@ -152,7 +155,7 @@ class _Frames(Dataset):
                 image = np.ascontiguousarray(image[:, ::-1])
         targets = self.targets(index, flip, M_out_in)
         return {"image": torch.from_numpy(network_input(image, self.spec.input_size)),
-                "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask),
+                "rows": torch.from_numpy(targets.rows), "mask": torch.from_numpy(targets.mask).long(),
                 "exist": torch.from_numpy(targets.exist), "index": torch.tensor(index),
                 **{key: torch.from_numpy(value) for key, value in targets.extra.items()}}
 
@@ -166,23 +169,48 @@ def file_sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-class LabelledFrames(_Frames):
-    """Frames of a split folder (``DIR/train``), the chosen ``indices`` of its label file, held in memory."""
+class SplitError(ValueError):
+    """A ``--data`` folder that holds no usable train split."""
 
-    def __init__(self, split_dir: str | Path, spec: ModelSpec, indices: list[int] | None = None, train: bool = True,
-                 augment: Augment | None = None, seed: int = 0, affine: bool = False) -> None:
+
+def read_splits(data_dirs: Sequence[Path]) -> tuple[list[tuple[Path, dict[str, Any]]], str]:
+    """Every frame of the train splits of ``data_dirs`` (each a dataset folder with ``train/`` or a split folder)
+    as (split folder, record) pairs in order, and the data's identity: the label file's sha256 for one split, the
+    sha256 of the label files' hashes in order for several."""
+    frames: list[tuple[Path, dict[str, Any]]] = []
+    hashes = []
+    for data in data_dirs:
+        split_dir = data / "train" if (data / "train").is_dir() else data
+        try:
+            label_file = split_labels(split_dir)
+        except ValueError as error:
+            raise SplitError(f"--data {data}: {error}") from None
+        records = read_records(label_file)
+        if not records:
+            raise SplitError(f"--data {data}: {label_file.name} has no frames")
+        frames += [(split_dir, record) for record in records]
+        hashes.append(file_sha256(label_file))
+    identity = hashes[0] if len(hashes) == 1 else hashlib.sha256("\n".join(hashes).encode()).hexdigest()
+    return frames, identity
+
+
+class LabelledFrames(_Frames):
+    """Frames of one or more split folders, held in memory: ``frames`` are (split folder, TuSimple record) pairs,
+    as ``read_splits`` returns them, and ``indices`` the chosen ones (default all)."""
+
+    def __init__(self, frames: Sequence[tuple[Path, dict[str, Any]]], spec: ModelSpec,
+                 indices: list[int] | None = None, train: bool = True, augment: Augment | None = None,
+                 seed: int = 0, affine: bool = False) -> None:
         super().__init__(spec, train, augment, seed, affine)
-        self.split_dir = Path(split_dir)
-        records = read_records(split_labels(self.split_dir))
-        chosen = range(len(records)) if indices is None else indices
-        self.records = [records[i] for i in chosen]
-        images = []
-        for record in self.records:
-            rgb = read_rgb(self.split_dir / record["raw_file"])
+        chosen = [frames[i] for i in (range(len(frames)) if indices is None else indices)]
+        self.records = [record for _, record in chosen]
+        width, height = spec.input_size
+        # filled in place: a 40,000-frame split at 320x180 is 6.9 GB, and a list stacked afterwards holds it twice
+        self.images = np.empty((len(chosen), height, width, 3), np.uint8)
+        for slot, (split_dir, record) in enumerate(chosen):
+            rgb = read_rgb(split_dir / record["raw_file"])
             self.frame_sizes.append((rgb.shape[1], rgb.shape[0]))
-            images.append(resized(rgb, spec.input_size))
-        if images:
-            self.images = np.stack(images)
+            self.images[slot] = resized(rgb, spec.input_size)
 
 
 class RenderedFrames(_Frames):

@@ -26,7 +26,6 @@ from ..detect.learned import decode_outputs, lanes_of
 from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
 from ..files import write_atomic
 from ..labels.lanes import on_tusimple_grid
-from ..metrics.formats import split_labels
 from ..metrics.tusimple import score_image
 from .aam import (
     AamSettings,
@@ -41,7 +40,7 @@ from .aam import (
 )
 from .augment import AUGMENTS
 from .backbone import load_init
-from .data import LabelledFrames, file_sha256, read_records, split_indices
+from .data import LabelledFrames, SplitError, read_splits, split_indices
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
@@ -58,7 +57,7 @@ class TrainError(ValueError):
 
 @dataclass(frozen=True)
 class TrainSettings:
-    data: Path
+    data: Path | tuple[Path, ...]  # a dataset (or split) folder, or several trained on together (repeated --data)
     out: Path
     spec: ModelSpec = field(default_factory=ModelSpec)
     epochs: int = 12
@@ -81,6 +80,11 @@ class TrainSettings:
     aam: AamSettings = field(default_factory=AamSettings)
     pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
+
+
+def data_folders(settings: TrainSettings) -> tuple[Path, ...]:
+    """The ``--data`` folders of a run, in order."""
+    return (settings.data,) if isinstance(settings.data, Path) else settings.data
 
 
 def pick_device(name: str) -> torch.device:
@@ -150,7 +154,7 @@ def _patience_spent(best: dict[str, Any] | None, epochs_done: int, patience: int
             and epochs_done - best["epoch"] >= patience)
 
 
-def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, Any]], data_sha: str) -> list:
+def aam_bank(settings: TrainSettings, frames: list[tuple[Path, dict[str, Any]]], data_sha: str) -> list:
     """The AAM bank of this run (rendered once, kept in the model folder for ``--resume``)."""
     path = settings.out / AAM_BANK_FILE
     key = {"data_sha256": data_sha, "seed": settings.seed, "input_size": list(settings.spec.input_size),
@@ -159,10 +163,11 @@ def aam_bank(settings: TrainSettings, split_dir: Path, records: list[dict[str, A
         cached = torch.load(path, weights_only=False)
         if cached.get("key") == key:
             return cached["patches"]
-    folders = sorted({str(Path(r["raw_file"]).parent) for r in records})
-    bases = [split_dir / folder / "case.json" for folder in folders if (split_dir / folder / "case.json").is_file()]
+    folders = sorted({split_dir / Path(record["raw_file"]).parent for split_dir, record in frames})
+    bases = [folder / "case.json" for folder in folders if (folder / "case.json").is_file()]
     if not bases:
-        raise TrainError(f"--augment aam: no case.json beside the frames of {split_dir}")
+        raise TrainError("--augment aam: no case.json beside the frames of "
+                         + ", ".join(str(data) for data in data_folders(settings)))
     patches = build_bank(bases, settings.spec.input_size, settings.seed, settings.aam)
     settings.out.mkdir(parents=True, exist_ok=True)
     _save({"key": key, "patches": patches}, path)
@@ -197,26 +202,22 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     torch.set_num_threads(settings.threads or os.cpu_count() or 1)
     device = pick_device(settings.device)
     spec = settings.spec
-    split_dir = settings.data / "train" if (settings.data / "train").is_dir() else settings.data
     try:
-        label_file = split_labels(split_dir)
-    except ValueError as error:
-        raise TrainError(f"--data {settings.data}: {error}") from None
-    records = read_records(label_file)
-    if not records:
-        raise TrainError(f"--data {settings.data}: {label_file.name} has no frames")
-    groups = [str(Path(r["raw_file"]).parent) for r in records]
-    train_idx, val_idx = split_indices(len(records), groups, settings.val_fraction, settings.seed)
+        frames, data_sha = read_splits(data_folders(settings))
+    except SplitError as error:
+        raise TrainError(str(error)) from None
+    # a case folder is held out whole; folders of the same name in two splits are different cases
+    groups = [f"{split_dir}:{Path(record['raw_file']).parent}" for split_dir, record in frames]
+    train_idx, val_idx = split_indices(len(frames), groups, settings.val_fraction, settings.seed)
     augment = AUGMENTS.get(settings.augment)
-    train_set = LabelledFrames(split_dir, spec, train_idx, train=True, augment=augment, seed=settings.seed,
+    train_set = LabelledFrames(frames, spec, train_idx, train=True, augment=augment, seed=settings.seed,
                                affine=settings.affine)
-    val_set = LabelledFrames(split_dir, spec, val_idx, train=False) if val_idx else None
+    val_set = LabelledFrames(frames, spec, val_idx, train=False) if val_idx else None
     if settings.patience is not None and val_set is None:
         raise TrainError("--patience: no validation frames to watch (--val is 0 or the split has one case folder)")
 
     out = settings.out
     out.mkdir(parents=True, exist_ok=True)
-    data_sha = file_sha256(label_file)
     model = build_model(spec).to(device)
     if settings.init is not None:
         copied, skipped = load_init(model, settings.init)
@@ -243,7 +244,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         best = checkpoint.get("best")
     write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
 
-    bank = aam_bank(settings, split_dir, records, data_sha) if settings.augment == "aam" else []
+    bank = aam_bank(settings, frames, data_sha) if settings.augment == "aam" else []
     hard: list = []
 
     model.train()
@@ -307,7 +308,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     seconds = [h["seconds"] for h in history]
     summary = {
         "spec": asdict(spec),
-        "data": settings.data.name,
+        "data": "+".join(data.name for data in data_folders(settings)),
         "data_sha256": data_sha,
         "train_frames": len(train_set),
         "val_frames": len(val_idx),

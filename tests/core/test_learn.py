@@ -179,10 +179,10 @@ def test_min_epochs_needs_patience_and_fits_the_epochs(tiny_dataset, tmp_path, c
 
 
 def test_training_samples_reuse_their_targets_and_match_a_fresh_encoding(tiny_dataset):
-    from lanevil_core.learn.data import LabelledFrames, targets_for
+    from lanevil_core.learn.data import LabelledFrames, read_splits, targets_for
 
     spec = ModelSpec(family="laneatt", **TINY_SPEC)
-    frames = LabelledFrames(tiny_dataset / "train", spec, train=True, seed=1)
+    frames = LabelledFrames(read_splits([tiny_dataset])[0], spec, train=True, seed=1)
     for epoch in (0, 1, 2):
         frames.epoch = epoch
         for index in range(len(frames)):
@@ -192,6 +192,30 @@ def test_training_samples_reuse_their_targets_and_match_a_fresh_encoding(tiny_da
             assert np.array_equal(sample["rows"].numpy(), fresh.rows)
             assert np.array_equal(sample["anchor_regs"].numpy(), fresh.extra["anchor_regs"])
     assert len(frames._targets) <= 2 * len(frames)
+
+
+def test_several_data_folders_train_together_and_hold_out_whole_case_folders(tiny_dataset, tmp_path, capsys):
+    import shutil
+
+    from lanevil_core.learn.data import file_sha256, read_splits
+
+    other = tmp_path / "other"  # the same case folder names in a second split: different cases
+    shutil.copytree(tiny_dataset, other)
+    frames, identity = read_splits([tiny_dataset, other])
+    single = read_splits([tiny_dataset])
+    label = tiny_dataset / "train" / "train_label.json"
+    assert len(frames) == 2 * len(single[0]) and single[1] == file_sha256(label) != identity
+    assert [split for split, _ in frames] == [tiny_dataset / "train"] * len(single[0]) + [other / "train"] * len(
+        single[0])
+    out = tmp_path / "model"
+    assert main(["train", "--data", str(tiny_dataset), "--data", str(other), "--out", str(out), "--model", "seg",
+                 "--width", str(TINY_SPEC["width"]), "--size", "x".join(map(str, TINY_SPEC["input_size"])),
+                 "--epochs", "1", "--batch", "2", "--max-steps", "1", "--val", "0.5", "--quiet"]) == 0
+    summary = json.loads((out / "training.json").read_text())
+    assert summary["train_frames"] + summary["val_frames"] == len(frames)
+    assert summary["data"] == f"{tiny_dataset.name}+other" and summary["data_sha256"] == identity
+    assert _train(tiny_dataset, tmp_path / "again", "seg", "--data", str(tiny_dataset)) == 2
+    assert "--data: the same folder given twice" in capsys.readouterr().err
 
 
 def test_patience_without_validation_frames_exits_2(tiny_dataset, tmp_path, capsys):
@@ -470,10 +494,10 @@ def test_affine_moves_the_lines_with_the_paint_and_the_identity_moves_nothing():
 
 
 def test_affine_training_draws_the_same_samples_and_leaves_plain_runs_unchanged(tiny_dataset, tmp_path):
-    from lanevil_core.learn.data import LabelledFrames
+    from lanevil_core.learn.data import LabelledFrames, read_splits
 
     spec = ModelSpec(family="ufld", width=TINY_SPEC["width"], input_size=tuple(TINY_SPEC["input_size"]))
-    split = tiny_dataset / "train"
+    split = read_splits([tiny_dataset])[0]
     plain = LabelledFrames(split, spec, seed=2)
     moved_a = LabelledFrames(split, spec, seed=2, affine=True)
     moved_b = LabelledFrames(split, spec, seed=2, affine=True)
