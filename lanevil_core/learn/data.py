@@ -169,14 +169,10 @@ def file_sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-class SplitError(ValueError):
-    """A ``--data`` folder that holds no usable train split."""
-
-
 def read_splits(data_dirs: Sequence[Path]) -> tuple[list[tuple[Path, dict[str, Any]]], str]:
     """Every frame of the train splits of ``data_dirs`` (each a dataset folder with ``train/`` or a split folder)
     as (split folder, record) pairs in order, and the data's identity: the label file's sha256 for one split, the
-    sha256 of the label files' hashes in order for several."""
+    sha256 of the label files' hashes in order for several. ``ValueError`` names the folder without a usable split."""
     frames: list[tuple[Path, dict[str, Any]]] = []
     hashes = []
     for data in data_dirs:
@@ -184,10 +180,10 @@ def read_splits(data_dirs: Sequence[Path]) -> tuple[list[tuple[Path, dict[str, A
         try:
             label_file = split_labels(split_dir)
         except ValueError as error:
-            raise SplitError(f"--data {data}: {error}") from None
+            raise ValueError(f"--data {data}: {error}") from None
         records = read_records(label_file)
         if not records:
-            raise SplitError(f"--data {data}: {label_file.name} has no frames")
+            raise ValueError(f"--data {data}: {label_file.name} has no frames")
         frames += [(split_dir, record) for record in records]
         hashes.append(file_sha256(label_file))
     identity = hashes[0] if len(hashes) == 1 else hashlib.sha256("\n".join(hashes).encode()).hexdigest()

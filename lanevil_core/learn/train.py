@@ -40,7 +40,7 @@ from .aam import (
 )
 from .augment import AUGMENTS
 from .backbone import load_init
-from .data import LabelledFrames, SplitError, read_splits, split_indices
+from .data import LabelledFrames, read_splits, split_indices
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
@@ -57,7 +57,7 @@ class TrainError(ValueError):
 
 @dataclass(frozen=True)
 class TrainSettings:
-    data: Path | tuple[Path, ...]  # a dataset (or split) folder, or several trained on together (repeated --data)
+    data: tuple[Path, ...]  # dataset (or split) folders, trained on together (--data, repeated)
     out: Path
     spec: ModelSpec = field(default_factory=ModelSpec)
     epochs: int = 12
@@ -80,11 +80,6 @@ class TrainSettings:
     aam: AamSettings = field(default_factory=AamSettings)
     pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
-
-
-def data_folders(settings: TrainSettings) -> tuple[Path, ...]:
-    """The ``--data`` folders of a run, in order."""
-    return (settings.data,) if isinstance(settings.data, Path) else settings.data
 
 
 def pick_device(name: str) -> torch.device:
@@ -167,7 +162,7 @@ def aam_bank(settings: TrainSettings, frames: list[tuple[Path, dict[str, Any]]],
     bases = [folder / "case.json" for folder in folders if (folder / "case.json").is_file()]
     if not bases:
         raise TrainError("--augment aam: no case.json beside the frames of "
-                         + ", ".join(str(data) for data in data_folders(settings)))
+                         + ", ".join(str(data) for data in settings.data))
     patches = build_bank(bases, settings.spec.input_size, settings.seed, settings.aam)
     settings.out.mkdir(parents=True, exist_ok=True)
     _save({"key": key, "patches": patches}, path)
@@ -203,8 +198,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     device = pick_device(settings.device)
     spec = settings.spec
     try:
-        frames, data_sha = read_splits(data_folders(settings))
-    except SplitError as error:
+        frames, data_sha = read_splits(settings.data)
+    except ValueError as error:
         raise TrainError(str(error)) from None
     # a case folder is held out whole; folders of the same name in two splits are different cases
     groups = [f"{split_dir}:{Path(record['raw_file']).parent}" for split_dir, record in frames]
@@ -308,7 +303,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     seconds = [h["seconds"] for h in history]
     summary = {
         "spec": asdict(spec),
-        "data": "+".join(data.name for data in data_folders(settings)),
+        "data": "+".join(data.name for data in settings.data),
         "data_sha256": data_sha,
         "train_frames": len(train_set),
         "val_frames": len(val_idx),

@@ -394,7 +394,7 @@ def test_aam_training_mixes_hard_examples(tiny_dataset, tmp_path, relight, keep_
     from lanevil_core.learn.train import AAM_BANK_FILE, TrainSettings, train
 
     spec = ModelSpec(family="seg", **TINY_SPEC)
-    settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=2, batch=2, augment="aam",
+    settings = TrainSettings(data=(tiny_dataset,), out=tmp_path, spec=spec, epochs=2, batch=2, augment="aam",
                              val_fraction=0.5, max_steps=2,
                              aam=AamSettings(bank_cases=2, probability=1.0, relight=relight, keep_paint=keep_paint))
     summary = train(settings, show_progress=False)
@@ -444,7 +444,7 @@ def test_pgd_training_replaces_a_share_of_each_batch(tiny_dataset, tmp_path):
     from lanevil_core.learn.train import TrainSettings, train
 
     spec = ModelSpec(family="ufld", **TINY_SPEC)
-    settings = TrainSettings(data=tiny_dataset, out=tmp_path, spec=spec, epochs=1, batch=2, augment="pgd",
+    settings = TrainSettings(data=(tiny_dataset,), out=tmp_path, spec=spec, epochs=1, batch=2, augment="pgd",
                              val_fraction=0.5, max_steps=2)
     summary = train(settings, show_progress=False)
     assert summary["augment"] == "pgd" and len(summary["history"]) == 1
