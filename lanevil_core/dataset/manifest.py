@@ -81,9 +81,12 @@ def _lanevil_version() -> str:
 
 
 def software_versions() -> dict[str, str]:
-    """Versions that decide the bytes of a frame (renderer, array and JIT libraries, image encoder, zlib)."""
-    return {"lanevil": _lanevil_version(), "python": platform.python_version(), "numpy": np.__version__,
-            "numba": numba.__version__, "pillow": PIL.__version__, "zlib": zlib.ZLIB_RUNTIME_VERSION}
+    """Versions that decide the bytes of a frame: the package and the digest of its render-path sources (an
+    edit that does not bump the version still changes the frames), the array and JIT libraries, the image
+    encoder and zlib."""
+    return {"lanevil": _lanevil_version(), "renderer_source_sha256": source_digest(),
+            "python": platform.python_version(), "numpy": np.__version__, "numba": numba.__version__,
+            "pillow": PIL.__version__, "zlib": zlib.ZLIB_RUNTIME_VERSION}
 
 
 def frame_key(case: PlannedCase, frame_index: int, plan: DatasetPlan, versions: dict[str, str]) -> str:
@@ -122,7 +125,7 @@ def case_entry(case: PlannedCase, plan: DatasetPlan, frame_hashes: dict[int, str
     }
 
 
-def build_manifest(plan: DatasetPlan, versions: dict[str, str], code_sha256: str,
+def build_manifest(plan: DatasetPlan, versions: dict[str, str],
                    frame_hashes: dict[tuple[str, str], dict[int, str]]) -> dict[str, Any]:
     """The whole manifest; ``frame_hashes`` maps (split, folder) -> frame -> sha256 of the written file."""
     settings = plan.settings
@@ -134,7 +137,7 @@ def build_manifest(plan: DatasetPlan, versions: dict[str, str], code_sha256: str
                              "frames": sum(len(case.frames) for case in cases)}
     return {
         "manifest_version": MANIFEST_VERSION,
-        "versions": {**versions, "renderer_source_sha256": code_sha256},
+        "versions": versions,
         "settings": {"size": list(settings.size), "format": settings.image_format,
                      "frames_per_case": settings.frames_per_case, "train_frames": settings.train_frames,
                      "seed": settings.seed, "no_paint": settings.no_paint,

@@ -1,8 +1,9 @@
 """A dataset run: plan, keep what is already on disk and verified, render the rest, then write labels and manifest.
 
 Resume: a frame is kept when its sidecar carries the frame's key (``manifest.frame_key``) and the image file still
-has the sha256 the sidecar recorded; anything else (missing, truncated, corrupt, from other settings) is rendered
-again. Label files and the manifest are rebuilt from the sidecars at the end of every run.
+has the sha256 the sidecar recorded; anything else (missing, truncated, corrupt, from other settings or from
+other code: the key holds the digest of the render-path sources) is rendered again. Label files and the manifest
+are rebuilt from the sidecars at the end of every run.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .manifest import build_manifest, frame_key, software_versions, source_digest
+from .manifest import build_manifest, frame_key, software_versions
 from .plan import (
     SPLIT_LABELS,
     DatasetPlan,
@@ -96,8 +97,7 @@ class _Sidecars:
         return {index: self.found[(*case.key, index)]["sha256"] for index in case.frames}
 
 
-def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versions: dict[str, str],
-            code_sha256: str) -> None:
+def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versions: dict[str, str]) -> None:
     """Per-case ``case.json`` and ``labels.json``, the split label files, then the manifest."""
     for split in SPLIT_LABELS:
         cases = plan.split_cases(split)
@@ -110,7 +110,7 @@ def _finish(plan: DatasetPlan, folder: DatasetFolder, sidecars: _Sidecars, versi
             split_records += records
         folder.write_split_labels(split, split_records)
     hashes = {case.key: sidecars.hashes(case) for case in plan.cases}
-    folder.write_manifest(build_manifest(plan, versions, code_sha256, hashes))
+    folder.write_manifest(build_manifest(plan, versions, hashes))
 
 
 def counted(mapper: Mapper, enabled: bool) -> Mapper:
@@ -135,8 +135,7 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
     try:
         mapper = counted(getattr(executor, "map", threads_map), show_progress)
         plan = build_plan(discover_cases(cases_dir), settings, mapper)
-        versions = software_versions()
-        code_sha256 = source_digest()  # the code the frames are rendered with, read before they are
+        versions = software_versions()  # the render-path sources are hashed before any frame is rendered
         folder = DatasetFolder(out_dir, settings.suffix)
         sidecars = _Sidecars(plan, folder, versions)
         pending = sidecars.scan()
@@ -153,6 +152,6 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
             render_seconds = time.perf_counter() - render_start
     finally:
         getattr(executor, "close", lambda: None)()
-    _finish(plan, folder, sidecars, versions, code_sha256)
+    _finish(plan, folder, sidecars, versions)
     return RunSummary(out_dir, plan.total_frames, plan.total_frames - kept, kept, time.perf_counter() - start,
                       render_seconds)

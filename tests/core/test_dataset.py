@@ -225,6 +225,22 @@ def test_frames_from_other_settings_are_not_reused(dataset: Path, cases_dir: Pat
     assert [entry["split"] for entry in manifest["cases"]] == ["test"] * 3
 
 
+def test_frames_from_other_code_are_not_reused(dataset: Path, cases_dir: Path, tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    # an illusion's code can change its frames while the case files stay the same: the render-path digest is part
+    # of every frame's key, so a rerun after such a change renders every frame again
+    out = tmp_path / "other_code"
+    shutil.copytree(dataset, out)
+    monkeypatch.setattr("lanevil_core.dataset.manifest.source_digest", lambda: "0" * 64)
+    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3, sampling="even")
+    summary = generate_dataset(cases_dir, out, settings, functools.partial(run_local, workers=1),
+                               show_progress=False)
+    assert (summary.kept, summary.rendered) == (0, 9)
+    assert json.loads((out / "manifest.json").read_text())["versions"]["renderer_source_sha256"] == "0" * 64
+    assert {path: data for path, data in tree(out).items() if path.endswith(".png")} == \
+        {path: data for path, data in tree(dataset).items() if path.endswith(".png")}
+
+
 def test_jpg_format(cases_dir: Path, tmp_path: Path) -> None:
     cases = copy_cases(tmp_path / "cases", CASE_FILES[:1])
     out = tmp_path / "jpg"
