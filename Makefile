@@ -52,9 +52,10 @@ test-browser: $(STAMP)
 # (4,000 frames, seed 1: its roads also concrete or with worn paint, its horizon anywhere, 60 % of its cameras at
 # car heights). ufld and seg end with one epoch at a quarter of the rate on the benchmark's 40,000-frame clean train
 # split pooled with the second randomised split (the train split alone, all through the paper's camera, unlearns
-# real roads). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate (docs/learning.md, with each stage's measured time). The four splits
-# render in about 3 + 3 + 13 + 55 min (the last two measured beside other work); MODELS_DATA, MODELS_DATA_VARIED,
-# MODELS_DATA_VARIED2 and MODELS_TRAIN keep the renders for reruns. The last stage holds about 8 GB in memory.
+# real roads). scnn and bezier train on the first split only, bezier 10 more epochs at half the rate
+# (docs/learning.md, with each stage's measured time). The four splits render in about 3 + 3 + 13 + 55 min (the
+# last two measured beside other work); MODELS_DATA, MODELS_DATA_VARIED, MODELS_DATA_VARIED2 and MODELS_TRAIN keep
+# the renders for reruns. The last stage holds about 8 GB in memory.
 MODELS_DATA ?= out/models-data
 MODELS_DATA_VARIED ?= out/models-data-v
 MODELS_DATA_VARIED2 ?= out/models-data-v2

@@ -36,6 +36,7 @@ EXPECTED_TEST = {  # case folder -> (category, type, severity, source file)
     "RoadDamage/RoadCrack/00_straight_suburban_cloudy/03_level3": ("RoadDamage", "RoadCrack", 3, CASE_FILES[2]),
 }
 ARGS = ["--size", SIZE, "--frames-per-case", "2", "--sampling", "even", "--train-frames", "3", "--quiet"]
+SETTINGS = Settings(size=(160, 90), frames_per_case=2, train_frames=3, sampling="even")  # ARGS in the API
 
 
 def copy_cases(root: Path, files: tuple[str, ...] = CASE_FILES) -> Path:
@@ -185,7 +186,6 @@ def test_resume_repairs_exactly_the_damaged_frames(
 
 def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "interrupted"
-    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3, sampling="even")
 
     def interrupt_after_two_tasks(tasks: Sequence[RenderTask], on_done: TaskDone) -> None:
         done = []
@@ -199,11 +199,11 @@ def test_interrupted_run_resumes_to_the_same_bytes(dataset: Path, cases_dir: Pat
         run_local(tasks, counting, workers=1)
 
     with pytest.raises(KeyboardInterrupt):
-        generate_dataset(cases_dir, out, settings, interrupt_after_two_tasks, show_progress=False)
+        generate_dataset(cases_dir, out, SETTINGS, interrupt_after_two_tasks, show_progress=False)
     assert not (out / "manifest.json").exists()
     written = sorted(out.rglob("*.png"))
     assert 0 < len(written) < 9
-    summary = generate_dataset(cases_dir, out, settings, functools.partial(run_local, workers=1),
+    summary = generate_dataset(cases_dir, out, SETTINGS, functools.partial(run_local, workers=1),
                                show_progress=False)
     assert (summary.kept, summary.rendered) == (len(written), 9 - len(written))
     assert 0 < summary.render_seconds < summary.seconds  # planning, resume check and manifest are not rendering
@@ -232,8 +232,7 @@ def test_frames_from_other_code_are_not_reused(dataset: Path, cases_dir: Path, t
     out = tmp_path / "other_code"
     shutil.copytree(dataset, out)
     monkeypatch.setattr("lanevil_core.dataset.manifest.source_digest", lambda: "0" * 64)
-    settings = Settings(size=(160, 90), frames_per_case=2, train_frames=3, sampling="even")
-    summary = generate_dataset(cases_dir, out, settings, functools.partial(run_local, workers=1),
+    summary = generate_dataset(cases_dir, out, SETTINGS, functools.partial(run_local, workers=1),
                                show_progress=False)
     assert (summary.kept, summary.rendered) == (0, 9)
     assert json.loads((out / "manifest.json").read_text())["versions"]["renderer_source_sha256"] == "0" * 64
