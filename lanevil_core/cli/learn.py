@@ -46,6 +46,19 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--init", type=Path, default=None,
                         help="state dict to initialise from: a trained model's weights.pt (fine-tuning, heads "
                              "included) or a backbone's (e.g. ImageNet ResNet weights)")
+    parser.add_argument("--randomise", action="store_true",
+                        help="domain randomisation: everything but the lane paint re-coloured and re-textured, random "
+                             "shadows, lights, occluders and distractors (learn/randomise.py)")
+    parser.add_argument("--photometric", action="store_true",
+                        help="strong photometric augmentation: colour, exposure, gamma, blur, noise, JPEG, erasing")
+    parser.add_argument("--backbone-weights", type=Path, default=None,
+                        help="start the backbone from an ImageNet checkpoint you supply, in torchvision's ResNet key "
+                             "layout (resnet18/resnet34 state dict; needs --width 1.0; nothing is downloaded)")
+    parser.add_argument("--val-data", type=Path, action="append", default=[],
+                        help="validate (and with --patience choose the epoch) on these held-out synthetic splits "
+                             "instead of held-out case folders of --data; repeatable")
+    parser.add_argument("--loader-workers", type=count(0), default=0,
+                        help="data-loading processes (default 0; on a GPU, several keep it fed)")
     parser.add_argument("--threads", type=count(0), default=0,
                         help="CPU threads (default 0 = every core; use 1 when other work shares the cores: "
                              "oversubscribed threads make training many times slower)")
@@ -75,6 +88,13 @@ def _run_train(args: argparse.Namespace) -> int:
         raise UsageError("--data: the same folder given twice")
     if args.init is not None and not args.init.is_file():
         raise UsageError(f"--init {args.init}: no such file")
+    if args.backbone_weights is not None and not args.backbone_weights.is_file():
+        raise UsageError(f"--backbone-weights {args.backbone_weights}: no such file")
+    if args.backbone_weights is not None and args.width != 1.0:
+        raise UsageError(f"--backbone-weights: ImageNet ResNet weights need --width 1.0 (not {args.width})")
+    for data in args.val_data:
+        if not data.is_dir():
+            raise UsageError(f"--val-data {data}: no such folder")
     if args.aam_keep_paint and args.augment != "aam":
         raise UsageError(f"--aam-keep-paint: only with --augment aam (not {args.augment})")
     if args.min_epochs and args.patience is None:
@@ -91,7 +111,9 @@ def _run_train(args: argparse.Namespace) -> int:
                                  val_fraction=args.val_fraction, resume=args.resume, init=args.init,
                                  max_steps=args.max_steps, threads=args.threads, patience=args.patience,
                                  min_epochs=args.min_epochs,
-                                 aam=AamSettings(keep_paint=args.aam_keep_paint))
+                                 aam=AamSettings(keep_paint=args.aam_keep_paint), randomise=args.randomise,
+                                 photometric=args.photometric, backbone_weights=args.backbone_weights,
+                                 val_data=tuple(args.val_data), loader_workers=args.loader_workers)
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:
         raise UsageError(str(error)) from None
@@ -106,7 +128,58 @@ def _run_train(args: argparse.Namespace) -> int:
     return 0
 
 
+def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
+    from ..detect.model_spec import FAMILIES
+
+    parser.add_argument("--weights", required=True,
+                        help=f"the model to adapt: a model folder of `lanevil train` or a shipped family "
+                             f"({', '.join(FAMILIES)})")
+    parser.add_argument("--frames", type=Path, required=True, action="append",
+                        help="folder of your own unlabelled frames (png/jpg, searched recursively); repeatable")
+    parser.add_argument("--out", type=Path, required=True, help="model folder to write")
+    parser.add_argument("--method", choices=("adabn", "self-train", "adabn+self-train"), default="adabn+self-train",
+                        help="AdaBN (normalisation statistics re-estimated), self-training on confident "
+                             "pseudo-labels, or both in that order (default)")
+    parser.add_argument("--epochs", type=count(1), default=3, help="self-training epochs (default 3)")
+    parser.add_argument("--lr", type=float, default=2e-4, help="self-training learning rate (default 2e-4)")
+    parser.add_argument("--max-frames", type=count(1), default=2000, help="frames read at most (default 2000)")
+    parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
+    parser.add_argument("--seed", type=count(0), default=0, help="default 0")
+    parser.add_argument("--threads", type=count(0), default=0, help="CPU threads (default every core)")
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def _run_adapt(args: argparse.Namespace) -> int:
+    try:
+        import torch  # noqa: F401
+    except ImportError:
+        raise UsageError("lanevil adapt needs PyTorch: pip install -e '.[learn]'") from None
+    from ..detect.learned import shipped_model_dir
+    from ..detect.model_spec import FAMILIES, ModelSpecError
+    from ..learn.adapt import AdaptError, AdaptSettings, adapt
+
+    model = shipped_model_dir(args.weights) if args.weights in FAMILIES else Path(args.weights)
+    if not model.is_dir():
+        raise UsageError(f"--weights {args.weights}: no such model folder")
+    for folder in args.frames:
+        if not folder.is_dir():
+            raise UsageError(f"--frames {folder}: no such folder")
+    settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
+                             epochs=args.epochs, lr=args.lr, max_frames=args.max_frames, device=args.device,
+                             seed=args.seed, threads=args.threads)
+    try:
+        summary = adapt(settings, show_progress=not args.quiet)
+    except (AdaptError, ModelSpecError) as error:
+        raise UsageError(str(error)) from None
+    kept = summary.get("self_training", {}).get("pseudo_labelled")
+    extra = "" if kept is None else f", {kept} frames pseudo-labelled"
+    print(f"{args.out}: adapted on {summary['frames']} frames ({args.method}{extra}) in {summary['seconds']:.0f} s")
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
+    "adapt": Command("adapt a learned detector to your own unlabelled frames (AdaBN, self-training)",
+                     _adapt_arguments, _run_adapt),
     "train": Command("train a learned lane detector (ufld, seg, laneatt, bezier, ganet or scnn) on a dataset's "
                      "clean train split",
                      _train_arguments, _run_train),

@@ -86,3 +86,51 @@ def load_init(model: nn.Module, path: str | Path) -> tuple[int, int]:
                 break
     model.load_state_dict(own)
     return copied, len(state) - copied
+
+
+class BackboneWeightsError(ValueError):
+    """A ``--backbone-weights`` file that does not fit the network's backbone (named tensor and shapes)."""
+
+
+# The keys of torchvision's ``resnet18()`` / ``resnet34()`` state dicts that are not the backbone: its classifier.
+CLASSIFIER_PREFIX = "fc."
+
+
+def torchvision_keys(state: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    """A state dict in torchvision's ResNet layout (optionally under ``module.`` or ``backbone.``, or wrapped in
+    ``{"state_dict": ...}``) as the backbone's own names: the layouts are the same, the classifier is dropped."""
+    if "state_dict" in state and isinstance(state["state_dict"], dict):
+        state = state["state_dict"]
+    mapped = {}
+    for name, tensor in state.items():
+        name = name.removeprefix("module.").removeprefix("backbone.")
+        if not name.startswith(CLASSIFIER_PREFIX):
+            mapped[name] = tensor
+    return mapped
+
+
+def load_backbone_weights(backbone: ResNet, path: str | Path) -> int:
+    """Load an ImageNet checkpoint the user supplies (torchvision's ResNet key layout) into ``backbone``; every
+    backbone tensor must be there with its shape, else ``BackboneWeightsError`` names the first that is not (a
+    ResNet-34 file on a ResNet-18, or a network narrower than ``--width 1.0``). Returns the tensors copied."""
+    try:
+        loaded = torch.load(Path(path), map_location="cpu", weights_only=True)
+    except Exception as error:  # a file torch cannot read: say so in one line
+        raise BackboneWeightsError(f"{Path(path).name}: not a PyTorch state dict ({type(error).__name__})") from None
+    if not isinstance(loaded, dict):
+        raise BackboneWeightsError(f"{Path(path).name}: not a state dict")
+    state = torchvision_keys(loaded)
+    own = backbone.state_dict()
+    for name, tensor in own.items():
+        if name not in state:
+            raise BackboneWeightsError(f"{Path(path).name}: no tensor {name} (not a torchvision ResNet of this depth)")
+        if tuple(state[name].shape) != tuple(tensor.shape):
+            raise BackboneWeightsError(
+                f"{Path(path).name}: {name} is {tuple(state[name].shape)}, the network's {tuple(tensor.shape)} "
+                "(ImageNet weights need --width 1.0 and the same --backbone)")
+    extra = sorted(set(state) - set(own))
+    if extra:
+        raise BackboneWeightsError(f"{Path(path).name}: {extra[0]} is not a tensor of a {len(own)}-tensor backbone "
+                                   "(not a torchvision ResNet of this depth)")
+    backbone.load_state_dict({name: state[name].to(own[name].dtype) for name in own})
+    return len(own)

@@ -8,7 +8,8 @@ Two sources give the same samples:
 
 A sample's targets come from ``detect.lane_slots``: lanes placed in slots, row-anchor classes and a lane mask.
 A horizontal flip (half the training samples) mirrors image and slots; ``--augment`` adds one of ``augment``;
-``--affine`` rotates and shifts every training sample (``affine``).
+``--affine`` rotates and shifts every training sample (``affine``); ``--randomise`` and ``--photometric`` add the
+domain randomisation of ``randomise`` (from their own draws, so a run without them draws as before).
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from ..metrics.formats import split_labels
 from ..typed import UInt8Array
 from .affine import draw_affine, ego_column, warp_image, warp_lines
 from .augment import AUGMENT_PROBABILITY, Augment
+from .randomise import paint_mask, photometric, randomise
 
 
 @dataclass(frozen=True)
@@ -109,11 +111,13 @@ class _Frames(Dataset):
     and the ``frame_sizes`` the records refer to, which the subclasses fill."""
 
     def __init__(self, spec: ModelSpec, train: bool, augment: Augment | None, seed: int,
-                 affine: bool = False) -> None:
+                 affine: bool = False, randomised: bool = False, photometric: bool = False) -> None:
         self.spec = spec
         self.train = train
         self.augment = augment
         self.affine = affine
+        self.randomised = randomised
+        self.photometric = photometric
         self.seed = seed
         self.epoch = 0
         self.records: list[dict[str, Any]] = []
@@ -145,12 +149,19 @@ class _Frames(Dataset):
         if self.train:  # per (seed, epoch, index): the same run draws the same augmentations, also on resume
             rng = np.random.default_rng([self.seed, self.epoch, index])
             flip = bool(rng.random() < 0.5)
+            domain_rng = np.random.default_rng([self.seed, self.epoch, index, 11])
+            if self.randomised:
+                record = self.records[index]
+                lines = lane_lines(record["lanes"], record["h_samples"], self.frame_sizes[index])
+                image = randomise(image, paint_mask(lines, self.spec.input_size), domain_rng)
             if self.augment is not None and rng.random() < AUGMENT_PROBABILITY:
                 other = self.image(int(rng.integers(len(self))))
                 image = self.augment(image, rng, other)
             if self.affine:  # drawn last, so the draws above are those of a run without it
                 M_out_in = draw_affine(rng, self.spec.input_size)
                 image = warp_image(image, M_out_in)
+            if self.photometric:
+                image = photometric(image, domain_rng)
             if flip:
                 image = np.ascontiguousarray(image[:, ::-1])
         targets = self.targets(index, flip, M_out_in)
@@ -196,8 +207,8 @@ class LabelledFrames(_Frames):
 
     def __init__(self, frames: Sequence[tuple[Path, dict[str, Any]]], spec: ModelSpec,
                  indices: list[int] | None = None, train: bool = True, augment: Augment | None = None,
-                 seed: int = 0, affine: bool = False) -> None:
-        super().__init__(spec, train, augment, seed, affine)
+                 seed: int = 0, affine: bool = False, randomised: bool = False, photometric: bool = False) -> None:
+        super().__init__(spec, train, augment, seed, affine, randomised, photometric)
         chosen = [frames[i] for i in (range(len(frames)) if indices is None else indices)]
         self.records = [record for _, record in chosen]
         width, height = spec.input_size

@@ -39,7 +39,7 @@ from .aam import (
     update_attention_areas,
 )
 from .augment import AUGMENTS
-from .backbone import load_init
+from .backbone import BackboneWeightsError, load_backbone_weights, load_init
 from .data import LabelledFrames, read_splits, split_indices
 from .export import export_onnx
 from .losses import detector_loss
@@ -80,6 +80,13 @@ class TrainSettings:
     aam: AamSettings = field(default_factory=AamSettings)
     pgd: PgdSettings = field(default_factory=PgdSettings)
     threads: int = 0  # CPU threads of torch (0 = every core); 1 on a machine busy with other work
+    randomise: bool = False  # image-space domain randomisation of everything but the paint (learn.randomise)
+    photometric: bool = False  # strong photometric augmentation (learn.randomise.photometric)
+    backbone_weights: Path | None = None  # an ImageNet checkpoint in torchvision's ResNet layout (--backbone-weights)
+    # held-out synthetic splits (other cameras, roads, materials) to validate on instead of held-out case folders:
+    # the epoch kept with --patience is chosen on them, never on real frames
+    val_data: tuple[Path, ...] = ()
+    loader_workers: int = 0  # DataLoader processes (a GPU waits on one process's augmentation)
 
 
 def pick_device(name: str) -> torch.device:
@@ -189,6 +196,19 @@ def aam_batch(model: LaneNet, images: torch.Tensor, hard: list, settings: TrainS
     return images
 
 
+def _validation_set(settings: TrainSettings, frames: list[tuple[Path, dict[str, Any]]],
+                    val_idx: list[int]) -> LabelledFrames | None:
+    """The frames validated on: every frame of ``settings.val_data`` where given, else the held-out case folders
+    ``val_idx`` of the train data (None when there are none)."""
+    if settings.val_data:
+        try:
+            held_out, _ = read_splits(settings.val_data)
+        except ValueError as error:
+            raise TrainError(str(error).replace("--data", "--val-data")) from None
+        return LabelledFrames(held_out, settings.spec, train=False)
+    return LabelledFrames(frames, settings.spec, val_idx, train=False) if val_idx else None
+
+
 def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]:
     """Train, export and describe a model in ``settings.out``; returns the ``training.json`` content."""
     from tqdm import tqdm
@@ -203,17 +223,25 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         raise TrainError(str(error)) from None
     # a case folder is held out whole; folders of the same name in two splits are different cases
     groups = [f"{split_dir}:{Path(record['raw_file']).parent}" for split_dir, record in frames]
-    train_idx, val_idx = split_indices(len(frames), groups, settings.val_fraction, settings.seed)
+    val_fraction = 0.0 if settings.val_data else settings.val_fraction
+    train_idx, val_idx = split_indices(len(frames), groups, val_fraction, settings.seed)
     augment = AUGMENTS.get(settings.augment)
     train_set = LabelledFrames(frames, spec, train_idx, train=True, augment=augment, seed=settings.seed,
-                               affine=settings.affine)
-    val_set = LabelledFrames(frames, spec, val_idx, train=False) if val_idx else None
+                               affine=settings.affine, randomised=settings.randomise,
+                               photometric=settings.photometric)
+    val_set = _validation_set(settings, frames, val_idx)
     if settings.patience is not None and val_set is None:
         raise TrainError("--patience: no validation frames to watch (--val is 0 or the split has one case folder)")
 
     out = settings.out
     out.mkdir(parents=True, exist_ok=True)
-    model = build_model(spec).to(device)
+    model = build_model(spec)
+    if settings.backbone_weights is not None:
+        try:
+            load_backbone_weights(model.backbone, settings.backbone_weights)
+        except BackboneWeightsError as error:
+            raise TrainError(f"--backbone-weights {error}") from None
+    model = model.to(device)
     if settings.init is not None:
         copied, skipped = load_init(model, settings.init)
         if copied == 0:
@@ -256,7 +284,8 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         started = time.perf_counter()
         train_set.epoch = epoch
         generator = torch.Generator().manual_seed(settings.seed * 1000 + epoch)
-        loader = DataLoader(train_set, batch_size=settings.batch, shuffle=True, generator=generator, drop_last=True)
+        loader = DataLoader(train_set, batch_size=settings.batch, shuffle=True, generator=generator, drop_last=True,
+                            num_workers=settings.loader_workers, persistent_workers=False)
         bar = tqdm(total=steps_per_epoch, desc=f"epoch {epoch + 1}/{settings.epochs}", disable=not show_progress,
                    unit="batch", dynamic_ncols=True)
         losses = []
@@ -306,13 +335,17 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "data": "+".join(data.name for data in settings.data),
         "data_sha256": data_sha,
         "train_frames": len(train_set),
-        "val_frames": len(val_idx),
+        "val_frames": 0 if val_set is None else len(val_set),
         "epochs": settings.epochs,
         "batch": settings.batch,
         "lr": settings.lr,
         "augment": settings.augment,
         **({"aam_settings": asdict(settings.aam)} if settings.augment == "aam" else {}),
         "affine": settings.affine,
+        "randomise": settings.randomise,
+        "photometric": settings.photometric,
+        "backbone_weights": None if settings.backbone_weights is None else settings.backbone_weights.name,
+        "val_data": [data.name for data in settings.val_data],
         "seed": settings.seed,
         "device": device.type,
         "threads": torch.get_num_threads(),

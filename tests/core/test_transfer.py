@@ -1,0 +1,186 @@
+"""Training that transfers: the domain randomiser is deterministic per seed and keeps the paint, ImageNet
+checkpoints in torchvision's layout load into the backbone (and wrong ones are refused in one line), and
+``lanevil adapt`` writes a usable model from unlabelled frames."""
+
+from __future__ import annotations
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from test_learn import TINY_SPEC, _train, straight_record, tiny_dataset  # noqa: E402, F401 (the fixture by name)
+
+from lanevil_core.cli import main  # noqa: E402
+from lanevil_core.detect.lane_slots import LaneLine, lane_lines  # noqa: E402
+from lanevil_core.detect.learned import LearnedDetector  # noqa: E402
+from lanevil_core.detect.model_spec import ModelSpec  # noqa: E402
+from lanevil_core.learn.adapt import adapt_batch_norm, agreeing_lanes, frame_files  # noqa: E402
+from lanevil_core.learn.backbone import BackboneWeightsError, ResNet, load_backbone_weights  # noqa: E402
+from lanevil_core.learn.data import LabelledFrames, read_splits  # noqa: E402
+from lanevil_core.learn.models import build_model  # noqa: E402
+from lanevil_core.learn.randomise import paint_mask, photometric, randomise, recolour  # noqa: E402
+
+SIZE = (320, 180)
+
+
+def _scene() -> tuple[np.ndarray, np.ndarray, list[LaneLine]]:
+    """A grey road with white lines where ``straight_record`` puts them, and the lines."""
+    record = straight_record()
+    lines = lane_lines(record["lanes"], record["h_samples"], (1280, 720))
+    image = np.full((SIZE[1], SIZE[0], 3), 90, np.uint8)
+    for line in lines:
+        points = np.round(line.points * SIZE).astype(np.int32)
+        cv2.polylines(image, [points], False, (235, 235, 235), 2)
+    return image, paint_mask(lines, SIZE), lines
+
+
+def test_randomiser_is_deterministic_per_seed_and_differs_between_seeds():
+    image, keep, _ = _scene()
+    a = randomise(image, keep, np.random.default_rng(5))
+    b = randomise(image, keep, np.random.default_rng(5))
+    c = randomise(image, keep, np.random.default_rng(6))
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    p = photometric(image, np.random.default_rng(5))
+    assert np.array_equal(p, photometric(image, np.random.default_rng(5)))
+    assert p.shape == image.shape and p.dtype == np.uint8
+
+
+def test_paint_mask_covers_the_painted_lines_and_little_else():
+    image, keep, lines = _scene()
+    painted = image[..., 0] > 200
+    painted[: int(SIZE[1] * 0.6)] = False  # near the vanishing point a 2-pixel stroke is wider than paint would be
+    assert keep[painted].mean() > 0.95  # the lines' pixels are kept
+    assert keep.mean() < 0.15  # the rest of the road is free to change
+    assert not paint_mask([], SIZE).any()
+
+
+def test_recolouring_changes_the_road_and_only_tints_the_paint():
+    image, keep, _ = _scene()
+    painted = (image[..., 0] > 200) & keep
+    road = ~keep
+    changed_road = []
+    for seed in range(12):
+        out = recolour(image, keep, np.random.default_rng(seed)) * 255.0
+        ratio = out[painted] / image[painted]
+        assert ratio.min() >= 0.74 and ratio.max() <= 1.16
+        changed_road.append(np.abs(out[road] - image[road]).mean())
+    assert np.median(changed_road) > 15.0
+
+
+def test_training_samples_with_randomisation_are_reproducible(tiny_dataset):  # noqa: F811
+    spec = ModelSpec(family="ufld", width=TINY_SPEC["width"], input_size=tuple(TINY_SPEC["input_size"]))
+    split = read_splits([tiny_dataset])[0]
+    plain = LabelledFrames(split, spec, seed=3)
+    a = LabelledFrames(split, spec, seed=3, randomised=True, photometric=True)
+    b = LabelledFrames(split, spec, seed=3, randomised=True, photometric=True)
+    for index in range(len(plain)):
+        sample_a, sample_b, sample_p = a[index], b[index], plain[index]
+        assert torch.equal(sample_a["image"], sample_b["image"])
+        assert not torch.equal(sample_a["image"], sample_p["image"])
+        assert torch.equal(sample_a["rows"], sample_p["rows"])  # labels (and the flip) are those of a plain run
+
+
+def test_randomised_training_records_its_ingredients(tiny_dataset, tmp_path):  # noqa: F811
+    assert _train(tiny_dataset, tmp_path, "ufld", "--randomise", "--photometric") == 0
+    summary = json.loads((tmp_path / "training.json").read_text())
+    assert summary["randomise"] is True and summary["photometric"] is True
+
+
+def _torchvision_state(depth: str) -> dict[str, torch.Tensor]:
+    """A state dict in torchvision's ResNet layout: the backbone's names, random values, and its classifier."""
+    generator = torch.Generator().manual_seed(0)
+    state = {name: torch.randn(tensor.shape, generator=generator) if tensor.is_floating_point() else tensor
+             for name, tensor in ResNet(depth, 1.0).state_dict().items()}
+    state["fc.weight"] = torch.randn(1000, 512, generator=generator)
+    state["fc.bias"] = torch.randn(1000, generator=generator)
+    return state
+
+
+def test_backbone_weights_in_torchvision_layout_load_every_tensor(tmp_path):
+    state = _torchvision_state("resnet18")
+    path = tmp_path / "resnet18-imagenet.pth"
+    torch.save(state, path)
+    model = build_model(ModelSpec(family="seg", width=1.0, input_size=(128, 72)))
+    assert load_backbone_weights(model.backbone, path) == len(model.backbone.state_dict())
+    for name, tensor in model.backbone.state_dict().items():
+        assert torch.equal(tensor, state[name].to(tensor.dtype)), name
+    torch.save({"state_dict": {"module." + k: v for k, v in state.items()}}, path)  # a wrapped checkpoint
+    assert load_backbone_weights(build_model(ModelSpec(family="ufld", width=1.0)).backbone, path) > 0
+
+
+def test_backbone_weights_of_another_depth_or_width_are_refused(tmp_path):
+    path = tmp_path / "resnet34.pth"
+    torch.save(_torchvision_state("resnet34"), path)
+    with pytest.raises(BackboneWeightsError, match="layer1.2|not a tensor"):
+        load_backbone_weights(ResNet("resnet18", 1.0), path)
+    torch.save(_torchvision_state("resnet18"), path)
+    with pytest.raises(BackboneWeightsError, match="--width 1.0"):
+        load_backbone_weights(ResNet("resnet18", 0.5), path)
+    (tmp_path / "junk.pth").write_bytes(b"not a checkpoint")
+    with pytest.raises(BackboneWeightsError, match="not a PyTorch state dict"):
+        load_backbone_weights(ResNet("resnet18", 1.0), tmp_path / "junk.pth")
+
+
+def test_backbone_weights_cli_errors_exit_2(tiny_dataset, tmp_path, capsys):  # noqa: F811
+    path = tmp_path / "resnet18.pth"
+    torch.save(_torchvision_state("resnet18"), path)
+    assert _train(tiny_dataset, tmp_path / "m", "ufld", "--backbone-weights", str(path)) == 2  # width 0.125
+    assert "--width 1.0" in capsys.readouterr().err
+    assert _train(tiny_dataset, tmp_path / "m", "ufld", "--backbone-weights", str(tmp_path / "none.pth")) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_mirror_agreement_keeps_lanes_read_alike_and_drops_the_rest():
+    rows = np.linspace(0.5, 1.0, 11)
+    left = LaneLine(np.stack([0.45 - 0.6 * (rows - 0.5), rows], axis=1))
+    right = LaneLine(np.stack([0.55 + 0.6 * (rows - 0.5), rows], axis=1))
+    mirrored_left = LaneLine(np.stack([0.55 + 0.6 * (rows - 0.5), rows], axis=1))  # the left line in the mirror
+    mirrored_right_off = LaneLine(np.stack([np.full(11, 0.5), rows], axis=1))  # the right line read elsewhere
+    direct = [None, None, left, right, None, None]
+    flipped = [None, None, mirrored_right_off, mirrored_left, None, None]
+    kept = agreeing_lanes(direct, flipped, 0.015)
+    assert len(kept) == 1 and kept[0] is left
+
+
+def test_adabn_re_estimates_the_normalisation_statistics_only():
+    model = build_model(ModelSpec(family="seg", width=0.125, input_size=(128, 72)))
+    weights_before = {k: v.clone() for k, v in model.state_dict().items() if "running" not in k and "num_batches" not in k}
+    images = np.random.default_rng(0).integers(0, 255, (6, 72, 128, 3), dtype=np.uint8)
+    layers = adapt_batch_norm(model, images, torch.device("cpu"), batch=3)
+    assert layers > 0 and not model.training
+    state = model.state_dict()
+    assert all(torch.equal(state[k], v) for k, v in weights_before.items())
+    assert float(model.backbone.bn1.running_mean.abs().sum()) > 0.0  # reset from zero, then estimated
+
+
+def test_adapt_writes_a_model_usable_as_weights(tiny_dataset, tmp_path, capsys):  # noqa: F811
+    assert _train(tiny_dataset, tmp_path / "model", "ufld") == 0
+    frames = tmp_path / "my_frames"
+    frames.mkdir()
+    for index, path in enumerate(sorted((tiny_dataset / "train").rglob("*.png"))[:4]):
+        (frames / f"{index}.png").write_bytes(path.read_bytes())
+    assert frame_files((frames,), 2) == [frames / "0.png", frames / "3.png"]
+    out = tmp_path / "adapted"
+    code = main(["adapt", "--weights", str(tmp_path / "model"), "--frames", str(frames), "--out", str(out),
+                 "--epochs", "1", "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    summary = json.loads((out / "training.json").read_text())
+    assert summary["frames"] == 4 and summary["adabn_layers"] > 0 and "self_training" in summary
+    detector = LearnedDetector(out)
+    rgb = cv2.imread(str(frames / "0.png"))[..., ::-1]
+    assert isinstance(detector(np.ascontiguousarray(rgb), list(range(100, 144, 4))), list)
+    assert main(["detect", str(tiny_dataset / "train"), "--method", "ufld", "--weights", str(out),
+                 "--out", str(tmp_path / "pred.json")]) == 0
+
+
+def test_adapt_errors_exit_2(tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    assert main(["adapt", "--weights", "ufld", "--frames", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 2
+    assert "no png or jpg" in capsys.readouterr().err
+    assert main(["adapt", "--weights", str(tmp_path / "nowhere"), "--frames", str(tmp_path),
+                 "--out", str(tmp_path / "o")]) == 2
+    assert "no such model folder" in capsys.readouterr().err
