@@ -9,9 +9,9 @@ switched on apart so each can be measured (``lanevil train --photometric`` / ``-
   white-balance jitter, gamma, blur (defocus or motion), sensor noise (shot and read), JPEG at a random quality and
   random erasing. Always the same number of draws.
 - ``randomise``: what different worlds do: the paint mask comes from the labels (``paint_mask``: each lane drawn at
-  the width of a road marking, 15 cm of a 3.6 m lane, widened by ``PAINT_MARGIN``), and everything outside it is
-  re-coloured by a smooth random colour field and mixed with a random procedural texture (value noise, stripes or
-  blotches); then random cast shadows and light pools (soft polygons, across the paint too), and random occluders
+  the width of a road marking, 15 cm of a 3.6 m lane, widened by ``PAINT_MARGIN``); the whole image is re-coloured
+  by a smooth random colour field and mixed with a random procedural texture (value noise, stripes or blotches),
+  and inside the mask the paint's detail over its blurred road is added back on the new road (``recolour``); then random cast shadows and light pools (soft polygons, across the paint too), and random occluders
   and distractors (boxes of vehicle-like size, kerb-like and crack-like strokes) that are not lanes.
 """
 
@@ -27,6 +27,7 @@ PAINT_TO_LANE = 0.15 / 3.6  # a marking's width over a lane's width
 PAINT_MARGIN = 1.6  # the kept area is this many times the marking's width
 DEFAULT_SPACING = 0.35  # a lane's width at the bottom row over the image width, where one lane alone is labelled
 PHOTOMETRIC_DRAWS = 24
+PAINT_BLUR = 9  # box filter (pixels at the input size) wide enough to take the paint out of the road around it
 
 
 def _value_noise(rng: np.random.Generator, shape: tuple[int, int], cells: int, channels: int) -> np.ndarray:
@@ -166,18 +167,25 @@ def _distractors(rng: np.random.Generator, image: np.ndarray) -> None:
 
 
 def recolour(image: UInt8Array, keep: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """(H, W, 3) float32 in [0, 1]: ``image`` with everything outside ``keep`` (``paint_mask``) re-coloured by a
-    smooth random colour field and mixed with a random texture, and the paint inside it only tinted (by at most
-    25 % a channel)."""
+    """(H, W, 3) float32 in [0, 1]: ``image`` re-coloured by a smooth random colour field and mixed with a random
+    texture; inside ``keep`` (``paint_mask``) the same is done to the image blurred past the paint, and the paint's
+    own detail (the image less its blur) is added back, so the paint keeps its contrast on the new road and no seam
+    marks the kept area."""
     height, width = image.shape[:2]
     x = image.astype(np.float32) / 255.0
     tint = 0.4 + 1.2 * _value_noise(rng, (height, width), int(rng.integers(2, 8)), 3)
-    background = np.clip(x * tint, 0.0, 1.0)
     alpha = rng.uniform(0.0, 0.7)
-    lightness = 0.5 + x.mean(axis=2, keepdims=True)
-    background = (1.0 - alpha) * background + alpha * _texture(rng, (height, width)) * lightness
-    paint = np.clip(x * rng.uniform(0.75, 1.15, 3), 0.0, 1.0)
-    return np.where(keep[..., None], paint, np.clip(background, 0.0, 1.0)).astype(np.float32)
+    texture = _texture(rng, (height, width))
+
+    def new_look(rgb: np.ndarray) -> np.ndarray:
+        lightness = 0.5 + rgb.mean(axis=2, keepdims=True)
+        return (1.0 - alpha) * np.clip(rgb * tint, 0.0, 1.0) + alpha * texture * lightness
+
+    road = np.asarray(cv2.blur(x, (PAINT_BLUR, PAINT_BLUR)), np.float32)
+    painted = new_look(road) + (x - road) * rng.uniform(0.7, 1.2)
+    soft = np.asarray(cv2.GaussianBlur(keep.astype(np.float32), (0, 0), 1.0), np.float32)[..., None]
+    out = soft * painted + (1.0 - soft) * new_look(x)
+    return np.clip(out, 0.0, 1.0).astype(np.float32)
 
 
 def clutter(x: np.ndarray, rng: np.random.Generator) -> np.ndarray:
