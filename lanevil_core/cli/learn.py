@@ -59,6 +59,9 @@ def _train_arguments(parser: argparse.ArgumentParser) -> None:
                              "instead of held-out case folders of --data; repeatable")
     parser.add_argument("--loader-workers", type=count(0), default=0,
                         help="data-loading processes (default 0; on a GPU, several keep it fed)")
+    parser.add_argument("--time-limit", type=float, default=None,
+                        help="seconds of training after which no new epoch starts (the model is then exported as "
+                             "after the last epoch)")
     parser.add_argument("--threads", type=count(0), default=0,
                         help="CPU threads (default 0 = every core; use 1 when other work shares the cores: "
                              "oversubscribed threads make training many times slower)")
@@ -92,6 +95,8 @@ def _run_train(args: argparse.Namespace) -> int:
         raise UsageError(f"--backbone-weights {args.backbone_weights}: no such file")
     if args.backbone_weights is not None and args.width != 1.0:
         raise UsageError(f"--backbone-weights: ImageNet ResNet weights need --width 1.0 (not {args.width})")
+    if args.time_limit is not None and args.time_limit <= 0:
+        raise UsageError(f"--time-limit {args.time_limit:g}: must be positive")
     for data in args.val_data:
         if not data.is_dir():
             raise UsageError(f"--val-data {data}: no such folder")
@@ -113,7 +118,8 @@ def _run_train(args: argparse.Namespace) -> int:
                                  min_epochs=args.min_epochs,
                                  aam=AamSettings(keep_paint=args.aam_keep_paint), randomise=args.randomise,
                                  photometric=args.photometric, backbone_weights=args.backbone_weights,
-                                 val_data=tuple(args.val_data), loader_workers=args.loader_workers)
+                                 val_data=tuple(args.val_data), loader_workers=args.loader_workers,
+                                 time_limit=args.time_limit)
         summary = train(settings, show_progress=not args.quiet)
     except (ModelSpecError, TrainError) as error:
         raise UsageError(str(error)) from None

@@ -87,6 +87,7 @@ class TrainSettings:
     # the epoch kept with --patience is chosen on them, never on real frames
     val_data: tuple[Path, ...] = ()
     loader_workers: int = 0  # DataLoader processes (a GPU waits on one process's augmentation)
+    time_limit: float | None = None  # seconds of training after which no new epoch starts (--time-limit)
 
 
 def pick_device(name: str) -> torch.device:
@@ -271,9 +272,14 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     hard: list = []
 
     model.train()
+    training_started = time.perf_counter()
     for epoch in range(start_epoch, settings.epochs):
         if _patience_spent(best, epoch, settings.patience, settings.min_epochs):
             break  # a resumed run that had already stopped
+        if settings.time_limit is not None and time.perf_counter() - training_started > settings.time_limit:
+            if show_progress:
+                print(f"--time-limit {settings.time_limit:g} s reached: no epoch {epoch + 1}", flush=True)
+            break
         if bank and epoch >= 1:  # the model's attention means something after one epoch
             scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
                                 [p.frame_size for p in bank], device)
@@ -346,6 +352,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "photometric": settings.photometric,
         "backbone_weights": None if settings.backbone_weights is None else settings.backbone_weights.name,
         "val_data": [data.name for data in settings.val_data],
+        "time_limit": settings.time_limit,
         "seed": settings.seed,
         "device": device.type,
         "threads": torch.get_num_threads(),
