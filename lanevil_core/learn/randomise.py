@@ -11,8 +11,9 @@ switched on apart so each can be measured (``lanevil train --photometric`` / ``-
 - ``randomise``: what different worlds do: the paint mask comes from the labels (``paint_mask``: each lane drawn at
   the width of a road marking, 15 cm of a 3.6 m lane, widened by ``PAINT_MARGIN``); the whole image is re-coloured
   by a smooth random colour field and mixed with a random procedural texture (value noise, stripes or blotches),
-  and inside the mask the paint's detail over its blurred road is added back on the new road (``recolour``); then random cast shadows and light pools (soft polygons, across the paint too), and random occluders
-  and distractors (boxes of vehicle-like size, kerb-like and crack-like strokes) that are not lanes.
+  and inside the mask the paint's detail over its blurred road is added back on the new road (``recolour``);
+  then random cast shadows and light pools (soft polygons, across the paint too), and random occluders and
+  distractors (boxes of vehicle-like size, kerb-like and crack-like strokes) that are not lanes.
 """
 
 from __future__ import annotations

@@ -149,7 +149,8 @@ def test_mirror_agreement_keeps_lanes_read_alike_and_drops_the_rest():
 
 def test_adabn_re_estimates_the_normalisation_statistics_only():
     model = build_model(ModelSpec(family="seg", width=0.125, input_size=(128, 72)))
-    weights_before = {k: v.clone() for k, v in model.state_dict().items() if "running" not in k and "num_batches" not in k}
+    statistics = ("running", "num_batches")
+    weights_before = {k: v.clone() for k, v in model.state_dict().items() if not any(s in k for s in statistics)}
     images = np.random.default_rng(0).integers(0, 255, (6, 72, 128, 3), dtype=np.uint8)
     layers = adapt_batch_norm(model, images, torch.device("cpu"), batch=3)
     assert layers > 0 and not model.training
