@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -56,10 +57,13 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
                                                  "images; a dataset folder stands for its test split")
     from ..detect.split import METHODS
 
-    parser.add_argument("--method", choices=METHODS, required=True, action="append",
-                        help="learned (ufld: row anchors, seg: segmentation, laneatt: line anchors, bezier: "
-                             "Bézier curves, ganet: keypoints, scnn: message-passing segmentation; ONNX) or "
-                             "classical baseline; repeat to run several over one reading of the images")
+    parser.add_argument("--method", required=True, action="append", metavar="METHOD",
+                        help=f"built-in: {', '.join(METHODS)} (learned ufld: row anchors, seg: segmentation, laneatt: "
+                             "line anchors, bezier: Bézier curves, ganet: keypoints, scnn: message-passing "
+                             "segmentation; ONNX; hough, birdseye: classical); a plug-in's name "
+                             "(LANEVIL_DETECTORS, LANEVIL_DETECTORS_FILE, installed lanevil.detectors); or a "
+                             "source: http://HOST:PORT/PATH (a detector server) or onnx:PATH (a model with a sidecar "
+                             "JSON); repeat to run several over one reading of the images")
     parser.add_argument("--weights", type=Path, default=None,
                         help="model folder of a learned method (default: the model shipped with lanevil); "
                              "only with a single --method")
@@ -68,6 +72,12 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
                              "one METHOD.json each")
     parser.add_argument("--fixed-run-time", type=float, default=None, metavar="MS",
                         help="write this run_time instead of the measured one (byte-reproducible output)")
+
+
+def file_stem(method: str) -> str:
+    """A file name for a method: its name, or a source (``http://...``, ``onnx:PATH``) with every character that is
+    not a letter, digit, ``_``, ``.`` or ``-`` made one ``_`` per run."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", method).strip("._") or "detector"
 
 
 def _run_detect(args: argparse.Namespace) -> int:
@@ -88,7 +98,7 @@ def _run_detect(args: argparse.Namespace) -> int:
     except LaneFileError as error:
         raise UsageError(str(error)) from None
     for method, records in by_method.items():
-        path = args.out / f"{method}.json" if several else args.out
+        path = args.out / f"{file_stem(method)}.json" if several else args.out
         write_atomic(path, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
         print(f"{len(records)} predictions in {path}")
     return 0

@@ -36,7 +36,7 @@ def test_detectors_lists_every_method_with_kind_and_model(client) -> None:
     assert ufld["kind"] == "learned" and ufld["available"] and ufld["reason"] is None
     assert 0.0 <= ufld["model"]["val_accuracy"] <= 1.0 and ufld["model"]["input_size"] == [320, 180]
     assert by_name["hough"] == {"name": "hough", "kind": "classical", "available": True, "reason": None,
-                                "model": None}
+                                "model": None, "source": None, "real_trained": False}
     assert all(entry["available"] or entry["reason"] for entry in body["data"])
 
 
