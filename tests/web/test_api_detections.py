@@ -143,3 +143,28 @@ def test_openapi_documents_the_detector_routes(client) -> None:
     detector = next(param for param in image["parameters"] if param["name"] == "detector")
     assert "magenta" in detector["description"]
     assert "/api/detectors" in paths
+
+
+def test_a_plugin_server_is_listed_run_and_refused_when_down(client, monkeypatch, lane_server) -> None:
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        down = f"http://127.0.0.1:{sock.getsockname()[1]}/detect"
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={lane_server.url()};down={down}")
+    entries = {entry["name"]: entry for entry in client.get("/api/detectors").json()["data"]}
+    assert entries["mine"]["kind"] == "http" and entries["mine"]["source"] == lane_server.url()
+    response = client.get(f"{FRAME}/0/detections?detector=mine&{SIZE}")
+    assert response.status_code == 200, response.text
+    assert response.json()["detector"] == "mine" and lane_server.sizes == [(320, 180)]
+    for url in (f"{FRAME}/0/detections?detector=down&{SIZE}", f"{FRAME}/0.png?detector=down&{SIZE}"):
+        response = client.get(url)
+        assert response.status_code == 422, url
+        assert response.json()["field"] == "detector" and "cannot connect" in response.json()["detail"]
+    response = client.post("/api/drives", json={"case_id": SHADOW_ID, "detector": "down"})
+    assert response.status_code == 422 and "cannot connect" in response.json()["detail"]
+    response = client.get(f"{FRAME}/0/detections?detector={lane_server.url()}&{SIZE}")
+    assert response.status_code == 422  # a source is not a name here: the server calls no address it is given
+    monkeypatch.setenv("LANEVIL_DETECTORS", "broken")
+    response = client.get("/api/detectors")
+    assert response.status_code == 422 and "NAME=SOURCE" in response.json()["detail"]
