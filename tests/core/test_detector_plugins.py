@@ -252,7 +252,7 @@ def test_an_installed_entry_point_is_a_detector(installed_plugin, stripes) -> No
     assert names[: len(METHODS)] == METHODS and {"bright", "broken"} <= set(names)
     assert names.count("ufld") == 1  # a plug-in cannot take a built-in's name
     lanes = detector_for("bright")(stripes([200]), ROWS)
-    assert [set(lane) for lane in lanes] == [{201}]  # the first brightest column 100 of 160 (u_image 100.5) is 201 of 320
+    assert [set(lane) for lane in lanes] == [{201}]  # the brightest column 100 of 160: u_image 100.5, 201 of 320
     info = detector_info("bright")
     assert (info.kind, info.available, info.real_trained) == ("plugin", True, True)
     assert info.version == "bright@1.2.0" and info.source == "bright_lanes:BrightColumn"
