@@ -161,3 +161,14 @@ def striped_frame(columns: list[int], size: tuple[int, int] = SMALL_SIZE) -> Any
 @pytest.fixture
 def stripes() -> Callable[..., Any]:
     return striped_frame
+
+
+@pytest.fixture
+def down_url() -> str:
+    """The URL of a detector server that is down: a port just bound and closed again."""
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    return f"http://127.0.0.1:{port}/detect"

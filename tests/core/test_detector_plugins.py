@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import socket
 import textwrap
 import threading
 
@@ -26,13 +25,6 @@ from lanevil_core.labels.lanes import h_samples_for
 from lanevil_core.metrics.formats import LaneFileError
 
 ROWS = h_samples_for(180)
-
-
-def closed_port_url() -> str:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    return f"http://127.0.0.1:{port}/detect"
 
 
 @pytest.fixture(autouse=True)
@@ -119,7 +111,7 @@ def test_a_malformed_config_file_names_the_field(monkeypatch, tmp_path) -> None:
             detector_names()
 
 
-def test_failures_are_one_line_naming_the_detector(lane_server, stripes) -> None:
+def test_failures_are_one_line_naming_the_detector(lane_server, stripes, down_url) -> None:
     rgb = stripes([60])
     for path, message in (("/nonsense", "not JSON"), ("/bad", r"lanes\[0\] is not a list|lanes\[0\]\[0\]"),
                           ("/reject", "answered HTTP 400: .*image too small")):
@@ -131,7 +123,7 @@ def test_failures_are_one_line_naming_the_detector(lane_server, stripes) -> None
         detector_for(lane_server.url("/fail"))(rgb, ROWS)
     assert lane_server.calls["/fail"] == 2  # retried once (the default)
     with pytest.raises(LaneFileError, match=r"cannot connect .*\(after 2 tries\)"):
-        detector_for(closed_port_url())(rgb, ROWS)
+        detector_for(down_url)(rgb, ROWS)
 
 
 def test_a_slow_server_times_out(monkeypatch, tmp_path, lane_server, stripes) -> None:
@@ -160,11 +152,11 @@ def test_requests_in_flight_stay_within_the_concurrency_limit(monkeypatch, tmp_p
     assert lane_server.calls["/detect"] == 4 and lane_server.peak == concurrency
 
 
-def test_ready_detector_asks_an_http_detector_once(lane_server) -> None:
+def test_ready_detector_asks_an_http_detector_once(lane_server, down_url) -> None:
     ready_detector(lane_server.url())
     assert lane_server.calls == {"/detect": 1}
     with pytest.raises(LaneFileError, match="cannot connect"):
-        ready_detector(closed_port_url())
+        ready_detector(down_url)
 
 
 def _write_split(split, frames) -> None:
@@ -178,7 +170,8 @@ def _write_split(split, frames) -> None:
     (split / "test_label.json").write_text("\n".join(lines) + "\n")
 
 
-def test_lanevil_detect_with_an_http_method_and_with_the_server_down(tmp_path, lane_server, stripes, capsys) -> None:
+def test_lanevil_detect_with_an_http_method_and_with_the_server_down(tmp_path, lane_server, stripes, capsys,
+                                                                  down_url) -> None:
     split = tmp_path / "test"
     split.mkdir()
     _write_split(split, [stripes([60, 200]), stripes([100])])
@@ -191,7 +184,7 @@ def test_lanevil_detect_with_an_http_method_and_with_the_server_down(tmp_path, l
     assert sorted(path.name for path in both.iterdir()) == ["hough.json", "http_127.0.0.1_"
                                                             f"{lane_server.httpd.server_address[1]}_detect.json"]
     capsys.readouterr()
-    assert main(["detect", str(split), "--method", closed_port_url(), "--out", str(out)]) == 2
+    assert main(["detect", str(split), "--method", down_url, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("lanevil: error: detector: http://127.0.0.1:") and "cannot connect" in err
     assert len(err.splitlines()) == 1
@@ -199,10 +192,10 @@ def test_lanevil_detect_with_an_http_method_and_with_the_server_down(tmp_path, l
     assert "unknown detector 'yolo'" in capsys.readouterr().err
 
 
-def test_lanevil_drive_refuses_a_server_that_is_down(tmp_path, capsys) -> None:
+def test_lanevil_drive_refuses_a_server_that_is_down(tmp_path, capsys, down_url) -> None:
     case = tmp_path / "case.json"
     case.write_text("{}")
-    assert main(["drive", str(case), "--detector", closed_port_url(), "--out", str(tmp_path / "out")]) == 2
+    assert main(["drive", str(case), "--detector", down_url, "--out", str(tmp_path / "out")]) == 2
     assert "cannot connect" in capsys.readouterr().err
 
 

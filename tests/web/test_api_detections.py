@@ -145,13 +145,8 @@ def test_openapi_documents_the_detector_routes(client) -> None:
     assert "/api/detectors" in paths
 
 
-def test_a_plugin_server_is_listed_run_and_refused_when_down(client, monkeypatch, lane_server) -> None:
-    import socket
-
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        down = f"http://127.0.0.1:{sock.getsockname()[1]}/detect"
-    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={lane_server.url()};down={down}")
+def test_a_plugin_server_is_listed_run_and_refused_when_down(client, monkeypatch, lane_server, down_url) -> None:
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={lane_server.url()};down={down_url}")
     entries = {entry["name"]: entry for entry in client.get("/api/detectors").json()["data"]}
     assert entries["mine"]["kind"] == "http" and entries["mine"]["source"] == lane_server.url()
     response = client.get(f"{FRAME}/0/detections?detector=mine&{SIZE}")
