@@ -13,7 +13,7 @@ from ..metrics.formats import LaneFileError
 from ..metrics.tusimple import F1_VARIANTS
 from .base import Command, UsageError
 
-METRIC_CHOICES = ("tusimple", "culane", "ego")
+METRIC_CHOICES = ("tusimple", "culane", "ego", "pixel")
 
 
 def _eval_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,7 +23,12 @@ def _eval_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--pred", type=Path, required=True, help="predictions in the same format as --gt")
     parser.add_argument("--metric", choices=METRIC_CHOICES, default="tusimple",
                         help="default tusimple; ego: share of the ego lane's two lines matched (>= 85 %% of their "
-                             "labelled rows within 20 px) and their mean point accuracy")
+                             "labelled rows within 20 px) and their mean point accuracy; pixel: IoU and F1 of the "
+                             "lane-line pixels, both sides' lanes drawn --line-width wide (--pred may also be a "
+                             "folder of mask PNGs named like the GT images)")
+    parser.add_argument("--line-width", type=float, default=None, metavar="PX",
+                        help="pixel metric: lane-line width in pixels at 720 image rows, scaled with the height "
+                             "(default 8)")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet",
                         help="TuSimple F1 variant: ganet (P = 1-FP, R = 1-FN) or clrnet (default ganet)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -33,6 +38,10 @@ def _format_eval(result: dict) -> str:
     if result["metric"] == "tusimple":
         return (f"TuSimple  images {result['images']}  Accuracy {100 * result['accuracy']:.2f} %  "
                 f"FP {result['fp']:.4f}  FN {result['fn']:.4f}  F1({result['f1_variant']}) {100 * result['f1']:.2f} %")
+    if result["metric"] == "pixel":
+        return (f"Pixel lane lines ({result['line_width']:g} px at 720 rows)  images {result['images']}  "
+                f"IoU {100 * result['iou']:.2f} %  F1 {100 * result['f1']:.2f} %  P {100 * result['precision']:.2f} %  "
+                f"R {100 * result['recall']:.2f} %")
     if result["metric"] == "ego":
         return (f"Ego lines  images {result['images']}  lines {result['ego_lines']}  matched {result['matched']} "
                 f"({100 * result['match_share']:.2f} %)  point accuracy {100 * result['point_accuracy']:.2f} %")
@@ -43,9 +52,13 @@ def _format_eval(result: dict) -> str:
 
 def _run_eval(args: argparse.Namespace) -> int:
     from ..metrics.evaluate import evaluate
+    from ..metrics.pixel import LINE_WIDTH_720
 
+    if args.line_width is not None and args.metric != "pixel":
+        raise UsageError("--line-width: only with --metric pixel")
     try:
-        result = evaluate(args.gt, args.pred, args.metric, args.f1)
+        result = evaluate(args.gt, args.pred, args.metric, args.f1,
+                          args.line_width if args.line_width is not None else LINE_WIDTH_720)
     except LaneFileError as error:
         raise UsageError(str(error)) from None
     print(json.dumps(result) if args.json else _format_eval(result))
