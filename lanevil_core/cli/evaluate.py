@@ -129,9 +129,30 @@ def _report_arguments(parser: argparse.ArgumentParser) -> None:
                              "gain over this one (e.g. the model trained with --augment none); with runs named "
                              "DEFENCE@SEED (e.g. --name none@0 --name aam@0 --name none@1 --name aam@1 --baseline "
                              "none), one table per seed and the mean gain over seeds")
+    parser.add_argument("--real-trained", action="append", default=[], metavar="NAME",
+                        help="a detector (its --name) trained on real roads: reported apart in the Real -> LanEvil "
+                             "table (real_to_lanevil.md); repeatable. Plug-ins marked real_trained are included "
+                             "without it")
     parser.add_argument("--out", type=Path, required=True, help="report folder")
     parser.add_argument("--f1", choices=tuple(F1_VARIANTS), default="ganet", help="F1 variant (default ganet)")
     parser.add_argument("--title", default=None, help="report title (default: from the prediction file name)")
+
+
+def real_trained(names: list[str], marked: list[str]) -> list[str]:
+    """The detectors of ``names`` reported in the Real -> LanEvil table: those ``--real-trained`` names, and the
+    plug-ins whose configuration or metadata says so (a malformed plug-in configuration marks none)."""
+    from ..detect.catalog import detector_info
+    from ..detect.registry import plugin_specs
+
+    unknown = sorted(set(marked) - set(names))
+    if unknown:
+        raise UsageError(f"--real-trained {unknown[0]!r}: not one of the detector names {', '.join(names)}")
+    try:
+        plugins = set(plugin_specs())
+        by_plugin = {name for name in names if name in plugins and detector_info(name).real_trained}
+    except LaneFileError:
+        by_plugin = set()
+    return [name for name in names if name in marked or name in by_plugin]
 
 
 def _run_report(args: argparse.Namespace) -> int:
@@ -159,6 +180,7 @@ def _run_report(args: argparse.Namespace) -> int:
                    (("original", total.original), ("perturbed", total.perturbed), ("paint-free", total.no_paint))
                    if stats is not None]
         print(f"{detector.name}: accuracy " + ", ".join(figures))
+    real = real_trained(names, args.real_trained)
     if len(detectors) == 1:
         paths = write_report(detectors[0].report, args.out)
     else:
@@ -167,6 +189,10 @@ def _run_report(args: argparse.Namespace) -> int:
             raise UsageError(f"--baseline {args.baseline!r}: not one of the detector names {', '.join(names)} "
                              f"(nor a defence whose runs are named {args.baseline}{SEED_MARK}SEED)")
         paths = write_comparison(detectors, args.out, args.f1, args.baseline)
+    if real:
+        from ..report.real_to_lanevil import write_real_table
+
+        paths += write_real_table([d for d in detectors if d.name in real], args.out, args.f1)
     for path in paths:
         print(path)
     return 0
