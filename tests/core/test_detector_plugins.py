@@ -251,3 +251,14 @@ def test_an_installed_entry_point_is_a_detector(installed_plugin, stripes) -> No
     assert info.version == "bright@1.2.0" and info.source == "bright_lanes:BrightColumn"
     broken = detector_info("broken")
     assert not broken.available and "RuntimeError: no weights file" in broken.reason
+
+
+def test_lanevil_drive_with_an_http_detector_in_the_loop(tmp_path, make_case, lane_server) -> None:
+    case = tmp_path / "case.json"
+    case.write_text(make_case().model_dump_json())
+    out = tmp_path / "drive"
+    assert main(["drive", str(case), "--detector", lane_server.url(), "--seconds", "0.3", "--size", "160x90",
+                 "--out", str(out), "--no-video", "--json"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    # one black probe frame before the drive, then every step's frame
+    assert summary["steps"] >= 3 and lane_server.sizes == [(640, 360)] + [(160, 90)] * summary["steps"]
