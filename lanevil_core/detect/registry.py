@@ -22,10 +22,10 @@ or ``-``; a built-in method's name, ``gt`` and ``none`` are taken.
 
 from __future__ import annotations
 
-import functools
 import json
 import os
 import re
+import threading
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, Literal
@@ -201,12 +201,21 @@ def plugin_real_trained(spec: PluginSpec) -> bool:
     return spec.real_trained or bool(getattr(loaded_plugin(spec).plugin, "real_trained", False))
 
 
-@functools.lru_cache(maxsize=16)
+_HTTP_CLIENTS: dict[PluginSpec, Any] = {}
+_HTTP_LOCK = threading.Lock()
+
+
 def _http(spec: PluginSpec) -> Any:
+    """One client per spec, made under a lock: two callers never get two clients (and twice the concurrency)."""
     from .http_detector import HttpLaneDetector
 
-    return HttpLaneDetector(spec.name, spec.source, spec.input_size, spec.real_trained, spec.timeout_s, spec.retries,
-                            spec.concurrency)
+    with _HTTP_LOCK:
+        client = _HTTP_CLIENTS.get(spec)
+        if client is None:
+            client = _HTTP_CLIENTS[spec] = HttpLaneDetector(spec.name, spec.source, spec.input_size,
+                                                            spec.real_trained, spec.timeout_s, spec.retries,
+                                                            spec.concurrency)
+        return client
 
 
 def loaded_plugin(spec: PluginSpec) -> Any:
