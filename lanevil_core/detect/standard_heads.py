@@ -13,7 +13,7 @@ coordinates (docs/conventions.md). The expected tensors, with the batch axis:
   ``(1, h, w)``; any ``h, w`` (the map covers the whole input). Pixels above ``threshold`` are cut into runs per
   map row, runs are chained bottom-up into lanes (the nearest run within ``cluster_px`` map pixels of where a lane
   is heading, across gaps up to ``max_gap`` of the map's height, so dashes join), and each lane with enough rows
-  is fitted by a polynomial ``x(y)`` of degree at most 2.
+  is fitted by ``x(y)``: a parabola when it spans a quarter of the map's height or more, else a line.
 - ``polynomial`` (LSTR): ``(1, Q, C)`` class scores (softmax; a query is a lane where class ``lane_class`` wins) and
   ``(1, Q, 8)`` curves ``[y_lower, y_upper, k, f, m, n, b, b']`` in normalised input coordinates:
   ``x = k / (y - f)^2 + m / (y - f) + n + b * y - b'`` for ``y`` from ``y_lower`` to ``y_upper``.
@@ -33,6 +33,7 @@ HEADS = ("row_anchors", "mask", "polynomial")
 CURVE_SAMPLES = 50
 MIN_MASK_ROWS = 4  # map rows a mask lane must cover
 MAX_FIT_DEGREE = 2
+CURVED_SPAN = 0.25  # share of the map's height a lane must span to be fitted by a parabola rather than a line
 
 
 def softmax(scores: FloatArray, axis: int) -> FloatArray:
@@ -107,10 +108,13 @@ def cluster_mask(on: np.ndarray, cluster_px: float, max_gap_rows: int) -> list[l
 
 
 def fitted_chain(points: Sequence[tuple[float, float]], size: tuple[int, int]) -> FloatArray:
-    """(n, 2) normalised polyline of a chain of map points fitted by ``x(y)`` of degree <= 2, one point per row."""
+    """(n, 2) normalised polyline of a chain of map points fitted by ``x(y)`` (a parabola for a long chain, else a
+    line), one point per row."""
     width, height = size
     u_map, v_map = np.asarray(points, np.float64).T
-    degree = min(MAX_FIT_DEGREE, len(np.unique(v_map)) - 1)
+    # a short chain bends wherever its few rows lead a parabola: only a long one may curve
+    curved = np.ptp(v_map) >= CURVED_SPAN * height
+    degree = min(MAX_FIT_DEGREE if curved else 1, len(np.unique(v_map)) - 1)
     coeffs = np.polyfit(v_map, u_map, degree)
     v_rows = np.sort(np.unique(v_map))
     return np.stack([np.polyval(coeffs, v_rows) / width, v_rows / height], axis=1)
