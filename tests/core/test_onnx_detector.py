@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import json
+import math
 import warnings
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -154,3 +156,51 @@ def test_a_trained_mask_model_finds_the_lines(tmp_path, monkeypatch, capsys) -> 
     capsys.readouterr()
     assert main(["detect", str(split), "--method", f"onnx:{tmp_path / 'other.onnx'}", "--out", str(out)]) == 2
     assert "no ONNX model at" in capsys.readouterr().err
+
+
+def constant_model(tmp_path, outputs: dict[str, np.ndarray], sidecar: dict) -> Path:
+    """An ONNX model whose outputs are fixed tensors (the image only touches them times zero), and its sidecar."""
+    torch = pytest.importorskip("torch")
+
+    class Constant(torch.nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.values = torch.nn.ParameterList([torch.nn.Parameter(torch.tensor(v[None], dtype=torch.float32))
+                                                  for v in outputs.values()])
+
+        def forward(self, image):
+            return tuple(value + 0.0 * image.mean() for value in self.values)
+
+    path = tmp_path / "constant.onnx"
+    width, height = sidecar["input_size"]
+    with torch.no_grad(), warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        torch.onnx.export(Constant(), torch.zeros(1, 3, height, width), str(path), input_names=["image"],
+                          output_names=list(outputs), dynamo=False)
+    (tmp_path / "constant.json").write_text(json.dumps(sidecar))
+    return path
+
+
+def test_a_row_anchor_model_s_lanes_land_in_the_frame_through_the_crop(tmp_path) -> None:
+    scores = np.full((11, 4, 2), -10.0)
+    scores[4, :, 0] = 10.0  # lane 0 in cell 4 of 10 at every anchor: x_norm 0.45
+    scores[10, :, 1] = 10.0  # lane 1 absent
+    path = constant_model(tmp_path, {"row_scores": scores}, {
+        "head": "row_anchors", "input_size": [80, 40], "crop": [0, 0.5, 1, 1], "row_anchors": [10, 20, 30, 39]})
+    (lane,) = detector_for(f"onnx:{path}")(line_frame([]), ROWS)
+    # the crop is rows 90..180; anchors at input rows 10..39 of 40 are frame rows 112.5 .. 177.75
+    seen = {h: x for h, x in zip(ROWS, lane, strict=True) if x >= 0}
+    assert min(seen) == 112 and max(seen) == 175 and set(seen.values()) == {144}  # u_image 0.45 * 320
+
+
+def test_a_polynomial_model_s_curves_are_sampled_in_frame_pixels(tmp_path) -> None:
+    curves = np.array([[0.2, 1.0, 0.0, -1.0, 0.0, 0.25, 0.5, 0.0], [0.2, 1.0, 0.0, -1.0, 0.0, 0.9, 0.0, 0.0]])
+    path = constant_model(tmp_path, {"pred_logits": np.array([[0.0, 5.0], [5.0, 0.0]]), "pred_curves": curves},
+                          {"head": "polynomial", "input_size": [64, 36], "outputs": ["pred_logits", "pred_curves"]})
+    (lane,) = detector_for(f"onnx:{path}")(line_frame([]), ROWS)
+    for h, x in zip(ROWS, lane, strict=True):
+        y = (h + 0.5) / 180
+        if y >= 0.2 + 0.01:
+            assert abs(x - math.floor((0.25 + 0.5 * y) * 320)) <= 1, (h, x)
+        elif y < 0.2 - 0.01:
+            assert x == -2
