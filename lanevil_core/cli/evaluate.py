@@ -106,6 +106,10 @@ def _run_detect(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {args.out}: with several --method, a folder (it is a file)")
     if not several and args.out.is_dir():
         raise UsageError(f"--out {args.out}: with one --method, a predictions file (it is a folder)")
+    stems = [file_stem(method) for method in args.method]
+    if several and len(set(stems)) < len(stems):
+        raise UsageError(f"--method: two methods would write the same file in --out ({', '.join(args.method)}); "
+                         "name them in LANEVIL_DETECTORS")
     try:
         by_method = detect_split_methods(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:

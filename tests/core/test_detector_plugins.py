@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import textwrap
 import threading
 
 import numpy as np
@@ -184,6 +183,9 @@ def test_lanevil_detect_with_an_http_method_and_with_the_server_down(tmp_path, l
     assert sorted(path.name for path in both.iterdir()) == ["hough.json", "http_127.0.0.1_"
                                                             f"{lane_server.httpd.server_address[1]}_detect.json"]
     capsys.readouterr()
+    assert main(["detect", str(split), "--method", lane_server.url(), "--method", lane_server.url() + "?",
+                 "--out", str(both)]) == 2
+    assert "would write the same file" in capsys.readouterr().err
     assert main(["detect", str(split), "--method", down_url, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("lanevil: error: detector: http://127.0.0.1:") and "cannot connect" in err
@@ -197,47 +199,6 @@ def test_lanevil_drive_refuses_a_server_that_is_down(tmp_path, capsys, down_url)
     case.write_text("{}")
     assert main(["drive", str(case), "--detector", down_url, "--out", str(tmp_path / "out")]) == 2
     assert "cannot connect" in capsys.readouterr().err
-
-
-PLUGIN_MODULE = '''
-"""A plug-in detector installed for a test: the brightest column of the bottom row is its one lane."""
-import numpy as np
-
-from lanevil_core.detect.plugin import LaneDetector
-
-
-class BrightColumn(LaneDetector):
-    input_size = (160, 90)
-    real_trained = True
-
-    def detect(self, rgb):
-        assert rgb.shape == (90, 160, 3), rgb.shape
-        x = float(np.argmax(rgb[-1].sum(axis=1)))
-        return [[[x, 0.0], [x, rgb.shape[0] - 1.0]]]
-
-
-class Broken:
-    def __init__(self):
-        raise RuntimeError("no weights file")
-'''
-
-
-@pytest.fixture
-def installed_plugin(tmp_path, monkeypatch):
-    """A real installed distribution: a module and its ``*.dist-info`` with ``entry_points.txt`` on sys.path."""
-    site = tmp_path / "site"
-    site.mkdir()
-    (site / "bright_lanes.py").write_text(textwrap.dedent(PLUGIN_MODULE))
-    info = site / "bright_lanes-1.2.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: bright-lanes\nVersion: 1.2.0\n")
-    (info / "entry_points.txt").write_text("[lanevil.detectors]\nbright = bright_lanes:BrightColumn\n"
-                                           "broken = bright_lanes:Broken\nufld = bright_lanes:BrightColumn\n")
-    monkeypatch.syspath_prepend(str(site))
-    yield site
-    import sys
-
-    sys.modules.pop("bright_lanes", None)
 
 
 def test_an_installed_entry_point_is_a_detector(installed_plugin, stripes) -> None:

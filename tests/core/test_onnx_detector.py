@@ -91,47 +91,8 @@ def test_the_sidecar_is_checked_field_by_field(tmp_path) -> None:
     assert np.all(batch[0, 2] == 1.0) and np.all(batch[0, 0] == -1.0)  # red is the last channel in bgr
 
 
-def train_mask_model(tmp_path, input_size=(128, 72)):
-    """A two-layer lane-line segmenter trained for a few steps on drawn lines, exported to ONNX."""
-    torch = pytest.importorskip("torch")
-    torch.manual_seed(0)
-    torch.set_num_threads(1)
-    rng = np.random.default_rng(0)
-    width, height = input_size
-    images, masks = [], []
-    for _ in range(16):
-        rgb = np.full((height, width, 3), rng.integers(20, 90), np.uint8)
-        mask = np.zeros((height, width), np.uint8)
-        for _ in range(2):
-            start = (int(rng.integers(0, width)), height - 1)
-            end = (int(rng.integers(0, width)), int(rng.integers(0, height // 2)))
-            cv2.line(rgb, start, end, (255, 255, 255), 2)
-            cv2.line(mask, start, end, 1, 2)
-        noise = rng.normal(0, 8, rgb.shape)
-        images.append(np.clip(rgb + noise, 0, 255).astype(np.uint8))
-        masks.append(mask)
-    x = torch.tensor((np.stack(images).astype(np.float32) / 255.0 - 0.5) / 0.5).permute(0, 3, 1, 2)
-    y = torch.tensor(np.stack(masks), dtype=torch.float32)[:, None]
-    model = torch.nn.Sequential(torch.nn.Conv2d(3, 8, 3, padding=1), torch.nn.ReLU(), torch.nn.Conv2d(8, 1, 1))
-    optimiser = torch.optim.Adam(model.parameters(), lr=0.03)
-    for _ in range(150):
-        optimiser.zero_grad()
-        loss = torch.nn.functional.binary_cross_entropy_with_logits(model(x), y, pos_weight=torch.tensor(4.0))
-        loss.backward()
-        optimiser.step()
-    path = tmp_path / "lanes.onnx"
-    model.eval()
-    with torch.no_grad(), warnings.catch_warnings():  # the TorchScript exporter, as lanevil_core.learn.export
-        warnings.simplefilter("ignore", DeprecationWarning)
-        torch.onnx.export(model, x[:1], str(path), input_names=["image"], output_names=["mask"], dynamo=False)
-    (tmp_path / "lanes.json").write_text(json.dumps({
-        "head": "mask", "input_size": list(input_size), "mean": [0.5] * 3, "std": [0.5] * 3, "color_order": "bgr",
-        "crop": [0.0, 0.25, 1.0, 1.0], "logits": True, "threshold": 0.5, "real_trained": True}))
-    return path
-
-
-def test_a_trained_mask_model_finds_the_lines(tmp_path, monkeypatch, capsys) -> None:
-    path = train_mask_model(tmp_path)
+def test_a_trained_mask_model_finds_the_lines(mask_model, tmp_path, monkeypatch, capsys) -> None:
+    path = mask_model
     lines = [((40, 179), (140, 70)), ((290, 179), (190, 70))]
     rgb = line_frame(lines)
     lanes = detector_for(f"onnx:{path}")(rgb, ROWS)
@@ -152,7 +113,7 @@ def test_a_trained_mask_model_finds_the_lines(tmp_path, monkeypatch, capsys) -> 
     out = tmp_path / "pred.json"
     assert main(["detect", str(split), "--method", "seg-real", "--out", str(out)]) == 0
     assert json.loads(out.read_text())["lanes"] == lanes
-    (tmp_path / "lanes.json").unlink()
+    path.with_suffix(".json").unlink()
     capsys.readouterr()
     assert main(["detect", str(split), "--method", f"onnx:{tmp_path / 'other.onnx'}", "--out", str(out)]) == 2
     assert "no ONNX model at" in capsys.readouterr().err

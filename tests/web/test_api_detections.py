@@ -163,3 +163,21 @@ def test_a_plugin_server_is_listed_run_and_refused_when_down(client, monkeypatch
     monkeypatch.setenv("LANEVIL_DETECTORS", "broken")
     response = client.get("/api/detectors")
     assert response.status_code == 422 and "NAME=SOURCE" in response.json()["detail"]
+
+
+def test_an_onnx_model_and_an_installed_plugin_work_as_a_server_does(client, monkeypatch, mask_model,
+                                                                     installed_plugin) -> None:
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"bdd-seg=onnx:{mask_model}")
+    entries = {entry["name"]: entry for entry in client.get("/api/detectors").json()["data"]}
+    assert (entries["bdd-seg"]["kind"], entries["bdd-seg"]["available"], entries["bdd-seg"]["real_trained"]) == \
+        ("onnx", True, True)
+    assert (entries["bright"]["kind"], entries["bright"]["real_trained"]) == ("plugin", True)
+    assert not entries["broken"]["available"] and "no weights file" in entries["broken"]["reason"]
+    for name in ("bdd-seg", "bright"):
+        response = client.get(f"{FRAME}/0/detections?detector={name}&{SIZE}")
+        assert response.status_code == 200, response.text
+        body = response.json()
+        assert body["detector"] == name and all(len(lane) == len(body["h_samples"]) for lane in body["lanes"])
+        assert client.get(f"{FRAME}/0.png?detector={name}&{SIZE}").status_code == 200
+    response = client.get(f"{FRAME}/0/detections?detector=broken&{SIZE}")
+    assert response.status_code == 422 and "RuntimeError: no weights file" in response.json()["detail"]
