@@ -12,15 +12,17 @@ give; every other field of the case camera (``case.Camera``) keeps its default::
       "height": 1.55,                                // required: mount height above the road (m)
       "pitch": 3.5,                                  // degrees, positive looks down; or instead
       "horizon_row": 290,                            //   the image row of the flat road's horizon, or
-      "vanishing_point": [652, 290],                 //   where the straight road's lines meet (also gives yaw)
+      "vanishing_point": [652, 290],                 //   where the straight road's lines meet (also gives yaw), or
+      "lane_labels": "straight_frames.json",         //   TuSimple labels of straight-road frames it is found from
       "yaw": 0.0, "roll": 0.0, "x": 1.6, "y": 0.0,   // optional: degrees; mount ahead of / left of the vehicle (m)
       "bonnet_row": 672,                             // optional: the row where the bonnet starts at the centre column
       "bonnet": {"reach": 2.2, "drop": 0.5},         //   or the bonnet itself (``case.Bonnet``)
       "sensor": {"noise": 1.0}                       // optional: ``case.Sensor`` fields
     }
 
-A horizon row or vanishing point (read off a few straight-road frames of the camera: where the lane lines meet)
-gives the pitch ``atan((cy - v) / fy)`` and, from the vanishing point's column, the yaw
+A horizon row or vanishing point (read off a few straight-road frames of the camera: where the lane lines meet;
+or found from those frames' TuSimple lane labels, ``camera.vanishing``; a relative path is read from the
+calibration file's folder) gives the pitch ``atan((cy - v) / fy)`` and, from the vanishing point's column, the yaw
 ``atan(cos(pitch) (u - cx) / fx)`` (the mount turns by yaw, then pitches);
 both are measured through the lens (undistorted first). A bonnet row gives the bonnet's reach for a front edge
 ``bonnet_drop`` below the camera (default 0.5 m). Pixels are square: ``fx`` and ``fy`` must agree within 1 %.
@@ -60,6 +62,7 @@ class Calibration(BaseModel):
     pitch: float | None = None
     horizon_row: float | None = None
     vanishing_point: tuple[float, float] | None = None
+    lane_labels: str | None = None
     yaw: float | None = None
     roll: float = 0.0
     x: float | None = None
@@ -74,10 +77,11 @@ class Calibration(BaseModel):
         focal = [name for name in ("fx", "K", "hfov") if getattr(self, name) is not None]
         if len(focal) != 1:
             raise ValueError("give the focal length once: fx (and fy), K or hfov")
-        tilt = [name for name in ("pitch", "horizon_row", "vanishing_point") if getattr(self, name) is not None]
+        tilt = [name for name in ("pitch", "horizon_row", "vanishing_point", "lane_labels")
+                if getattr(self, name) is not None]
         if len(tilt) > 1:
-            raise ValueError(f"give one of pitch, horizon_row, vanishing_point (not {' and '.join(tilt)})")
-        if self.vanishing_point is not None and self.yaw is not None:
+            raise ValueError(f"give one of pitch, horizon_row, vanishing_point, lane_labels (not {' and '.join(tilt)})")
+        if (self.vanishing_point is not None or self.lane_labels is not None) and self.yaw is not None:
             raise ValueError("the vanishing point gives the yaw: leave yaw out")
         if self.bonnet_row is not None and self.bonnet is not None:
             raise ValueError("give bonnet_row or bonnet, not both")
@@ -156,6 +160,21 @@ def _first_error(error: ValidationError) -> str:
     return f"{where}: {first['msg']}" if where else first["msg"]
 
 
+def labelled_vanishing_point(labels: Path) -> tuple[float, float]:
+    """The vanishing point of the straight-road frames labelled in a TuSimple file (``camera.vanishing``)."""
+    from ..metrics.formats import LaneFileError, read_tusimple
+    from .vanishing import vanishing_point
+
+    try:
+        records = read_tusimple(labels, "gt")
+    except LaneFileError as error:
+        raise ValueError(f"lane_labels: {error}") from None
+    try:
+        return vanishing_point([(record.lanes, record.h_samples) for record in records])
+    except ValueError as error:
+        raise ValueError(f"lane_labels {labels.name}: {error}") from None
+
+
 def load_camera(path: str | Path) -> Camera:
     """The case camera described by the calibration file ``path``; raises ``CalibrationError``."""
     path = Path(path)
@@ -166,7 +185,12 @@ def load_camera(path: str | Path) -> Camera:
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise CalibrationError(f"--camera {path}: not JSON ({error})") from None
     try:
-        return Camera.model_validate(camera_fields(Calibration.model_validate(data)))
+        calibration = Calibration.model_validate(data)
+        if calibration.lane_labels is not None:
+            calibration = calibration.model_copy(update={
+                "vanishing_point": labelled_vanishing_point(path.parent / calibration.lane_labels),
+                "lane_labels": None})
+        return Camera.model_validate(camera_fields(calibration))
     except ValidationError as error:
         raise CalibrationError(f"--camera {path}: {_first_error(error)}") from None
     except ValueError as error:

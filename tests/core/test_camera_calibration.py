@@ -99,3 +99,42 @@ def test_dataset_cases_are_seen_through_the_calibrated_camera(tmp_path, capsys) 
     assert "--camera" in capsys.readouterr().err
     assert main(["dataset", "--cases", str(SCENES), "--out", str(tmp_path / "out"), "--camera", "fisheye"]) == 2
     assert "unknown camera preset 'fisheye'" in capsys.readouterr().err
+
+
+def test_the_vanishing_point_of_synthetic_lanes_is_where_they_meet() -> None:
+    from lanevil_core.camera.vanishing import vanishing_point
+
+    truth = (652.0, 290.0)
+    rows = list(range(300, 720, 10))
+    records = []
+    for shift in (-30.0, 0.0, 25.0):  # three frames, the lanes' bottoms shifted as the car drifts
+        lanes = [[math.floor(truth[0] + (h + 0.5 - truth[1]) * (slope + shift / 430)) for h in rows]
+                 for slope in (-1.6, -0.5, 0.6, 1.7)]
+        records.append((lanes, rows))
+    u, v = vanishing_point(records)
+    assert u == pytest.approx(truth[0], abs=1.0) and v == pytest.approx(truth[1], abs=1.0)
+    with pytest.raises(ValueError, match="two lanes that meet"):
+        vanishing_point([([[100] * len(rows)], rows)])
+
+
+def test_lane_labels_of_rendered_straight_frames_give_the_pitch(tmp_path) -> None:
+    from lanevil_core.labels.lanes import tusimple_record
+    from lanevil_core.pipeline.compile import compile_scene
+    from lanevil_core.render import render_frame
+
+    data = json.loads((SCENES / "00_clean" / "00_straight_urban.json").read_text())
+    data["camera"] = {"width": 640, "height": 360, "fov": 62.0, "z": 1.55, "x": 1.6, "pitch": 2.5}
+    case = parse_case(data)
+    scene = compile_scene(case)
+    labels = tmp_path / "straight.json"
+    lines = []
+    for index in (0, 20):
+        frame = render_frame(scene, index, (640, 360))
+        lines.append(json.dumps(tusimple_record(scene, index, frame, f"{index}.png")))
+    labels.write_text("\n".join(lines) + "\n")
+    camera = load_camera(write(tmp_path, {"image_size": [640, 360], "hfov": 62.0, "height": 1.55,
+                                          "lane_labels": "straight.json"}))
+    assert camera.pitch == pytest.approx(2.5, abs=0.05) and abs(camera.yaw) < 0.1  # measured: 2.498, -0.002
+    with pytest.raises(CalibrationError, match="lane_labels: .*no such file"):
+        load_camera(write(tmp_path, {"image_size": [640, 360], "hfov": 62.0, "height": 1.55,
+                                     "lane_labels": "missing.json"}))
