@@ -278,14 +278,11 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
 NO_PAINT_SUFFIX = "_nopaint"
 
 
-def seen_through(planned: PlannedCase, camera: str) -> PlannedCase:
-    """The same case and frames seen through ``--camera``: a camera preset, or a calibration file
-    (``camera.calibration``)."""
+def seen_through(planned: PlannedCase, camera: dict[str, Any], label: str) -> PlannedCase:
+    """The same case and frames seen through the camera fields ``camera`` of ``--camera`` (``label``: the preset's
+    or the calibration file's name)."""
     data = parse_case(planned.case_text).model_dump()
-    try:
-        data["camera"], label = camera_choice(camera)
-    except CalibrationError as error:
-        raise PlanError(str(error)) from None
+    data["camera"] = camera
     return replace(planned, case_text=case_json(parse_case(data)), source={**planned.source, "camera": label})
 
 
@@ -426,7 +423,11 @@ def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = t
         planned += [paint_free(case) for case in planned if case.severity == 0]
     planned += train_cases(clean, settings.train_frames, settings.seed, settings.vary_camera)
     if settings.camera is not None:  # every case through one camera; drawn train cameras stay drawn
-        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, settings.camera)
+        try:  # a preset, or a calibration file read once (``camera.calibration``)
+            camera, label = camera_choice(settings.camera)
+        except CalibrationError as error:
+            raise PlanError(str(error)) from None
+        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, camera, label)
                    for case in planned]
     if not planned:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")

@@ -94,6 +94,9 @@ def test_dataset_cases_are_seen_through_the_calibrated_camera(tmp_path, capsys) 
     plan = build_plan(sources, Settings(frames_per_case=1, sampling="even", camera=str(path)))
     for planned in plan.cases:
         assert parse_case(planned.case_text).camera.model_dump() == fields and planned.source["camera"] == label
+    dashcam = Camera.model_validate({"preset": "dashcam"}).model_dump()
+    plan = build_plan(sources, Settings(frames_per_case=1, sampling="even", camera="dashcam"))
+    assert all(parse_case(planned.case_text).camera.model_dump() == dashcam for planned in plan.cases)
     assert main(["dataset", "--cases", str(SCENES), "--out", str(tmp_path / "out"), "--camera",
                  str(tmp_path / "none.json")]) == 2
     assert "--camera" in capsys.readouterr().err
