@@ -181,7 +181,7 @@ MASK_INPUT_SIZE = (128, 72)
 @pytest.fixture(scope="session")
 def trained_mask_model(tmp_path_factory) -> Path:
     """A two-layer lane-line segmenter trained for a few steps on drawn white lines, exported to ONNX with its
-    sidecar (a ``mask`` head; the frame's top quarter cropped; real_trained); trained once per session."""
+    sidecar (a ``mask`` head; the frame's top quarter cropped; real_trained); trained once per test run."""
     import json
     import warnings
 

@@ -26,6 +26,7 @@ then ``(value - mean) / std``.
 from __future__ import annotations
 
 import functools
+import importlib.util
 import json
 import threading
 from collections.abc import Sequence
@@ -166,22 +167,16 @@ class OnnxLaneDetector:
     input_size = None  # the crop and resize are the sidecar's
 
     def __init__(self, name: str, onnx_path: Path) -> None:
-        try:
-            import onnxruntime
-        except ImportError:
-            raise LaneFileError("detector: onnxruntime is not installed (pip install onnxruntime)") from None
-
-        from .learned import providers
+        if importlib.util.find_spec("onnxruntime") is None:
+            raise LaneFileError("detector: onnxruntime is not installed (pip install onnxruntime)")
+        from .learned import inference_session
 
         self.name = name
         self.path = onnx_path
         self.sidecar = Sidecar.load(sidecar_path(onnx_path))
         self.real_trained = self.sidecar.real_trained
-        options = onnxruntime.SessionOptions()
-        options.add_session_config_entry("session.intra_op.allow_spinning", "0")
-        options.log_severity_level = 3
         try:
-            self._session = onnxruntime.InferenceSession(str(onnx_path), options, providers=providers())
+            self._session = inference_session(onnx_path)
         except Exception as error:  # noqa: BLE001 - onnxruntime raises its own error types
             raise LaneFileError(f"{onnx_path}: not a usable ONNX model ({str(error).splitlines()[0]})") from None
         names = [output.name for output in self._session.get_outputs()]
