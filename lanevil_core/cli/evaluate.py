@@ -1,4 +1,5 @@
-"""``lanevil eval``, ``lanevil detect`` and ``lanevil report``: metrics, classical baselines, robustness tables."""
+"""``lanevil eval``, ``lanevil detect``, ``lanevil detectors`` and ``lanevil report``: metrics, detectors,
+robustness tables."""
 
 from __future__ import annotations
 
@@ -202,9 +203,34 @@ def _run_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _detectors_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print one JSON object per detector")
+
+
+def _run_detectors(args: argparse.Namespace) -> int:
+    from ..detect.catalog import detector_infos
+
+    try:
+        infos = detector_infos()
+    except LaneFileError as error:
+        raise UsageError(str(error)) from None
+    for info in infos:
+        if args.json:
+            print(json.dumps(info.as_dict()))
+            continue
+        state = "available" if info.available else f"not available: {info.reason}"
+        extra = "".join(part for part in (f"  {info.source}" if info.source else "",
+                                          "  real-trained" if info.real_trained else ""))
+        print(f"{info.name:20s} {info.kind:10s} {state}{extra}")
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
     "eval": Command("score predictions with the TuSimple, CULane or ego line metric", _eval_arguments, _run_eval),
-    "detect": Command("run a lane detector (learned or classical) over a split folder", _detect_arguments, _run_detect),
+    "detect": Command("run a lane detector (built-in or plug-in) over a split folder", _detect_arguments, _run_detect),
+    "detectors": Command("list the lane detectors: built-ins and plug-ins (LANEVIL_DETECTORS, LANEVIL_DETECTORS_FILE, "
+                         "installed lanevil.detectors), whether each can run here", _detectors_arguments,
+                         _run_detectors),
     "report": Command("robustness tables and plot: original vs perturbed per category, type and severity, "
                       "for one detector or several side by side",
                       _report_arguments, _run_report),

@@ -223,3 +223,19 @@ def test_lanevil_drive_with_an_http_detector_in_the_loop(tmp_path, make_case, la
     summary = json.loads((out / "summary.json").read_text())
     # one black probe frame before the drive, then every step's frame
     assert summary["steps"] >= 3 and lane_server.sizes == [(640, 360)] + [(160, 90)] * summary["steps"]
+
+
+def test_lanevil_detectors_lists_built_ins_and_plugins(monkeypatch, lane_server, capsys) -> None:
+    monkeypatch.setenv(ENV_DETECTORS, f"mine={lane_server.url()};gone=onnx:missing.onnx")
+    assert main(["detectors"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == [*METHODS, "mine", "gone"]
+    assert lines[-2].split()[1:3] == ["http", "available"] and lane_server.url() in lines[-2]
+    assert "not available: gone: no ONNX model at missing.onnx" in lines[-1]
+    assert main(["detectors", "--json"]) == 0
+    entries = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert entries[-2] == {"name": "mine", "kind": "http", "available": True, "reason": None, "model": None,
+                           "source": lane_server.url(), "real_trained": False}
+    monkeypatch.setenv(ENV_DETECTORS, "mine")
+    assert main(["detectors"]) == 2
+    assert "is not NAME=SOURCE" in capsys.readouterr().err
