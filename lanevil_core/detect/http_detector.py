@@ -73,7 +73,8 @@ class HttpLaneDetector:
 
     @property
     def where(self) -> str:
-        return f"detector: {self.name} ({self.url})"
+        """How errors name the detector: its name and URL (the URL once when it is its own name)."""
+        return f"detector: {self.name}" if self.name == self.url else f"detector: {self.name} ({self.url})"
 
     def detect(self, rgb: UInt8Array) -> list[FloatArray]:
         """The server's lanes on ``rgb`` (the image it was sent), checked; raises ``LaneFileError`` on failure."""
