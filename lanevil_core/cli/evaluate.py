@@ -84,6 +84,9 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True,
                         help="predictions file (TuSimple JSON lines); with several --method a folder that gets "
                              "one METHOD.json each")
+    parser.add_argument("--masks", type=Path, default=None, metavar="DIR",
+                        help="also write each image's lane-line mask as DIR/<image>.png (an ONNX model with a mask "
+                             "head, one --method) for lanevil eval --metric pixel --pred DIR")
     parser.add_argument("--fixed-run-time", type=float, default=None, metavar="MS",
                         help="write this run_time instead of the measured one (byte-reproducible output)")
 
@@ -107,6 +110,16 @@ def _run_detect(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {args.out}: with several --method, a folder (it is a file)")
     if not several and args.out.is_dir():
         raise UsageError(f"--out {args.out}: with one --method, a predictions file (it is a folder)")
+    masks_by = None
+    if args.masks is not None:  # checked before the images are read, like --out
+        from ..detect.mask_split import mask_detector
+
+        if several:
+            raise UsageError("--masks: only with a single --method")
+        try:
+            masks_by = mask_detector(args.method[0])
+        except LaneFileError as error:
+            raise UsageError(str(error)) from None
     stems = [file_stem(method) for method in args.method]
     if several and len(set(stems)) < len(stems):
         raise UsageError(f"--method: two methods would write the same file in --out ({', '.join(args.method)}); "
@@ -119,6 +132,14 @@ def _run_detect(args: argparse.Namespace) -> int:
         path = args.out / f"{file_stem(method)}.json" if several else args.out
         write_atomic(path, "".join(json.dumps(record) + "\n" for record in records).encode("utf-8"))
         print(f"{len(records)} predictions in {path}")
+    if masks_by is not None:
+        from ..detect.mask_split import write_split_masks
+
+        try:
+            count = write_split_masks(args.split, masks_by, args.masks, progress)
+        except LaneFileError as error:
+            raise UsageError(str(error)) from None
+        print(f"{count} lane-line masks in {args.masks}")
     return 0
 
 

@@ -38,8 +38,14 @@ import cv2
 import numpy as np
 
 from ..metrics.formats import LaneFileError
-from ..typed import FloatArray, UInt8Array
-from .standard_heads import HEADS, decode_mask_head, decode_polynomial_head, decode_row_anchor_head
+from ..typed import BoolArray, FloatArray, UInt8Array
+from .standard_heads import (
+    HEADS,
+    decode_mask_head,
+    decode_polynomial_head,
+    decode_row_anchor_head,
+    lane_probability,
+)
 
 ONNX_PREFIX = "onnx:"
 FULL_FRAME = (0.0, 0.0, 1.0, 1.0)
@@ -188,8 +194,8 @@ class OnnxLaneDetector:
         self._input = self._session.get_inputs()[0].name
         self._lock = threading.Lock()
 
-    def detect(self, rgb: UInt8Array) -> list[FloatArray]:
-        height, width = rgb.shape[:2]
+    def outputs(self, rgb: UInt8Array) -> list[FloatArray]:
+        """The network's outputs for one frame, batch axis removed, in the head's order."""
         batch = network_input(rgb, self.sidecar)
         with self._lock:
             try:
@@ -197,8 +203,29 @@ class OnnxLaneDetector:
             except Exception as error:  # noqa: BLE001
                 raise LaneFileError(f"detector: {self.name}: the model failed ({str(error).splitlines()[0]})") \
                     from None
+        return [np.asarray(value, np.float64)[0] for value in values]
+
+    def lane_mask(self, rgb: UInt8Array) -> BoolArray:
+        """(H, W) bool lane-line mask of a ``mask`` head in ``rgb``'s pixels: the probability map resized
+        (bilinear) over the crop, above ``threshold``; nothing outside the crop."""
+        if self.sidecar.head != "mask":
+            raise LaneFileError(f"detector: {self.name}: a {self.sidecar.head} head has no lane-line mask")
+        height, width = rgb.shape[:2]
         try:
-            lines = decode_head(self.sidecar, [np.asarray(value, np.float64)[0] for value in values])
+            probability = lane_probability(self.outputs(rgb)[0], self.sidecar.logits)
+        except ValueError as error:
+            raise LaneFileError(f"detector: {self.name}: {error}") from None
+        left, top, right, bottom = crop_box(self.sidecar.crop, (width, height))
+        resized = cv2.resize(probability.astype(np.float32), (right - left, bottom - top),
+                             interpolation=cv2.INTER_LINEAR)
+        mask = np.zeros((height, width), bool)
+        mask[top:bottom, left:right] = resized > self.sidecar.threshold
+        return mask
+
+    def detect(self, rgb: UInt8Array) -> list[FloatArray]:
+        height, width = rgb.shape[:2]
+        try:
+            lines = decode_head(self.sidecar, self.outputs(rgb))
         except ValueError as error:
             raise LaneFileError(f"detector: {self.name}: {error}") from None
         left, top, right, bottom = crop_box(self.sidecar.crop, (width, height))

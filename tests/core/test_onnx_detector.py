@@ -165,3 +165,31 @@ def test_a_polynomial_model_s_curves_are_sampled_in_frame_pixels(tmp_path) -> No
             assert abs(x - math.floor((0.25 + 0.5 * y) * 320)) <= 1, (h, x)
         elif y < 0.2 - 0.01:
             assert x == -2
+
+
+def test_detect_writes_the_mask_model_s_masks_for_the_pixel_metric(mask_model, tmp_path, capsys) -> None:
+    lines = [((40, 179), (140, 70)), ((290, 179), (190, 70))]
+    split = tmp_path / "test"
+    split.mkdir()
+    rgb = line_frame(lines)
+    cv2.imwrite(str(split / "000000.png"), rgb[..., ::-1])
+    gt_lanes = [[math.floor(x_on(line, h + 0.5) + 0.5) if h >= 70 else -2 for h in ROWS] for line in lines]
+    (split / "test_label.json").write_text(json.dumps({"raw_file": "000000.png", "lanes": gt_lanes, "h_samples": ROWS,
+                                                       "image_size": list(FRAME_SIZE)}))
+    masks = tmp_path / "masks"
+    assert main(["detect", str(split), "--method", f"onnx:{mask_model}", "--out", str(tmp_path / "p.json"),
+                 "--masks", str(masks)]) == 0
+    mask = cv2.imread(str(masks / "000000.png"), cv2.IMREAD_GRAYSCALE) > 0
+    painted = rgb[..., 0] == 255
+    seen = painted.copy()
+    seen[:45] = False  # the sidecar crops the top quarter
+    assert mask.shape == painted.shape and not mask[:45].any()
+    assert (mask & seen).sum() > 0.8 * seen.sum() and (mask & painted).sum() > 0.5 * mask.sum()
+    capsys.readouterr()
+    assert main(["eval", "--gt", str(split), "--pred", str(masks), "--metric", "pixel", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["f1"] > 0.5
+    out = ["--out", str(tmp_path / "q.json"), "--masks", str(masks)]
+    assert main(["detect", str(split), "--method", "hough", *out]) == 2
+    assert "not an ONNX model with a mask head" in capsys.readouterr().err
+    assert main(["detect", str(split), "--method", f"onnx:{mask_model}", "--method", "hough", *out]) == 2
+    assert "only with a single --method" in capsys.readouterr().err
