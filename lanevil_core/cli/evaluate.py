@@ -121,7 +121,7 @@ def _run_detect(args: argparse.Namespace) -> int:
         except LaneFileError as error:
             raise UsageError(str(error)) from None
     stems = [file_stem(method) for method in args.method]
-    if several and len(set(stems)) < len(stems):
+    if several and len(set(stems)) < len(stems) == len(set(args.method)):  # (a method named twice: said below)
         raise UsageError(f"--method: two methods would write the same file in --out ({', '.join(args.method)}); "
                          "name them in LANEVIL_DETECTORS")
     try:
