@@ -282,7 +282,8 @@ class FrameService:
     def frame(self, case: Case, index: int, size: tuple[int, int] | None = None,
               overlay: bool = False, detector: str | None = None) -> RenderedFrame:
         """Frame ``index`` of ``case`` at ``size`` (default: the case camera's), lane overlay drawn if asked, and
-        the lanes of ``detector`` (a ``detect.split.METHODS`` name) drawn in the detection colour if given.
+        the lanes of ``detector`` (a name of ``detect.registry.detector_names()``) drawn in the detection colour if
+        given.
 
         Raises ``LaneFileError`` (message starting ``detector:``) for an unknown or unavailable detector."""
         if not 0 <= index < case.ego.frames:

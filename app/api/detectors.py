@@ -1,9 +1,10 @@
 """Lane detectors: ``GET /api/detectors`` and ``GET /api/cases/{case_id}/frames/{frame}/detections``.
 
-A detection runs a detector (``lanevil_core.detect``: learned ONNX models or classical OpenCV baselines) on the
-rendered frame and scores it against the frame's ground truth with the official TuSimple metric
-(``lanevil_core.detect.frame_detection``); the frame service caches it next to the frame. Unknown or unavailable
-detectors are a 422 naming ``detector``.
+A detection runs a detector (``lanevil_core.detect.registry``: learned ONNX models, classical OpenCV baselines, and
+the plug-ins the server is configured with: HTTP servers, ONNX models with a sidecar, installed Python plug-ins;
+docs/detectors.md) on the rendered frame and scores it against the frame's ground truth with the official TuSimple
+metric (``lanevil_core.detect.frame_detection``); the frame service caches it next to the frame. Unknown or unavailable
+detectors, and a plug-in that fails (its server down, an answer that is not lanes), are a 422 naming ``detector``.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from fastapi import APIRouter, Query
 from pydantic import BaseModel, Field
 
 from lanevil_core.detect.catalog import available_detector, detector_infos
+from lanevil_core.detect.registry import ready_detector
 from lanevil_core.detect.split import METHODS
 from lanevil_core.metrics.formats import LaneFileError
 
@@ -25,7 +27,8 @@ from .params import ScrubQueryDep, check_frame, image_size
 
 router = APIRouter(tags=["detectors"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
-DETECTOR_HELP = f"a detector name: {', '.join(METHODS)} (see `GET /api/detectors`)"
+DETECTOR_HELP = (f"a detector name of `GET /api/detectors`: built-in {', '.join(METHODS)}, or a plug-in "
+                 "configured on the server")
 
 
 @contextmanager
@@ -37,11 +40,14 @@ def detector_errors() -> Iterator[None]:
         raise ApiError(422, str(error).removeprefix("detector: "), "detector") from None
 
 
-def checked_detector(name: str | None) -> str | None:
-    """``name`` when it is a detector that can run here (None stays None); else a 422 naming ``detector``."""
+def checked_detector(name: str | None, ready: bool = False) -> str | None:
+    """``name`` when it is a detector that can run here (None stays None); else a 422 naming ``detector``. With
+    ``ready``, an HTTP plug-in is asked once (``detect.registry.ready_detector``), for a job that runs later."""
     if name is not None:
         with detector_errors():
             available_detector(name)
+            if ready:
+                ready_detector(name, sources=False)
     return name
 
 
@@ -49,13 +55,16 @@ class DetectorEntry(BaseModel):
     """A detector of ``GET /api/detectors``."""
 
     name: str = Field(description="the value of `detector=`")
-    kind: str = Field(description="`learned` (an ONNX network) or `classical` (OpenCV)")
+    kind: str = Field(description="`learned` (a shipped ONNX network), `classical` (OpenCV), or a plug-in: `http` (a "
+                                  "detector server), `onnx` (a model with a sidecar), `plugin` (a Python plug-in)")
     available: bool = Field(description="whether it can run on this server")
     reason: str | None = Field(None, description="why it is not available")
     model: dict[str, Any] | None = Field(None, description="a learned detector's model: `input_size`, `backbone`, "
                                                            "`width`, and from its training.json `val_accuracy`, "
                                                            "`epochs`, `train_frames`, `val_frames`, `data`, "
                                                            "`augment`")
+    source: str | None = Field(None, description="a plug-in's URL, `onnx:PATH` or entry point")
+    real_trained: bool = Field(False, description="trained on real roads (reported in the Real -> LanEvil table)")
 
 
 class DetectorList(BaseModel):
@@ -82,9 +91,11 @@ class FrameDetectionBody(BaseModel):
 
 @router.get("/detectors", summary="The lane detectors and whether they can run here", response_model=DetectorList)
 def get_detectors() -> dict[str, Any]:
-    """Every detector name, its kind (learned / classical), whether it is available (a learned one needs its
-    shipped model), and for learned ones the model's summary (`val_accuracy`, `input_size`, ...)."""
-    data = [info.as_dict() for info in detector_infos()]
+    """Every detector name, its kind (learned / classical / a plug-in), whether it is available (a learned one needs
+    its shipped model), for learned ones the model's summary (`val_accuracy`, `input_size`, ...), for plug-ins their
+    source and whether they were trained on real roads. A malformed plug-in configuration is a 422."""
+    with detector_errors():
+        data = [info.as_dict() for info in detector_infos()]
     return {"data": data, "count": len(data)}
 
 

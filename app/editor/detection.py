@@ -8,12 +8,23 @@ being placed fools the detector. Lanes and scores come from the frame service (`
 from __future__ import annotations
 
 from lanevil_core.detect.frame_detection import FrameDetection
-from lanevil_core.detect.split import METHODS
+from lanevil_core.detect.registry import detector_names
+from lanevil_core.metrics.formats import LaneFileError
 
 from .text import escape_markdown
 
 NO_DETECTOR = "none"
-DETECTOR_CHOICES: tuple[str, ...] = (NO_DETECTOR, *METHODS)
+
+
+def detector_choices() -> tuple[str, ...]:
+    """The dropdown's choices: none, the built-in methods and the configured or installed plug-ins (built-ins only
+    when the plug-in configuration is malformed; choosing a plug-in then says why)."""
+    try:
+        return (NO_DETECTOR, *detector_names())
+    except LaneFileError:
+        from lanevil_core.detect.split import METHODS
+
+        return (NO_DETECTOR, *METHODS)
 
 
 def chosen_detector(value: str) -> str | None:

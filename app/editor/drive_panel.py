@@ -19,12 +19,13 @@ import viser
 
 from lanevil_core.case import Case
 from lanevil_core.drive.controllers import CONTROLLERS
-from lanevil_core.drive.detectors import DRIVE_DETECTORS, GROUND_TRUTH
+from lanevil_core.drive.detectors import GROUND_TRUTH
 from lanevil_core.drive.loop import DEFAULT_SIZE, DriveSettings
 from lanevil_core.drive.outputs import SUMMARY_FILE, TRACE_PLOT_FILE
 
 from ..jobs import Job, drive_job
 from ..state import AppState
+from .detection import detector_choices
 from .text import escape_markdown
 
 POLL_S = 0.5
@@ -80,7 +81,8 @@ class DrivePanel:
         self._stopped = threading.Event()
         with gui.add_folder("Drive (closed loop)", expand_by_default=False):
             self.own_detector = None if chosen_detector is not None else gui.add_dropdown(
-                "Detector", list(DRIVE_DETECTORS), initial_value=GROUND_TRUTH, hint="gt = the projected ground truth")
+                "Detector", [GROUND_TRUTH, *detector_choices()[1:]], initial_value=GROUND_TRUTH,
+                hint="gt = the projected ground truth")
             self.controller = gui.add_dropdown("Controller", list(CONTROLLERS), initial_value=CONTROLLERS[0],
                                                hint="lateral controller steering the kinematic bicycle model")
             self.seconds = gui.add_slider("Seconds", 1.0, 30.0, 1.0, 10.0, hint="how long to drive")

@@ -15,7 +15,7 @@ from lanevil_core.illusions import ILLUSION_TYPES
 from lanevil_core.presets import CAMERA_PRESET_NAMES, PRESET_NAMES
 from lanevil_core.typed import PAVEMENTS, ROAD_TYPES, SCENE_KINDS
 
-from .detection import DETECTOR_CHOICES, NO_DETECTOR
+from .detection import NO_DETECTOR, detector_choices
 from .params import ParamInputs
 from .preview import PREVIEW_SIZE, QUALITIES
 
@@ -98,7 +98,7 @@ def build_panel(gui: viser.GuiApi, case_ids: list[str]) -> Panel:
         frame = gui.add_slider("Frame", 0, 99, 1, 0, hint="frame of the ego drive shown in the preview")
         play = gui.add_checkbox("Play", False, hint="step through the frames (loops)")
         overlay = gui.add_checkbox("Lane overlay", True, hint="draw the ground-truth lanes on the preview")
-        detector = gui.add_dropdown("Detector", list(DETECTOR_CHOICES), initial_value=NO_DETECTOR,
+        detector = gui.add_dropdown("Detector", list(detector_choices()), initial_value=NO_DETECTOR,
                                     hint="run a lane detector on the preview: its lanes in magenta, its TuSimple "
                                          "accuracy / FP / FN under the picture")
         quality = gui.add_dropdown("Quality", list(QUALITIES), initial_value="draft",

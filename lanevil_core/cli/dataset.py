@@ -36,9 +36,11 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-paint", action="store_true",
                         help="also render every original test case with its lane paint removed "
                              "(<case>_nopaint folders, records with \"paint\": false): the paint-free control")
-    parser.add_argument("--camera", choices=CAMERA_PRESET_NAMES, default=None,
-                        help="see every case through this camera preset (lens, bonnet, sensor; default: each case's "
-                        "own camera)")
+    parser.add_argument("--camera", default=None, metavar="PRESET|FILE.json",
+                        help=f"see every case through this camera: a preset ({', '.join(CAMERA_PRESET_NAMES)}: lens, "
+                        "bonnet, sensor) or a calibration file (intrinsics, distortion, mount height, pitch or "
+                        "horizon row or vanishing point, bonnet row; docs/cameras.md); default: each case's own "
+                        "camera")
     parser.add_argument("--vary-camera", action="store_true",
                         help="train variations draw their camera and sensor: HFOV 45-100, height 1.2-3.5 m, pitch "
                         "-2..6, roll +-2, principal point row, bonnet on/off, lens, exposure, noise, blur, colour, "
@@ -54,6 +56,13 @@ def _run_dataset(args: argparse.Namespace) -> int:
 
     if not args.cases.is_dir():
         raise UsageError(f"--cases {args.cases}: no such folder")
+    if args.camera is not None:  # checked before a plan is made: a bad file is one line, not a failed run
+        from ..camera.calibration import CalibrationError, camera_choice
+
+        try:
+            camera_choice(args.camera)
+        except CalibrationError as error:
+            raise UsageError(str(error)) from None
     if args.scheduler is not None:
         try:
             address = check_scheduler_address(args.scheduler)

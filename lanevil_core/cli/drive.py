@@ -11,14 +11,15 @@ from .base import Command, UsageError, bounded, parse_size
 
 def _drive_arguments(parser: argparse.ArgumentParser) -> None:
     from ..drive.controllers import CONTROLLERS
-    from ..drive.detectors import DRIVE_DETECTORS
+    from ..drive.detectors import GROUND_TRUTH
     from ..drive.loop import DEFAULT_SIZE
 
     parser.add_argument("case", type=Path, nargs="?", help="case file (JSON); leave out with --suite")
     parser.add_argument("--suite", type=Path, default=None, metavar="DIR",
                         help="drive every case under DIR (e.g. scenes/) and tabulate ASR per type and level")
-    parser.add_argument("--detector", required=True, choices=DRIVE_DETECTORS,
-                        help="gt = the projected ground truth (the reference)")
+    parser.add_argument("--detector", required=True, metavar="DETECTOR",
+                        help=f"{GROUND_TRUTH} = the projected ground truth (the reference), a method of `lanevil "
+                             "detect` (built-in or plug-in name), or a source http://HOST:PORT/PATH or onnx:PATH")
     parser.add_argument("--weights", type=Path, default=None, help="model folder of a learned detector")
     parser.add_argument("--controller", choices=CONTROLLERS, default="pure_pursuit",
                         help="lateral controller (default pure_pursuit)")
@@ -40,11 +41,15 @@ def _settings(args: argparse.Namespace):  # noqa: ANN202 - DriveSettings, import
 
 
 def _check_detector(args: argparse.Namespace) -> None:
-    from ..drive.detectors import drive_detector
+    """The detector can run (an HTTP one answers) before the first frame renders; exit 2 with one line if not."""
+    from ..detect.registry import ready_detector
+    from ..drive.detectors import GROUND_TRUTH
     from ..metrics.formats import LaneFileError
 
+    if args.detector == GROUND_TRUTH:
+        return
     try:
-        drive_detector(args.detector, args.weights)
+        ready_detector(args.detector, args.weights)
     except LaneFileError as error:
         raise UsageError(str(error)) from None
 
@@ -68,6 +73,15 @@ def _run_suite(args: argparse.Namespace) -> int:
 
 
 def _run_drive(args: argparse.Namespace) -> int:
+    from ..metrics.formats import LaneFileError
+
+    try:
+        return _drive(args)
+    except LaneFileError as error:  # a plug-in detector that fails mid-drive (its server went down)
+        raise UsageError(str(error)) from None
+
+
+def _drive(args: argparse.Namespace) -> int:
     from ..case import case_meshes_dir, load_case
     from ..drive.outputs import drive_to_folder, summary_json
     from ..drive.plots import plots_available

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ..camera.calibration import CalibrationError, camera_choice
 from ..camera.variation import random_camera
 from ..case import Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
@@ -38,7 +39,7 @@ from ..library.benchmark_layout import (
     folder_type,
     frame_file,
 )
-from ..presets import PRESET_NAMES, camera_preset_values, preset_values
+from ..presets import PRESET_NAMES, preset_values
 from ..typed import LineType
 
 TEST_SPLIT = "test"
@@ -88,7 +89,7 @@ class Settings:
     seed: int = 0
     no_paint: bool = False  # also render every original with its lane paint removed (the paint-free control)
     sampling: str = "in_view"  # test frames: "in_view" of each type's level-5 illusion, or "even" over the drive
-    camera: str | None = None  # a camera preset every case is seen through (None: each case's own camera)
+    camera: str | None = None  # a camera preset or calibration file every case is seen through (None: its own)
     vary_camera: bool = False  # train variations draw their camera and sensor (camera.variation.random_camera)
 
     @property
@@ -277,14 +278,12 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
 NO_PAINT_SUFFIX = "_nopaint"
 
 
-def seen_through(planned: PlannedCase, preset: str) -> PlannedCase:
-    """The same case and frames seen through the named camera preset (``--camera``)."""
+def seen_through(planned: PlannedCase, camera: dict[str, Any], label: str) -> PlannedCase:
+    """The same case and frames seen through the camera fields ``camera`` of ``--camera`` (``label``: the preset's
+    or the calibration file's name)."""
     data = parse_case(planned.case_text).model_dump()
-    try:
-        data["camera"] = camera_preset_values(preset)
-    except KeyError as error:
-        raise PlanError(f"camera: {error.args[0]}") from None
-    return replace(planned, case_text=case_json(parse_case(data)), source={**planned.source, "camera": preset})
+    data["camera"] = camera
+    return replace(planned, case_text=case_json(parse_case(data)), source={**planned.source, "camera": label})
 
 
 def paint_free(planned: PlannedCase) -> PlannedCase:
@@ -424,7 +423,11 @@ def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = t
         planned += [paint_free(case) for case in planned if case.severity == 0]
     planned += train_cases(clean, settings.train_frames, settings.seed, settings.vary_camera)
     if settings.camera is not None:  # every case through one camera; drawn train cameras stay drawn
-        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, settings.camera)
+        try:  # a preset, or a calibration file read once (``camera.calibration``)
+            camera, label = camera_choice(settings.camera)
+        except CalibrationError as error:
+            raise PlanError(str(error)) from None
+        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, camera, label)
                    for case in planned]
     if not planned:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")

@@ -1,8 +1,9 @@
 """Which lane detectors this installation can run: kind, availability and, for learned ones, the shipped model.
 
-The names are ``detect.split.METHODS``. A learned detector is available when its shipped model folder
-(``lanevil_core/detect/models/<family>/``) holds ``config.json`` and ``model.onnx`` and onnxruntime is installed;
-availability is read from the files on every call, so a model added while a server runs is picked up. A
+The names are ``detect.registry.detector_names()``: the built-in ``detect.split.METHODS`` and the plug-ins (HTTP
+servers, ONNX models with a sidecar, installed Python plug-ins). A learned detector is available when its shipped
+model folder (``lanevil_core/detect/models/<family>/``) holds ``config.json`` and ``model.onnx`` and onnxruntime is
+installed; availability is read from the files on every call, so a model added while a server runs is picked up. A
 detector's ``version`` changes with its model file, so caches keyed by it never serve a retrained model's
 stale lanes.
 """
@@ -12,14 +13,16 @@ from __future__ import annotations
 import importlib.util
 import json
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Literal
 
 from ..metrics.formats import LaneFileError
 from .learned import SHIPPED_MODELS
 from .model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE
-from .split import DETECTORS, LEARNED_METHODS, METHODS
+from .registry import ONNX_PREFIX, PluginSpec, detector_names, plugin_real_trained, plugin_spec
+from .split import DETECTORS, LEARNED_METHODS
 
-DetectorKind = Literal["learned", "classical"]
+DetectorKind = Literal["learned", "classical", "http", "onnx", "plugin"]
 # training.json keys shown as a learned model's summary
 SUMMARY_KEYS = ("val_accuracy", "epochs", "train_frames", "val_frames", "data", "augment")
 
@@ -29,11 +32,15 @@ class DetectorInfo:
     """A detector as a product lists it.
 
     Attributes:
-        name: the method name ``detect.split.detector_for`` takes.
-        kind: ``learned`` (an ONNX network) or ``classical`` (OpenCV).
-        available: whether it can run here; ``reason`` says why not.
-        version: cache token: the name, plus the model file's size and time for a learned detector.
+        name: the method name ``detect.registry.detector_for`` takes.
+        kind: ``learned`` (a shipped ONNX network), ``classical`` (OpenCV), or a plug-in: ``http`` (a server),
+            ``onnx`` (a model with a sidecar) or ``plugin`` (an installed Python entry point).
+        available: whether it can run here; ``reason`` says why not (an HTTP server is only reached when used).
+        version: cache token: the name, plus the model file's size and time for a learned or ONNX detector, the
+            URL of an HTTP one, the package version of a Python plug-in.
         model: a learned detector's training summary (``val_accuracy``, ``input_size``, ``backbone``, ...).
+        source: a plug-in's URL, ``onnx:PATH`` or entry point.
+        real_trained: whether the detector was trained on real roads (the Real -> LanEvil table).
     """
 
     name: str
@@ -42,10 +49,12 @@ class DetectorInfo:
     version: str
     reason: str | None = None
     model: dict[str, Any] | None = None
+    source: str | None = None
+    real_trained: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         return {"name": self.name, "kind": self.kind, "available": self.available, "reason": self.reason,
-                "model": self.model}
+                "model": self.model, "source": self.source, "real_trained": self.real_trained}
 
 
 def _kind(name: str) -> DetectorKind:
@@ -53,7 +62,9 @@ def _kind(name: str) -> DetectorKind:
         return "classical"
     if name in LEARNED_METHODS:
         return "learned"
-    raise LaneFileError(f"detector: unknown detector {name!r} (choose from {', '.join(METHODS)})")
+    spec = plugin_spec(name)
+    assert spec is not None
+    return spec.kind
 
 
 def _missing(name: str) -> str | None:
@@ -67,10 +78,28 @@ def _missing(name: str) -> str | None:
     return None
 
 
+def _plugin_version(spec: PluginSpec) -> str:
+    if spec.kind == "http":
+        return f"{spec.name}@{spec.source}"
+    if spec.kind == "onnx":
+        from .onnx_detector import onnx_version
+
+        return f"{spec.name}@{onnx_version(Path(spec.source.removeprefix(ONNX_PREFIX)))}"
+    from .plugin import entry_point_version, entry_points
+
+    point = entry_points().get(spec.name)
+    return f"{spec.name}@{entry_point_version(point) if point is not None else 'none'}"
+
+
 def detector_version(name: str) -> str:
     """The cache token of detector ``name`` (raises ``LaneFileError`` for an unknown name)."""
-    if _kind(name) == "classical":
+    kind = _kind(name)
+    if kind == "classical":
         return name
+    if kind != "learned":
+        spec = plugin_spec(name)
+        assert spec is not None
+        return _plugin_version(spec)
     try:
         stat = (SHIPPED_MODELS / name / ONNX_FILE).stat()
     except FileNotFoundError:
@@ -95,17 +124,34 @@ def model_summary(name: str) -> dict[str, Any] | None:
     return summary
 
 
+def _plugin_info(spec: PluginSpec) -> DetectorInfo:
+    """A plug-in's entry; an ONNX model or Python plug-in is opened to tell whether it can run and whether it is
+    marked real-trained (an HTTP server is only reached when it detects)."""
+    version = _plugin_version(spec)
+    try:
+        real_trained = spec.real_trained if spec.kind == "http" else plugin_real_trained(spec)
+    except LaneFileError as error:
+        return DetectorInfo(spec.name, spec.kind, False, version, str(error).removeprefix("detector: "),
+                            source=spec.source, real_trained=spec.real_trained)
+    return DetectorInfo(spec.name, spec.kind, True, version, source=spec.source, real_trained=real_trained)
+
+
 def detector_info(name: str) -> DetectorInfo:
     """What ``name`` is and whether it can run (raises ``LaneFileError`` for an unknown name)."""
-    if _kind(name) == "classical":
+    kind = _kind(name)
+    if kind == "classical":
         return DetectorInfo(name, "classical", True, name)
+    if kind != "learned":
+        spec = plugin_spec(name)
+        assert spec is not None
+        return _plugin_info(spec)
     reason = _missing(name)
     return DetectorInfo(name, "learned", reason is None, detector_version(name), reason, model_summary(name))
 
 
 def detector_infos() -> list[DetectorInfo]:
-    """Every detector of ``METHODS``, in that order."""
-    return [detector_info(name) for name in METHODS]
+    """Every detector of ``detect.registry.detector_names()``, in that order."""
+    return [detector_info(name) for name in detector_names()]
 
 
 def available_detector(name: str) -> DetectorInfo:

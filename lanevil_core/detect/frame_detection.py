@@ -17,7 +17,7 @@ from typing import Any
 from ..labels.lanes import on_tusimple_grid
 from ..metrics.tusimple import ImageScore, score_image
 from ..typed import UInt8Array
-from .split import detector_for
+from .registry import detector_for
 
 
 @dataclass(frozen=True)

@@ -101,25 +101,31 @@ def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: Sequence[
     return tusimple_lanes(lines, h_samples, size, reach)
 
 
+def inference_session(onnx_path: Path, threads: int = 0):  # noqa: ANN201 - onnxruntime.InferenceSession
+    """An onnxruntime session on ``onnx_path`` (CUDA first when there is one), with ``threads`` intra-op threads
+    (0 = onnxruntime's choice) that sleep between runs."""
+    import onnxruntime
+
+    options = onnxruntime.SessionOptions()
+    options.intra_op_num_threads = threads
+    # Pool threads that spin after each run burn the cores the renderer, or the next detector of a several-
+    # method run, needs: six families interleaved on one busy 2-core machine took 167 ms of CPU per frame
+    # spinning and 43 ms not. Alone on idle cores a network takes about 0.3-0.7 ms longer (ufld 3.5 ms).
+    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    options.log_severity_level = 3
+    return onnxruntime.InferenceSession(str(onnx_path), options, providers=providers())
+
+
 class LearnedDetector:
     """An ONNX lane detector: ``detector(rgb, h_samples)`` -> TuSimple lanes in the frame's own pixels."""
 
     def __init__(self, model_dir: str | Path, threads: int = 0) -> None:
-        import onnxruntime
-
         self.model_dir = Path(model_dir)
         self.spec = ModelSpec.load(self.model_dir)
         onnx_path = self.model_dir / ONNX_FILE
         if not onnx_path.is_file():
             raise ModelSpecError(f"{self.model_dir}: no {ONNX_FILE}")
-        options = onnxruntime.SessionOptions()
-        options.intra_op_num_threads = threads
-        # Pool threads that spin after each run burn the cores the renderer, or the next detector of a several-
-        # method run, needs: six families interleaved on one busy 2-core machine took 167 ms of CPU per frame
-        # spinning and 43 ms not. Alone on idle cores a network takes about 0.3-0.7 ms longer (ufld 3.5 ms).
-        options.add_session_config_entry("session.intra_op.allow_spinning", "0")
-        options.log_severity_level = 3
-        self._session = onnxruntime.InferenceSession(str(onnx_path), options, providers=providers())
+        self._session = inference_session(onnx_path, threads)
         self._names = [output.name for output in self._session.get_outputs()]
         self._lock = threading.Lock()  # one run at a time per session keeps the thread pool from oversubscribing
 

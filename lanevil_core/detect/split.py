@@ -1,4 +1,4 @@
-"""Run a detector over a split folder and write its predictions as TuSimple JSON lines."""
+"""Run a detector over a split folder and write its predictions as TuSimple JSON lines; the built-in methods."""
 
 from __future__ import annotations
 
@@ -26,9 +26,10 @@ LEARNED_METHODS: tuple[str, ...] = FAMILIES
 METHODS = (*LEARNED_METHODS, *DETECTORS)
 
 
-def detector_for(method: str, weights: str | Path | None = None) -> Detector:
-    """The detector called ``method``: a classical baseline, or a learned model (``weights``: its model folder,
-    default the model shipped for that family) run through onnxruntime."""
+def builtin_detector(method: str, weights: str | Path | None = None) -> Detector:
+    """The built-in detector called ``method``: a classical baseline, or a learned model (``weights``: its model
+    folder, default the model shipped for that family) run through onnxruntime. Plug-ins resolve through
+    ``detect.registry.detector_for``."""
     if method in DETECTORS:
         if weights is not None:
             raise LaneFileError(f"--weights: the {method} baseline has no weights")
@@ -96,6 +97,8 @@ def detect_split_methods(split_dir: str | Path, methods: Sequence[str], progress
         raise LaneFileError(f"--method: a method is named twice ({', '.join(methods)})")
     if weights is not None and len(methods) > 1:
         raise LaneFileError("--weights: only with a single --method")
+    from .registry import detector_for
+
     split_dir = split_folder(split_dir)  # a dataset folder: its test split, whose label file names the images
     detectors = {method: detector_for(method, weights) for method in methods}
     items = split_images(split_dir)

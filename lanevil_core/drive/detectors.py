@@ -1,26 +1,34 @@
-"""The lane detectors a drive can use: the projected ground truth (``gt``, the reference) or any of
-``detect.split.METHODS``, all as ``detect(rgb, h_samples, gt_lanes) -> lanes`` in the frame's pixels."""
+"""The lane detectors a drive can use: the projected ground truth (``gt``, the reference) or any detector of
+``detect.registry`` (built-in methods and plug-ins), all as ``detect(rgb, h_samples, gt_lanes) -> lanes`` in the
+frame's pixels."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from ..detect.split import METHODS, detector_for
+from ..detect.registry import detector_for, detector_names
+from ..detect.split import METHODS
 from ..labels.lanes import on_tusimple_grid
 from ..metrics.tusimple import score_image
 from ..typed import UInt8Array
 
 DriveDetector = Callable[[UInt8Array, list[int], list[list[int]]], list[list[int]]]
 GROUND_TRUTH = "gt"
-DRIVE_DETECTORS: tuple[str, ...] = (GROUND_TRUTH, *METHODS)
+DRIVE_DETECTORS: tuple[str, ...] = (GROUND_TRUTH, *METHODS)  # the built-in choices
 
 
-def drive_detector(name: str, weights: str | Path | None = None) -> DriveDetector:
-    """The detector ``name``; raises ``metrics.formats.LaneFileError`` for an unknown or unusable one."""
+def drive_detector_names() -> tuple[str, ...]:
+    """Every detector a drive can use: ``gt``, the built-in methods and the configured or installed plug-ins."""
+    return (GROUND_TRUTH, *detector_names())
+
+
+def drive_detector(name: str, weights: str | Path | None = None, sources: bool = True) -> DriveDetector:
+    """The detector ``name`` (with ``sources``, also a SOURCE such as ``http://HOST:PORT/PATH``); raises
+    ``metrics.formats.LaneFileError`` for an unknown or unusable one."""
     if name == GROUND_TRUTH:
         return lambda rgb, h_samples, gt_lanes: [list(lane) for lane in gt_lanes]
-    detector = detector_for(name, weights)
+    detector = detector_for(name, weights, sources)
     return lambda rgb, h_samples, gt_lanes: [[int(x) for x in lane] for lane in detector(rgb, h_samples)]
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ..labels.lanes import CULANE_SIZE, IMAGE_SIZE_FIELD, TUSIMPLE_SIZE, on_tusimple_grid
-from . import culane, ego, tusimple
+from . import culane, ego, pixel, tusimple
 from .formats import (
     CULANE_SUFFIX,
     LaneFileError,
@@ -25,8 +25,8 @@ from .formats import (
     tusimple_points,
 )
 
-Metric = Literal["tusimple", "culane", "ego"]
-METRICS: tuple[Metric, ...] = ("tusimple", "culane", "ego")
+Metric = Literal["tusimple", "culane", "ego", "pixel"]
+METRICS: tuple[Metric, ...] = ("tusimple", "culane", "ego", "pixel")
 
 
 @dataclass(frozen=True)
@@ -120,16 +120,22 @@ def _culane_pairs_from_folders(gt_root: Path, pred_root: Path) -> list[tuple[lis
 
 
 def evaluate(gt_path: str | Path, pred_path: str | Path, metric: Metric = "tusimple",
-             f1_variant: str = "ganet") -> dict[str, Any]:
+             f1_variant: str = "ganet", line_width: float = pixel.LINE_WIDTH_720) -> dict[str, Any]:
     """The metric's summary as a JSON-ready dict (``metric`` names it; TuSimple adds ``f1_variant``; ``ego`` is
-    ``metrics.ego``'s ego line match).
+    ``metrics.ego``'s ego line match; ``pixel`` is ``metrics.pixel``'s lane-line IoU and F1 with lines
+    ``line_width`` pixels wide at 720 rows).
 
-    ``gt_path`` may also be a split folder (its ``*_label.json`` is read) when ``pred_path`` is a file.
+    ``gt_path`` may also be a split folder (its ``*_label.json`` is read) when ``pred_path`` is a file (or, for
+    ``pixel``, a folder of mask PNGs).
     """
     gt_path, pred_path = Path(gt_path), Path(pred_path)
     for path in (gt_path, pred_path):
         if not path.exists():
             raise LaneFileError(f"{path}: no such file or folder")
+    if metric == "pixel":
+        if gt_path.is_dir():
+            gt_path = split_labels(gt_path)
+        return {"metric": "pixel", **pixel.score_pixel_files(gt_path, pred_path, line_width).as_dict()}
     if gt_path.is_dir() and not pred_path.is_dir() and not culane_files(gt_path):
         gt_path = split_labels(gt_path)  # a split folder: its *_label.json
     if gt_path.is_dir() != pred_path.is_dir():

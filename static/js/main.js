@@ -11,7 +11,10 @@ import { IllusionCard } from "./card.js";
 const LAZY_MARGIN = "300px 0px";
 const DEFAULT_DETECTOR = "ufld";
 
-/** Fill the detector select from `/api/detectors` (unavailable ones listed but disabled); returns its value. */
+/**
+ * Fill the detector select from `/api/detectors`: built-ins and the server's plug-ins (unavailable ones listed but
+ * disabled, detectors trained on real roads marked); returns its value.
+ */
 async function fillDetectors(select) {
   let list;
   try {
@@ -24,7 +27,8 @@ async function fillDetectors(select) {
   const options = [new Option("none", "")];
   for (const entry of list) {
     const accuracy = entry.model?.val_accuracy;
-    const option = new Option(`${entry.name} (${entry.available ? entry.kind : "not installed"})`, entry.name);
+    const kind = entry.real_trained ? `${entry.kind}, real-trained` : entry.kind;
+    const option = new Option(`${entry.name} (${entry.available ? kind : "not installed"})`, entry.name);
     option.disabled = !entry.available;
     option.title = !entry.available ? entry.reason ?? ""
       : typeof accuracy === "number" ? `validation accuracy ${(100 * accuracy).toFixed(1)}%` : "";

@@ -36,7 +36,7 @@ def test_detectors_lists_every_method_with_kind_and_model(client) -> None:
     assert ufld["kind"] == "learned" and ufld["available"] and ufld["reason"] is None
     assert 0.0 <= ufld["model"]["val_accuracy"] <= 1.0 and ufld["model"]["input_size"] == [320, 180]
     assert by_name["hough"] == {"name": "hough", "kind": "classical", "available": True, "reason": None,
-                                "model": None}
+                                "model": None, "source": None, "real_trained": False}
     assert all(entry["available"] or entry["reason"] for entry in body["data"])
 
 
@@ -143,3 +143,41 @@ def test_openapi_documents_the_detector_routes(client) -> None:
     detector = next(param for param in image["parameters"] if param["name"] == "detector")
     assert "magenta" in detector["description"]
     assert "/api/detectors" in paths
+
+
+def test_a_plugin_server_is_listed_run_and_refused_when_down(client, monkeypatch, lane_server, down_url) -> None:
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={lane_server.url()};down={down_url}")
+    entries = {entry["name"]: entry for entry in client.get("/api/detectors").json()["data"]}
+    assert entries["mine"]["kind"] == "http" and entries["mine"]["source"] == lane_server.url()
+    response = client.get(f"{FRAME}/0/detections?detector=mine&{SIZE}")
+    assert response.status_code == 200, response.text
+    assert response.json()["detector"] == "mine" and lane_server.sizes == [(320, 180)]
+    for url in (f"{FRAME}/0/detections?detector=down&{SIZE}", f"{FRAME}/0.png?detector=down&{SIZE}"):
+        response = client.get(url)
+        assert response.status_code == 422, url
+        assert response.json()["field"] == "detector" and "cannot connect" in response.json()["detail"]
+    response = client.post("/api/drives", json={"case_id": SHADOW_ID, "detector": "down"})
+    assert response.status_code == 422 and "cannot connect" in response.json()["detail"]
+    response = client.get(f"{FRAME}/0/detections?detector={lane_server.url()}&{SIZE}")
+    assert response.status_code == 422  # a source is not a name here: the server calls no address it is given
+    monkeypatch.setenv("LANEVIL_DETECTORS", "broken")
+    response = client.get("/api/detectors")
+    assert response.status_code == 422 and "NAME=SOURCE" in response.json()["detail"]
+
+
+def test_an_onnx_model_and_an_installed_plugin_work_as_a_server_does(client, monkeypatch, mask_model,
+                                                                     installed_plugin) -> None:
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"bdd-seg=onnx:{mask_model}")
+    entries = {entry["name"]: entry for entry in client.get("/api/detectors").json()["data"]}
+    assert (entries["bdd-seg"]["kind"], entries["bdd-seg"]["available"], entries["bdd-seg"]["real_trained"]) == \
+        ("onnx", True, True)
+    assert (entries["bright"]["kind"], entries["bright"]["real_trained"]) == ("plugin", True)
+    assert not entries["broken"]["available"] and "no weights file" in entries["broken"]["reason"]
+    for name in ("bdd-seg", "bright"):
+        response = client.get(f"{FRAME}/0/detections?detector={name}&{SIZE}")
+        assert response.status_code == 200, response.text
+        body = response.json()
+        assert body["detector"] == name and all(len(lane) == len(body["h_samples"]) for lane in body["lanes"])
+        assert client.get(f"{FRAME}/0.png?detector={name}&{SIZE}").status_code == 200
+    response = client.get(f"{FRAME}/0/detections?detector=broken&{SIZE}")
+    assert response.status_code == 422 and "RuntimeError: no weights file" in response.json()["detail"]

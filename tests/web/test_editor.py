@@ -256,6 +256,25 @@ def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(tab: EditorTab, 
     assert tab.panel.detection.content == "" and tab.last_result.request.detector is None
 
 
+@pytest.fixture
+def served_detector(monkeypatch, lane_server):
+    """``mine``: a detector server named in ``LANEVIL_DETECTORS`` before the editor's tab is made."""
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={lane_server.url()}")
+    return lane_server
+
+
+def test_a_plugin_detector_is_a_choice_and_a_server_down_is_said(served_detector, tab: EditorTab, monkeypatch,
+                                                                  down_url: str) -> None:
+    assert list(tab.panel.detector.options) == ["none", *METHODS, "mine"]
+    tab.panel.detector.value = "mine"
+    settle(tab)
+    assert "**mine**" in tab.panel.detection.content and served_detector.sizes
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={down_url}")
+    tab.panel.frame.value = 1
+    settle(tab)
+    assert "⚠ **mine**" in tab.panel.detection.content and "cannot connect" in tab.panel.detection.content
+
+
 def test_gizmo_move_and_parameter_inputs(tab: EditorTab) -> None:
     open_shadow(tab)
     settle(tab)
