@@ -189,5 +189,3 @@ COMMANDS: dict[str, Command] = {
     "preview": Command("render frame 0 of every stock case (and a labelled copy)", _preview_arguments, _run_preview),
     "bench": Command("time the renderer on the stock cases", _bench_arguments, _run_bench),
 }
-
-

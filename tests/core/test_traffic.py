@@ -4,7 +4,9 @@ path, JSON round trips and user obstacle models."""
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -83,7 +85,7 @@ def road_st(ctx: CompileContext, p_world: np.ndarray) -> tuple[np.ndarray, np.nd
 def test_traffic_types_are_registered() -> None:
     for name in TRAFFIC:
         assert REGISTRY[name].CATEGORY == "traffic"
-        rows = REGISTRY[name].SEVERITY
+        rows: Sequence[Any] = REGISTRY[name].SEVERITY  # each family its own row type
         assert len(rows) == 5 and all(type(row) is type(rows[0]) for row in rows)
         counts = [row.count for row in rows]
         distances = [row.distance for row in rows]
@@ -207,7 +209,7 @@ def test_load_obstacle_glb_converts_axes_and_colours(tmp_path: Path) -> None:
     np.testing.assert_allclose(size, (4.0, 2.0, 2.0), atol=1e-5)  # glTF +Z forward -> +X, +Y up -> +Z
     assert mesh.vertices[:, 2].min() == pytest.approx(0.0)
     np.testing.assert_allclose(mesh.vertices.min(0)[:2] + mesh.vertices.max(0)[:2], 0.0, atol=1e-6)
-    red, green = srgb_to_linear([200, 30, 30]), srgb_to_linear([20, 200, 30])
+    red, green = srgb_to_linear(np.array([200.0, 30, 30])), srgb_to_linear(np.array([20.0, 200, 30]))
     assert np.any(np.all(np.isclose(mesh.colors, red, atol=1e-3), axis=1))
     assert np.any(np.all(np.isclose(mesh.colors, green, atol=1e-3), axis=1))
     assert load_obstacle(path, up="z").vertices[:, 2].max() == pytest.approx(4.0)
