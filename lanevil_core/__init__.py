@@ -20,8 +20,8 @@ from .case import (
     save_case,
 )
 from .export.case import export_case
-from .export.encode import jpeg_bytes, png_bytes
 from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
+from .images import jpeg_bytes, png_bytes
 from .labels.lanes import culane_lines, tusimple_record
 from .labels.overlay import draw_lanes
 from .pipeline.compile import compile_scene

@@ -9,7 +9,7 @@ from fastapi import Depends, Query
 from pydantic import ValidationError
 
 from lanevil_core.case import Case
-from lanevil_core.cli.frame_range import parse_frame_range
+from lanevil_core.pipeline.frames import parse_frame_range
 
 from ..frames import apply_overrides
 from ..settings import Settings
