@@ -16,7 +16,7 @@ from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Generic, Literal, TypeVar
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 from pydantic.fields import FieldInfo
@@ -24,8 +24,8 @@ from pydantic.fields import FieldInfo
 from lanevil_core.case import Case, case_json
 from lanevil_core.detect.catalog import available_detector
 from lanevil_core.detect.frame_detection import FrameDetection, detect_frame
-from lanevil_core.export.encode import jpeg_bytes, png_bytes
 from lanevil_core.illusions import REGISTRY
+from lanevil_core.images import ImageFormat, encode_image
 from lanevil_core.labels.lanes import CULANE_SIZE, culane_lines, tusimple_record
 from lanevil_core.labels.overlay import draw_detections, draw_lanes
 from lanevil_core.library.benchmark_layout import frame_file
@@ -33,12 +33,10 @@ from lanevil_core.pipeline.compile import compile_scene, roadside_key
 from lanevil_core.render import all_cores, render_frame
 from lanevil_core.world.scene import CompiledScene
 
-ImageFormat = Literal["png", "jpg"]
+from .settings import FRAME_CACHE_BYTES, MAX_RENDER_QUEUE, MAX_RENDERS, SCENE_CACHE_BYTES
+
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
-JPEG_QUALITY = 90
-SCENE_CACHE_BYTES = 128_000_000  # compiled scenes kept for reuse (a stock scene: 7 to 170 MB once rendered)
-MAX_RENDERS = 2  # frames rendered at once (each on every core); a render's buffers are the server's peak memory
-MAX_RENDER_QUEUE = 32  # requests waiting for a render slot before the next is told to come back later
+JPEG_QUALITY = 90  # frames served over HTTP (files on disk: images.FILE_JPEG_QUALITY)
 CULANE_CACHE_ENTRIES = 2048  # label texts are small (< 1 kB)
 DETECTION_CACHE_ENTRIES = 4096  # a frame's lanes: a few kB
 
@@ -192,7 +190,7 @@ def _clamp_to_field(value: float, field: FieldInfo) -> float:
 
 def encode(rgb: np.ndarray, fmt: ImageFormat) -> bytes:
     """PNG (no metadata, deterministic) or baseline JPEG bytes of an (H, W, 3) uint8 image."""
-    return png_bytes(rgb) if fmt == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
+    return encode_image(rgb, fmt, JPEG_QUALITY)
 
 
 @dataclass(frozen=True)
@@ -216,7 +214,7 @@ class EncodedImage:
 class FrameService:
     """Renders frames of cases through ``lanevil_core``, caching compiled scenes, frames and encodings."""
 
-    def __init__(self, cache_bytes: int = 256_000_000, threads: int = 0, meshes_dir: Path | None = None,
+    def __init__(self, cache_bytes: int = FRAME_CACHE_BYTES, threads: int = 0, meshes_dir: Path | None = None,
                  scene_cache_bytes: int = SCENE_CACHE_BYTES, max_renders: int = MAX_RENDERS,
                  max_render_queue: int = MAX_RENDER_QUEUE) -> None:
         self.meshes_dir = meshes_dir  # where a vehicle's ``mesh_file`` is read from

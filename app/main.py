@@ -5,6 +5,8 @@ from __future__ import annotations
 from fastapi import FastAPI, HTTPException, Request, Response
 from fastapi.responses import RedirectResponse
 
+from lanevil_core import __version__
+
 from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
@@ -25,7 +27,7 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     """Build the app around ``state`` (default: opened from ``settings``, default: the environment)."""
     settings = settings or (state.settings if state else Settings())
     state = state or AppState.open(settings)
-    app = FastAPI(title="LanEvil Studio", version="0.1.0", docs_url=None, redoc_url=None,
+    app = FastAPI(title="LanEvil Studio", version=__version__, docs_url=None, redoc_url=None,
                   description="Editable 3D lane-detection robustness cases: store, render, export, study. Errors of "
                               "`/api` answer `{\"detail\": \"<field>: <message>\", \"field\": \"<field>\"}`.")
     app.state.lanevil = state

@@ -8,6 +8,11 @@ from typing import Annotated
 from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
+# Server limits: the defaults of the settings below and of the frame service (app/frames.py) that takes them.
+FRAME_CACHE_BYTES = 256_000_000  # rendered frames and their encodings kept (LRU)
+SCENE_CACHE_BYTES = 128_000_000  # compiled scenes kept for reuse (a stock scene: 7 to 170 MB once rendered)
+MAX_RENDERS = 2  # frames rendered at once (each on every core); a render's buffers are the server's peak memory
+MAX_RENDER_QUEUE = 32  # requests waiting for a render slot before the next is told to come back later
 
 class Settings(BaseSettings):
     """Everything the backend, the editor and the study read at start-up."""
@@ -27,10 +32,11 @@ class Settings(BaseSettings):
     max_height: int = Field(1080, description="largest rendered frame height")
     max_jobs: int = Field(16, ge=1, description="export jobs queued or running before clients get 429")
     max_jobs_per_client: int = Field(4, ge=1, description="export jobs one client may have queued or running")
-    frame_cache_bytes: int = Field(256_000_000, ge=0, description="memory budget of the rendered-frame LRU cache")
-    max_renders: int = Field(2, ge=1, description="frames rendered at once; more requests wait for a slot")
-    max_render_queue: int = Field(32, ge=0, description="requests waiting for a render slot before clients get 503")
-    scene_cache_bytes: int = Field(128_000_000, ge=0, description="memory budget of the compiled-scene cache")
+    frame_cache_bytes: int = Field(FRAME_CACHE_BYTES, ge=0, description="memory budget of the rendered-frame LRU cache")
+    max_renders: int = Field(MAX_RENDERS, ge=1, description="frames rendered at once; more requests wait for a slot")
+    max_render_queue: int = Field(MAX_RENDER_QUEUE, ge=0,
+                                  description="requests waiting for a render slot before clients get 503")
+    scene_cache_bytes: int = Field(SCENE_CACHE_BYTES, ge=0, description="memory budget of the compiled-scene cache")
     malloc_arenas: int = Field(2, ge=0, description="glibc malloc arenas of the server process (0 = glibc's default); "
                                "fewer arenas keep the resident memory of concurrent renders down")
     render_threads: int = Field(0, ge=0, description="threads per rendered frame (0 = every core this process may use)")

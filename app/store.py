@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any, Literal
 
-from lanevil_core.case import Case, CaseError, case_json, load_case, parse_case, write_atomic
-from lanevil_core.files import remove_stale_temps
+from lanevil_core.case import Case, CaseError, case_json, load_case, parse_case
+from lanevil_core.files import remove_stale_temps, write_atomic
 from lanevil_core.illusions import REGISTRY
 from lanevil_core.library.benchmark_layout import case_illusion_type, case_name, folder_type
 from lanevil_core.library.stock import CATEGORY_FOLDERS as STOCK_FOLDERS

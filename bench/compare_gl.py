@@ -39,7 +39,7 @@ import numpy as np
 
 from lanevil_core.camera import PinholeCamera
 from lanevil_core.case import load_case
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.images import png_bytes
 from lanevil_core.pipeline.bench import BENCH_SIZES, frames_to_time
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame

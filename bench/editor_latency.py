@@ -14,19 +14,17 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
+from app.editor import EditorTab, HeadlessTab, launch_editor
+from app.settings import Settings
+from app.state import AppState
 
-from app.editor import EditorTab, HeadlessTab, launch_editor  # noqa: E402
-from app.settings import Settings  # noqa: E402
-from app.state import AppState  # noqa: E402
+REPO = Path(__file__).resolve().parents[1]
 
 CASES = ["00_clean/00_straight_urban.json", "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json",
          "20_traffic/vehicle/00_straight_highway_noon/03_level3.json"]

@@ -14,20 +14,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
+from app.editor import EditorTab, HeadlessTab, launch_editor
+from app.editor.preview import QUALITIES
+from app.settings import Settings
+from app.state import AppState
 
-from app.editor import EditorTab, HeadlessTab, launch_editor  # noqa: E402
-from app.editor.preview import QUALITIES  # noqa: E402
-from app.settings import Settings  # noqa: E402
-from app.state import AppState  # noqa: E402
+REPO = Path(__file__).resolve().parents[1]
 
 SHADOW = "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json"
 # (case id in the store, stock file, camera override)

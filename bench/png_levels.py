@@ -2,7 +2,7 @@
 
 Frames are rendered once (not timed) from a few stock cases, a clean road, traffic, shadows and a wet reflection.
 Every setting then encodes every frame, in a rotating order so that the machine's load falls on all alike; the
-table gives the median ms per frame, the mean size, and both relative to ``lanevil_core.export.encode.png_bytes`` (the
+table gives the median ms per frame, the mean size, and both relative to ``lanevil_core.images.png_bytes`` (the
 project's choice, marked ``*``). Each setting's output is decoded once to check it is lossless, and encoded twice
 to check it is byte-stable.
 
@@ -29,7 +29,7 @@ import numpy as np
 from PIL import Image
 
 from lanevil_core.case import load_case
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.images import png_bytes
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 from lanevil_core.typed import UInt8Array

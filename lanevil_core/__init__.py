@@ -1,5 +1,7 @@
 """lanevil_core: editable 3D lane-detection robustness cases, a CPU renderer and exact lane ground truth."""
 
+from importlib.metadata import PackageNotFoundError, version
+
 from .camera import EgoPath, Intrinsics, PinholeCamera, VehiclePose, ego_camera, pose_camera
 from .case import (
     Camera,
@@ -18,8 +20,8 @@ from .case import (
     save_case,
 )
 from .export.case import export_case
-from .export.encode import jpeg_bytes, png_bytes
 from .illusions import CATEGORIES, ILLUSION_TYPES, REGISTRY, Illusion
+from .images import jpeg_bytes, png_bytes
 from .labels.lanes import culane_lines, tusimple_record
 from .labels.overlay import draw_lanes
 from .pipeline.compile import compile_scene
@@ -27,6 +29,11 @@ from .render import Frame, render_frame, render_view
 from .world.paint import RoadPaint
 from .world.road_layout import RoadNetwork, build_network
 from .world.scene import CompiledScene
+
+try:  # one source for the version: the installed package's metadata (pyproject.toml's `version`)
+    __version__ = version("lanevil")
+except PackageNotFoundError:  # a source tree on sys.path that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "CATEGORIES",
@@ -67,4 +74,5 @@ __all__ = [
     "render_view",
     "save_case",
     "tusimple_record",
+    "__version__",
 ]

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
 
 from .files import write_atomic
@@ -25,6 +26,8 @@ SCHEMA_VERSION: Literal[1] = 1
 PAINT_WIDTH_M = 0.15
 DASH_M = 3.0
 GAP_M = 9.0
+# Road a case keeps ahead of the ego's last frame (the camera sees that far down the road).
+END_MARGIN_M = 60.0
 
 
 class _Model(BaseModel):
@@ -145,6 +148,23 @@ def _take_preset(data: Any, lookup: Callable[[str], dict[str, Any]]) -> tuple[di
         raise ValueError(f"preset: {error.args[0]}") from None
 
 
+# Projected points are kept up to this factor past the image corners' radius (here and in ``camera.lens``).
+LENS_VALID_MARGIN = 1.15
+
+
+def lens_covers(distortion: tuple[float, float, float, float, float], corner_radius: float) -> bool:
+    """Whether the radial polynomial reaches the distorted radius of the image's farthest corner (normalised
+    coordinates) while still rising, with a margin, so every pixel of the image has one ray (``Camera``'s check;
+    the camera package renders such lenses)."""
+    k1, k2, _, _, k3 = distortion
+    r = np.linspace(0.0, 8.0 * max(corner_radius, 1e-6), 8001)
+    r2 = r * r
+    slope = 1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2**2 + 7.0 * k3 * r2**3
+    rising = np.argmax(slope <= 0.05) if np.any(slope <= 0.05) else r.size
+    reach = r[:rising] * (1.0 + r2[:rising] * (k1 + r2[:rising] * (k2 + r2[:rising] * k3)))
+    return bool(reach.size and reach.max() >= LENS_VALID_MARGIN * corner_radius)
+
+
 class Lens(_Model):
     """Brown-Conrady lens distortion (OpenCV's k1, k2, p1, p2, k3) on normalised image coordinates. All zero is a
     pinhole; k1 < 0 is the barrel distortion of a wide dash-cam lens. Labels go through the same model."""
@@ -231,13 +251,11 @@ class Camera(_Model):
 
     @model_validator(mode="after")
     def _check_lens(self) -> Camera:
-        from .camera.lens import covers  # the camera package builds on this model
-
         f = self.focal_px
         cx = self.cx if self.cx is not None else self.width / 2
         cy = self.cy if self.cy is not None else self.height / 2
         corner = math.hypot(max(cx, self.width - cx) / f, max(cy, self.height - cy) / f)
-        if not covers(self.lens.coefficients, corner):
+        if not lens_covers(self.lens.coefficients, corner):
             raise ValueError("lens: this distortion turns back inside the image at this field of view "
                              "(weaken k1/k2/k3 or narrow the view)")
         return self
@@ -304,10 +322,10 @@ class Case(_Model):
                 "lanes per direction"
             )
         end_s = self.ego.start_s + self.ego.speed * (self.ego.frames - 1) / self.ego.fps
-        if end_s > self.road.length - 60.0:
+        if end_s > self.road.length - END_MARGIN_M:
             raise ValueError(
                 f"ego drives to s={end_s:.0f} m but the road is {self.road.length:.0f} m long "
-                "(keep 60 m of road ahead of the last frame)"
+                f"(keep {END_MARGIN_M:.0f} m of road ahead of the last frame)"
             )
         return self
 

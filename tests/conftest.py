@@ -127,6 +127,7 @@ class LaneServer:
             time.sleep(self.slow_s)
         time.sleep(self.hold_s)
         gray = cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_GRAYSCALE)
+        assert gray is not None
         height, width = gray.shape
         self.sizes.append((width, height))
         self.content_types.append(content_type)

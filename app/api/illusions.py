@@ -9,8 +9,8 @@ from fastapi import APIRouter
 from pydantic import BaseModel, Field
 
 from lanevil_core.case import case_schema
-from lanevil_core.cli.library import illusion_info
 from lanevil_core.illusions import CATEGORIES, REGISTRY
+from lanevil_core.illusions.info import illusion_info
 
 from .errors import ApiRoute
 

@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Annotated, Literal
+from typing import Annotated
 
 from fastapi import Depends, Query
 from pydantic import ValidationError
 
 from lanevil_core.case import Case
-from lanevil_core.cli.frame_range import parse_frame_range
+from lanevil_core.images import ImageFormat as ImageFormat  # the format parameter of the image routes
+from lanevil_core.pipeline.frames import parse_frame_range
 
 from ..frames import apply_overrides
 from ..settings import Settings
 from .errors import ApiError, first_error
 
-ImageFormat = Literal["png", "jpg"]
 MIN_SIZE = 64  # smallest rendered width or height (the case camera's lower bound)
 # pydantic locations of the override fields in a case -> the query parameter that set them
 OVERRIDE_FIELDS: dict[tuple[str, ...], str] = {("sun", "azimuth"): "sun_azimuth", ("sun", "altitude"): "sun_altitude",

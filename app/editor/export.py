@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import PurePosixPath
 
 from lanevil_core.case import Case, case_json
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.images import png_bytes
 from lanevil_core.library.benchmark_layout import case_folder, frame_file
 
 from ..jobs import Job, export_zip

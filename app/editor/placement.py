@@ -25,7 +25,6 @@ from lanevil_core.world.road_mesh import RoadSurface
 
 EDGE_EPS = 1e-9  # barycentric slack, so a ray through an edge between two faces hits one of them
 RAY_EPS = 1e-9
-NEWTON_STEPS = 4
 
 
 @dataclass(frozen=True)
@@ -84,20 +83,9 @@ def ray_surface_hit(surface: RoadSurface, ray_origin_world: FloatArray, ray_dir_
 
 
 def road_coordinates(line: ReferenceLine, p_world: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """World points (n, 3) -> (s_road, t_road, h_road), each (n,), in ``line``'s road frame.
-
-    The nearest sample of the line seeds a few Newton steps along the horizontal tangent, so points within the
-    bend radius of the line map back exactly (to ``ReferenceLine.to_world``'s own interpolation).
-    """
-    p_world = np.atleast_2d(np.asarray(p_world, np.float64))
-    d2 = ((p_world[:, None, :2] - line.xy[None, :, :]) ** 2).sum(-1)
-    s_road = line.s[np.argmin(d2, axis=1)]
-    for _ in range(NEWTON_STEPS):
-        origin, tangent, _left = line.frame(s_road)
-        flat = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
-        s_road = np.clip(s_road + ((p_world[:, :2] - origin[:, :2]) * flat).sum(1), 0.0, line.length)
-    origin, _tangent, left = line.frame(s_road)
-    return s_road, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
+    """World points (n, 3) -> (s_road, t_road, h_road), each (n,), in ``line``'s road frame
+    (``ReferenceLine.road_coordinates``)."""
+    return line.road_coordinates(p_world)
 
 
 def _literal_options(model: type[Illusion], name: str) -> tuple[Any, ...]:

@@ -25,6 +25,7 @@ from PIL import Image
 
 from lanevil_core.camera import PinholeCamera, ego_camera
 from lanevil_core.case import Case
+from lanevil_core.images import linear_to_srgb as _linear_to_srgb
 from lanevil_core.typed import Float32Array, FloatArray, IntArray
 from lanevil_core.world.paint import MATERIAL_ALBEDO, paint_mesh
 from lanevil_core.world.primitives import flat_trimesh
@@ -66,11 +67,6 @@ def road_parts(surface: RoadSurface, network: RoadNetwork, case: Case) -> list[t
     """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``."""
     return [(surface.vertices, surface.faces, MATERIAL_ALBEDO[surface.material]),
             paint_mesh(network, case.road.markings)]
-
-
-def _linear_to_srgb(linear: np.ndarray) -> np.ndarray:
-    linear = np.clip(linear, 0.0, 1.0)
-    return np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1 / 2.4) - 0.055)
 
 
 def decal_trimesh(network: RoadNetwork, layer: SurfaceLayer) -> trimesh.Trimesh:

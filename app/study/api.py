@@ -20,10 +20,11 @@ from fastapi.responses import FileResponse, JSONResponse, Response
 from pydantic import ValidationError
 from starlette.datastructures import UploadFile
 
+from ..api.deps import StateDep
 from ..api.errors import ApiError, ApiRoute, ErrorBody, first_error
 from ..api.forms import read_form
 from ..api.json_body import BodyError, check_json_type, is_json_type, parse_json
-from ..state import AppState, get_state
+from ..state import AppState
 from .auth import AdminDep
 from .bodies import (
     Completed,
@@ -59,7 +60,6 @@ from .spec import ConsentIn, RatingIn, StudySpec
 from .stats import exclusions, summarize
 from .tables import raw_ratings_csv, summary_csv
 
-StateDep = Annotated[AppState, Depends(get_state)]
 MAX_UPLOAD_FILES = 1000
 FORM_TYPES = ("multipart/form-data", "application/x-www-form-urlencoded")
 

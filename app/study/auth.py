@@ -8,15 +8,15 @@ from typing import Annotated
 from fastapi import Depends
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
+from ..api.deps import StateDep
 from ..api.errors import ApiError
-from ..state import AppState, get_state
 
 # Declared as a security scheme, so /docs has an "Authorize" button; missing or malformed headers are ours to refuse.
 bearer = HTTPBearer(auto_error=False, scheme_name="OrganiserToken",
                     description="the organiser token, LANEVIL_ADMIN_TOKEN of the server")
 
 
-def require_admin(state: Annotated[AppState, Depends(get_state)],
+def require_admin(state: StateDep,
                   credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)] = None) -> None:
     """Pass when ``Authorization: Bearer <token>`` matches the configured token (constant-time compare).
 

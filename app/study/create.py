@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lanevil_core.case import Case, write_atomic
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.case import Case
+from lanevil_core.files import write_atomic
+from lanevil_core.images import png_bytes
 
 from ..frames import FrameService
 from ..jobs import Job, JobManager

@@ -162,15 +162,17 @@ def _first_error(error: ValidationError) -> str:
 
 def labelled_vanishing_point(labels: Path) -> tuple[float, float]:
     """The vanishing point of the straight-road frames labelled in a TuSimple file (``camera.vanishing``)."""
-    from ..metrics.formats import LaneFileError, read_tusimple
     from .vanishing import vanishing_point
 
+    if not labels.is_file():
+        raise ValueError(f"lane_labels: {labels.name}: no such file")
+    try:  # TuSimple JSON lines, read here: the label readers of metrics/ sit above the camera
+        records = [json.loads(line) for line in labels.read_text(encoding="utf-8").splitlines() if line.strip()]
+        pairs = [(record["lanes"], record["h_samples"]) for record in records]
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ValueError(f"lane_labels {labels.name}: not a TuSimple label file ({type(error).__name__})") from None
     try:
-        records = read_tusimple(labels, "gt")
-    except LaneFileError as error:
-        raise ValueError(f"lane_labels: {error}") from None
-    try:
-        return vanishing_point([(record.lanes, record.h_samples) for record in records])
+        return vanishing_point(pairs)
     except ValueError as error:
         raise ValueError(f"lane_labels {labels.name}: {error}") from None
 

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..case import LENS_VALID_MARGIN as VALID_MARGIN
+from ..case import lens_covers as covers  # noqa: F401  # which lenses a case may hold: the case model's check
 from ..typed import FloatArray
 
 Distortion = tuple[float, float, float, float, float]
 NO_DISTORTION: Distortion = (0.0, 0.0, 0.0, 0.0, 0.0)
 UNDISTORT_ITERATIONS = 20
-VALID_MARGIN = 1.15  # projected points are kept up to this factor past the image corners' radius
 
 
 def is_pinhole(distortion: Distortion) -> bool:
@@ -40,18 +41,6 @@ def valid_radius2(distortion: Distortion, corner_r2: float) -> float:
     slope = 1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2**2 + 7.0 * k3 * r2**3  # d(r * radial(r)) / dr
     turning = r2[np.argmax(slope <= 0.05)] if np.any(slope <= 0.05) else np.inf
     return float(min(VALID_MARGIN**2 * corner_r2, turning))
-
-
-def covers(distortion: Distortion, corner_radius: float) -> bool:
-    """Whether the radial polynomial reaches the distorted radius of the image's farthest corner (normalised
-    coordinates) while still rising, with a margin, so every pixel of the image has one ray."""
-    k1, k2, _, _, k3 = distortion
-    r = np.linspace(0.0, 8.0 * max(corner_radius, 1e-6), 8001)
-    r2 = r * r
-    slope = 1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2**2 + 7.0 * k3 * r2**3
-    rising = np.argmax(slope <= 0.05) if np.any(slope <= 0.05) else r.size
-    reach = r[:rising] * (1.0 + r2[:rising] * (k1 + r2[:rising] * (k2 + r2[:rising] * k3)))
-    return bool(reach.size and reach.max() >= VALID_MARGIN * corner_radius)
 
 
 def undistort(x_d: FloatArray, y_d: FloatArray, distortion: Distortion) -> tuple[FloatArray, FloatArray]:

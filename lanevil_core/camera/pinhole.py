@@ -164,6 +164,7 @@ class EgoPath:
     speed: float  # m/s
     fps: float
     frames: int
+    seed: int = 0  # the case's seed: a sensor's noise in each frame is drawn from it and the frame index
 
     def s_road(self, frame: int) -> float:
         """Station (m along the main road) of the ego at frame ``frame``."""
@@ -183,7 +184,8 @@ class EgoPath:
 def ego_path(case: Case, network: RoadNetwork) -> EgoPath:
     """The case's scripted drive on ``network`` (its main road)."""
     return EgoPath(mount=case.camera, line=network.main.line, t_road=network.lane_center_t(case.ego.lane),
-                   start_s=case.ego.start_s, speed=case.ego.speed, fps=case.ego.fps, frames=case.ego.frames)
+                   start_s=case.ego.start_s, speed=case.ego.speed, fps=case.ego.fps, frames=case.ego.frames,
+                   seed=case.seed)
 
 
 def scripted_vehicle_transform(case: Case, network: RoadNetwork, frame: int) -> FloatArray:

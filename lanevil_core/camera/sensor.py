@@ -22,6 +22,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..case import Sensor
+from ..images import linear_to_srgb, srgb_to_linear
 from ..typed import FloatArray, UInt8Array
 
 KEY = 0.18  # middle grey the metered mean log luminance is brought to
@@ -84,7 +85,7 @@ def blackbody_rgb(kelvin: float) -> FloatArray:
         g = 288.1221695283 * (t - 60.0) ** -0.0755148492
         b = 255.0
     srgb = np.clip(np.array([r, g, b]) / 255.0, 1e-3, 1.0)
-    linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+    linear = srgb_to_linear(srgb)
     return linear / linear[1]
 
 
@@ -106,8 +107,7 @@ def tone_lut(contrast: float) -> UInt8Array:
     """(TONE_LUT_SIZE,) uint8: sRGB bytes of the filmic curve at sensor values ``i / (n - 1)``."""
     x = np.linspace(0.0, 1.0, TONE_LUT_SIZE)
     display = filmic(x, contrast)  # display-referred linear light in [0, 1]
-    srgb = np.where(display <= 0.0031308, 12.92 * display, 1.055 * np.power(display, 1 / 2.4) - 0.055)
-    lut = np.clip(np.round(srgb * 255.0), 0, 255).astype(np.uint8)
+    lut = np.clip(np.round(linear_to_srgb(display) * 255.0), 0, 255).astype(np.uint8)
     lut.setflags(write=False)
     return lut
 

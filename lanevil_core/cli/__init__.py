@@ -17,6 +17,7 @@ import pkgutil
 import sys
 from collections.abc import Sequence
 
+from .. import __version__
 from ..case import CaseError
 from .base import PROG, Command, UsageError, _Parser, remove_leftovers
 
@@ -38,6 +39,7 @@ def all_commands() -> dict[str, Command]:
 def build_parser(commands: dict[str, Command]) -> argparse.ArgumentParser:
     """The top-level parser with one subparser per command."""
     parser = _Parser(prog=PROG, description="LanEvil Studio: lane-detection robustness cases.")
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, command in commands.items():
         command.add_arguments(sub.add_parser(name, help=command.help, description=command.help))

@@ -12,13 +12,13 @@ import numpy as np
 
 from ..case import Case
 from ..files import remove_stale_temps
-from .frame_range import parse_frame_range
+from ..images import FILE_JPEG_QUALITY, SUFFIX_FORMATS
+from ..images import encode_image as encode_as
+from ..pipeline.frames import parse_frame_range
 
 PROG = "lanevil"
 SCENES_DIR = Path("scenes")
 CLEAN_DIR = SCENES_DIR / "00_clean"
-IMAGE_FORMATS = {".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg"}  # --out suffix -> encoding
-JPEG_QUALITY = 95
 OUTPUT_ARGUMENTS = ("out", "labels")  # path arguments whose folders get their leftover temporary files removed
 
 
@@ -115,18 +115,16 @@ def output_file(path: Path, flag: str, example: str) -> Path:
 
 
 def image_path(path: Path, flag: str = "--out") -> Path:
-    """An output image path whose suffix names a format we write (``IMAGE_FORMATS``)."""
+    """An output image path whose suffix names a format we write (``images.SUFFIX_FORMATS``)."""
     output_file(path, flag, "frame.png")
-    if path.suffix.lower() not in IMAGE_FORMATS:
-        raise UsageError(f"{flag} {path}: the suffix picks the format; use one of {', '.join(IMAGE_FORMATS)}")
+    if path.suffix.lower() not in SUFFIX_FORMATS:
+        raise UsageError(f"{flag} {path}: the suffix picks the format; use one of {', '.join(SUFFIX_FORMATS)}")
     return path
 
 
 def encode_image(rgb: np.ndarray, path: Path) -> bytes:
-    """(H, W, 3) uint8 pixels encoded as ``path``'s suffix says (PNG or JPEG)."""
-    from ..export.encode import jpeg_bytes, png_bytes
-
-    return png_bytes(rgb) if IMAGE_FORMATS[path.suffix.lower()] == "png" else jpeg_bytes(rgb, JPEG_QUALITY)
+    """(H, W, 3) uint8 pixels encoded as ``path``'s suffix says (PNG, or JPEG at ``FILE_JPEG_QUALITY``)."""
+    return encode_as(rgb, SUFFIX_FORMATS[path.suffix.lower()], FILE_JPEG_QUALITY)
 
 
 def remove_leftovers(args: argparse.Namespace) -> None:

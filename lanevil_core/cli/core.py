@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..case import Case, case_meshes_dir, load_case, write_atomic
+from ..case import Case, case_meshes_dir, load_case
+from ..files import write_atomic
 from ..presets import CAMERA_PRESET_NAMES
 from .base import (
     CLEAN_DIR,
@@ -131,7 +132,7 @@ def preview_path(case_path: Path, out_dir: Path, root: Path = SCENES_DIR) -> Pat
 
 
 def _run_preview(args: argparse.Namespace) -> int:
-    from ..export.encode import png_bytes
+    from ..images import png_bytes
     from ..labels.overlay import draw_lanes
 
     paths = args.cases or stock_scenes()
@@ -189,5 +190,3 @@ COMMANDS: dict[str, Command] = {
     "preview": Command("render frame 0 of every stock case (and a labelled copy)", _preview_arguments, _run_preview),
     "bench": Command("time the renderer on the stock cases", _bench_arguments, _run_bench),
 }
-
-

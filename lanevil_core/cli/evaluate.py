@@ -9,7 +9,7 @@ import re
 import sys
 from pathlib import Path
 
-from ..case import write_atomic
+from ..files import write_atomic
 from ..metrics.formats import LaneFileError
 from ..metrics.tusimple import F1_VARIANTS
 from .base import Command, UsageError

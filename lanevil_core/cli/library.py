@@ -3,29 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 from pathlib import Path
 from typing import Any
 
-from ..case import write_atomic
-from ..illusions import REGISTRY, Illusion
+from ..files import write_atomic
+from ..illusions import REGISTRY
+from ..illusions.info import illusion_info
 from .base import Command, UsageError, parse_size
-
-
-def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
-    """Name, category, tunable parameters (with ranges and defaults) and the severity table of one type."""
-    schema = cls.model_json_schema()
-    parameters = {}
-    for field, spec in schema.get("properties", {}).items():
-        if field == "type":
-            continue
-        keys = ("type", "anyOf", "enum", "default", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",
-                "description")
-        parameters[field] = {key: spec[key] for key in keys if key in spec}
-    return {"name": cls.model_fields["type"].default, "category": cls.CATEGORY,
-            "description": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()), "parameters": parameters,
-            "severity": [dataclasses.asdict(row) for row in cls.SEVERITY]}
 
 
 def _range(spec: dict[str, Any]) -> str:
@@ -71,7 +56,7 @@ def _sheet_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run_sheet(args: argparse.Namespace) -> int:
     from ..dataset.progress import progress_bar
-    from ..export.encode import png_bytes
+    from ..images import png_bytes
     from ..report.sheet import contact_sheet, sheet_frames
 
     types = None

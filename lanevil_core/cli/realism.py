@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..case import write_atomic
+from ..files import write_atomic
 from .base import Command, UsageError, count, output_file
 
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..camera.calibration import CalibrationError, camera_choice
 from ..camera.variation import random_camera
-from ..case import Case, case_json, load_case, parse_case
+from ..case import END_MARGIN_M, Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
 from ..library.benchmark_layout import (
     CATEGORY_FOLDERS,
@@ -39,6 +39,7 @@ from ..library.benchmark_layout import (
     folder_type,
     frame_file,
 )
+from ..pipeline.frames import evenly_spaced
 from ..presets import PRESET_NAMES, preset_values
 from ..typed import LineType
 
@@ -50,7 +51,6 @@ FORMATS: dict[str, str] = {"png": ".png", "jpg": ".jpg"}  # --format -> frame fi
 
 TRAIN_FRAMES_PER_VARIANT = 5  # frames of one train variation, evenly spaced over its drive
 CHUNK_FRAMES = 10  # frames per render task: one scene compile (~0.25 s) amortised over ~3 s of rendering
-END_MARGIN_M = 60.0  # road the case validator keeps ahead of the last frame
 SUN_ALTITUDE_JITTER_DEG = 10.0
 # The train split must not let a detector place lanes from the road's layout instead of its paint (the
 # paint-free control of the test split measures that). So the layout varies: half the variations move the camera
@@ -199,16 +199,6 @@ class DatasetPlan:
 
 class PlanError(ValueError):
     """A run that cannot be planned (no cases, clashing folders, no clean case for the train split)."""
-
-
-def evenly_spaced(total: int, count: int | None) -> tuple[int, ...]:
-    """``count`` indices spread evenly over ``0..total-1`` including both ends (all of them when ``count`` is None
-    or at least ``total``); one index is frame 0."""
-    if count is None or count >= total:
-        return tuple(range(total))
-    if count == 1:
-        return (0,)
-    return tuple(i * (total - 1) // (count - 1) for i in range(count))
 
 
 def discover_cases(root: Path) -> list[SourceCase]:

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..case import case_json, parse_case
-from ..export.encode import jpeg_bytes, png_bytes
+from ..images import FILE_JPEG_QUALITY
+from ..images import encode_image as encode_as
 from ..labels.lanes import tusimple_record
 from ..library.benchmark_layout import frame_file
 from ..pipeline.compile import compile_scene, roadside_key
@@ -26,7 +27,6 @@ from ..typed import BoolArray, UInt8Array
 from ..world.scene import CompiledScene
 from .plan import FORMATS, RenderTask
 
-JPEG_QUALITY = 95
 SCENE_CACHE_SIZE = 2  # compiled scenes kept per process: consecutive chunks of a case (and of the same case
 # without its illusion, which test records are measured against) compile it once
 
@@ -46,12 +46,8 @@ TaskDone = Callable[[RenderTask, list[FrameResult]], None]  # called in the call
 
 
 def encode_image(rgb: UInt8Array, image_format: str) -> bytes:
-    """PNG (``encode.png_bytes``) or JPEG (quality 95, 4:2:0) bytes with no metadata: same pixels, same bytes."""
-    if image_format == "png":
-        return png_bytes(rgb)
-    if image_format == "jpg":
-        return jpeg_bytes(rgb, JPEG_QUALITY)
-    raise ValueError(f"unknown image format {image_format!r} (choose from {', '.join(FORMATS)})")
+    """PNG or JPEG (``FILE_JPEG_QUALITY``, 4:2:0) bytes with no metadata: same pixels, same bytes."""
+    return encode_as(rgb, image_format, FILE_JPEG_QUALITY)
 
 
 def _encode_and_hash(rgb: UInt8Array, image_format: str) -> tuple[bytes, str]:

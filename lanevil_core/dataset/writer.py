@@ -21,7 +21,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from ..case import write_atomic
+from ..files import write_atomic
 from ..library.benchmark_layout import LABELS_FILE, frame_file
 from .manifest import MANIFEST_FILE, manifest_bytes
 from .plan import SPLIT_LABELS, PlannedCase

@@ -7,9 +7,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-import cv2
-import numpy as np
-
+from .. import images
+from ..images import IMAGE_SUFFIXES
 from ..labels.lanes import h_samples_for
 from ..metrics.formats import LaneFileError, read_tusimple, split_folder, split_labels
 from ..typed import UInt8Array
@@ -19,7 +18,6 @@ from .model_spec import FAMILIES
 
 Detector = Callable[[UInt8Array, list[int]], list[list[int]]]
 Progress = Callable[[int, int], None]
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 DETECTORS: dict[str, Detector] = {"hough": detect_hough, "birdseye": detect_birdseye}
 LEARNED_METHODS: tuple[str, ...] = FAMILIES
@@ -50,11 +48,8 @@ def builtin_detector(method: str, weights: str | Path | None = None) -> Detector
 
 
 def read_rgb(path: Path) -> UInt8Array:
-    """(H, W, 3) uint8 RGB pixels of an image file."""
-    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if bgr is None:
-        raise LaneFileError(f"{path}: cannot read the image")
-    return np.ascontiguousarray(bgr[..., ::-1])
+    """(H, W, 3) uint8 RGB pixels of an image file (``images.read_rgb``); a ``LaneFileError`` if unreadable."""
+    return images.read_rgb(path, error=LaneFileError)
 
 
 def split_images(split_dir: Path) -> list[tuple[str, list[int] | None]]:

@@ -9,7 +9,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..case import Case, write_atomic
+from ..case import Case
+from ..files import write_atomic
 from ..pipeline.compile import compile_scene
 from .loop import DriveSettings, DriveTrace, Progress, drive_case
 from .plots import path_plot, plots_available, trace_plot

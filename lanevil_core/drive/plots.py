@@ -113,4 +113,3 @@ def path_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:
         ax.grid(alpha=0.3)
     fig.tight_layout()
     return figure_png(fig)
-

@@ -15,7 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from ..case import Case, load_case, write_atomic
+from ..case import Case, load_case
+from ..files import write_atomic
 from ..illusions import CATEGORIES, REGISTRY
 from ..library.benchmark_layout import case_illusion_type, folder_type
 from .loop import DriveSettings

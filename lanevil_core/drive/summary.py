@@ -87,5 +87,3 @@ def summarize(trace: DriveTrace, wall_seconds: float | None = None) -> DriveSumm
         lane_departure=t_departure is not None, t_departure=t_departure,
         off_road=t_off_road is not None, t_off_road=t_off_road,
         steps_per_second=(len(trace.steps) / wall_seconds) if wall_seconds and wall_seconds > 0 else None)
-
-

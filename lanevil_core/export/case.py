@@ -22,7 +22,9 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from ..case import Case, case_json, write_atomic
+from ..case import Case, case_json
+from ..files import write_atomic
+from ..images import png_bytes
 from ..labels.lanes import CULANE_SIZE, TUSIMPLE_SIZE, culane_lines, tusimple_record
 from ..pipeline.compile import compile_scene
 from ..render import render_frame
@@ -31,7 +33,6 @@ from ..world.paint import MATERIAL_ALBEDO
 from ..world.primitives import flat_trimesh
 from ..world.road_mesh import road_surface
 from ..world.scene import CompiledScene
-from .encode import png_bytes
 
 FORMATS: tuple[str, ...] = ("tusimple", "culane")
 # glTF is +Y up: world (x, y, z) -> glTF (x, z, -y).

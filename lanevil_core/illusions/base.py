@@ -8,7 +8,6 @@ into real scene elements (meshes, road-surface layers, lights, sun and wetness c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
@@ -52,7 +51,7 @@ class CompileContext:
     layers: list[SurfaceLayer] = field(default_factory=list)
     lights: list[PointLight] = field(default_factory=list)
     source: int = -1  # index of the illusion being compiled
-    meshes_dir: Path | None = None  # the folder user meshes (``vehicle.mesh_file``) come from; None = no meshes
+    user_meshes: dict[int, Mesh] = field(default_factory=dict)  # illusion index -> its ``mesh_file``, as read
 
     def rng(self, seed: int) -> np.random.Generator:
         """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""

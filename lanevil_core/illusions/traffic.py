@@ -6,46 +6,43 @@ centre +- ``EGO_CLEAR_M`` from its start to past its last position) stays free, 
 participants crowd the lines beside it and the lanes next to it instead. Severity raises the number of
 participants, brings the first one closer and puts more of them on the lane lines.
 
-``load_obstacle`` reads a user's glTF/GLB/OBJ model; the ``vehicle`` type's ``mesh_file`` uses it in place of
-the procedural bodies. ``mesh_file`` is a file NAME, never a path: it is looked up in the meshes folder the compile
-is given (``CompileContext.meshes_dir``: a case file's ``meshes/`` folder for the library and CLI, the server's
-``<data dir>/uploads/``), and a name that resolves outside that folder or to no file is refused.
+The ``vehicle`` type's ``mesh_file`` puts a user's glTF/GLB/OBJ model in place of the procedural bodies. It is a
+file NAME, never a path (``world.user_meshes``); ``compile_scene`` reads it from the meshes folder it is given (a
+case file's ``meshes/`` folder for the library and CLI, the server's ``<data dir>/uploads/``) into
+``CompileContext.user_meshes``, so this module reads no files.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, cast
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-import trimesh
 from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 
 from ..world import props
-from ..world.primitives import pose_on_road, rotation_z, to_mesh, transformed
+from ..world.primitives import pose_on_road, rotation_z, transformed
 from ..world.scene import Mesh
+from ..world.user_meshes import (  # noqa: F401  # the user-mesh names as this module has always offered them
+    MAX_OBSTACLE_FACES,
+    MESH_NAME,
+    MESH_NAME_RULE,
+    MESH_SUFFIXES,
+    is_mesh_name,
+    load_obstacle,
+    mesh_path,
+    srgb_to_linear,
+)
 from .base import BEYOND_DRIVE_M, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
-
-if TYPE_CHECKING:
-    from ..typed import FloatArray
 
 EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
 EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position
 ROAD_END_MARGIN_M = 10.0
 NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, tried against crowding
 GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
-GREY = (0.3, 0.3, 0.3)
 
-# What a ``mesh_file`` may be: a plain file name of a model format ``load_obstacle`` reads (no folder, no "..").
-MESH_SUFFIXES = ("glb", "gltf", "obj")
-MESH_NAME = re.compile(rf"^[A-Za-z0-9][A-Za-z0-9._-]{{0,99}}\.({'|'.join(MESH_SUFFIXES)})$")
-MESH_NAME_RULE = (f"must be a file name in the uploads folder (letters, digits, '.', '_', '-'; ending "
-                  f"{', '.join('.' + suffix for suffix in MESH_SUFFIXES)}), not a path")
-MAX_OBSTACLE_FACES = 60_000
 
 Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 RGB = tuple[Unit, Unit, Unit]
@@ -403,11 +400,13 @@ class Vehicle(TrafficIllusion):
         return self.SEVERITY[self.severity - 1]
 
     def load_mesh(self, ctx: CompileContext) -> Mesh:
-        """The ``mesh_file`` model from ``ctx.meshes_dir``; ``MeshFileError`` naming the field otherwise."""
-        try:
-            return load_obstacle(mesh_path(ctx.meshes_dir, self.mesh_file or ""))
-        except (OSError, ValueError) as error:
-            raise MeshFileError(f"illusions.{ctx.source}.{self.type}.mesh_file", str(error)) from None
+        """The ``mesh_file`` model as ``compile_scene`` read it (``ctx.user_meshes``); ``MeshFileError`` naming the
+        field when it was not read."""
+        mesh = ctx.user_meshes.get(ctx.source)
+        if mesh is None:
+            raise MeshFileError(f"illusions.{ctx.source}.{self.type}.mesh_file",
+                                f"{self.mesh_file!r} was not read (compile_scene reads a case's meshes)")
+        return mesh
 
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
@@ -482,89 +481,6 @@ class Vehicle(TrafficIllusion):
         if kind == "van":
             return props.van(color, lights_on=self.lights_on)
         return props.car(color, lights_on=self.lights_on)
-
-
-def srgb_to_linear(rgb8: FloatArray) -> FloatArray:
-    """(..., 3) sRGB 0-255 -> linear [0, 1]."""
-    c = np.asarray(rgb8, np.float64) / 255.0
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-def _face_colors(geometry: trimesh.Trimesh) -> FloatArray:
-    """(m, 3) linear albedo per face from a loaded mesh's visual: face or vertex colours, the texture
-    sampled at the vertices, the material's base colour, else grey."""
-    visual: Any = geometry.visual  # one of several visual kinds, told apart by .kind
-    faces = geometry.faces
-    try:
-        if visual.kind == "face":
-            return srgb_to_linear(visual.face_colors[:, :3])
-        if visual.kind == "vertex":
-            return srgb_to_linear(visual.vertex_colors[faces][:, :, :3].mean(1))
-        if visual.kind == "texture":
-            material = getattr(visual, "material", None)
-            if getattr(visual, "uv", None) is not None and getattr(material, "image", None) is not None:
-                colors = visual.to_color().vertex_colors
-                return srgb_to_linear(colors[faces][:, :, :3].mean(1))
-            if material is not None:
-                return np.broadcast_to(srgb_to_linear(np.asarray(material.main_color)[:3]), (len(faces), 3))
-    except (AttributeError, ValueError, IndexError, ImportError):
-        pass
-    return np.broadcast_to(np.asarray(GREY, np.float64), (len(faces), 3))
-
-
-def is_mesh_name(name: str) -> bool:
-    """Whether ``name`` is an acceptable ``mesh_file``: a plain model file name (``MESH_NAME``, no "..")."""
-    return bool(MESH_NAME.match(name)) and ".." not in name
-
-
-def mesh_path(meshes_dir: Path | None, name: str) -> Path:
-    """The file ``name`` in ``meshes_dir``; ``ValueError`` for a name that is no plain model name, no folder, a
-    path resolving outside the folder (a link pointing away) or a missing file."""
-    if not is_mesh_name(name):
-        raise ValueError(f"{name!r} {MESH_NAME_RULE}")
-    if meshes_dir is None:
-        raise ValueError(f"{name!r}: no meshes folder to read it from")
-    folder = Path(meshes_dir).resolve()
-    path = (folder / name).resolve()
-    if not path.is_relative_to(folder):
-        raise ValueError(f"{name!r} resolves outside the meshes folder")
-    if not path.is_file():
-        raise ValueError(f"{name!r} is not in the meshes folder (upload it first)")
-    return path
-
-
-def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: int = MAX_OBSTACLE_FACES,
-                  name: str | None = None) -> Mesh:
-    """A user's glTF/GLB/OBJ model as a local-frame ``Mesh``: footprint centred on the origin, resting on z = 0,
-    +X forward.
-
-    ``up="y"`` converts glTF's convention (+Y up, +Z forward) to this frame; ``up="z"`` keeps the axes. Colours
-    come per face from the file (sRGB converted to linear), grey where it has none.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"obstacle model not found: {path}")
-    scene = cast(trimesh.Scene, trimesh.load(str(path), force="scene"))
-    parts = [g for g in scene.dump(concatenate=False) if isinstance(g, trimesh.Trimesh) and len(g.faces)]
-    if not parts:
-        raise ValueError(f"{path}: no triangles in the model")
-    faces = sum(len(g.faces) for g in parts)
-    if faces > max_faces:
-        raise ValueError(f"{path}: {faces} triangles, more than the {max_faces} the renderer takes per obstacle")
-    vertices, tris, colors, offset = [], [], [], 0
-    for g in parts:
-        vertices.append(np.asarray(g.vertices, np.float64))
-        tris.append(np.asarray(g.faces, np.int64) + offset)
-        colors.append(_face_colors(g))
-        offset += len(g.vertices)
-    p = np.concatenate(vertices)
-    if up == "y":  # (x, y, z) glTF -> +X forward (glTF +Z), +Y left (glTF +X), +Z up (glTF +Y)
-        p = np.stack([p[:, 2], p[:, 0], p[:, 1]], axis=1)
-    lo, hi = p.min(0), p.max(0)
-    p = p - [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]]
-    mesh = to_mesh(trimesh.Trimesh(p, np.concatenate(tris), process=False), np.concatenate(colors),
-                   name=name or path.stem, kind="obstacle", gloss=0.3)
-    return mesh
 
 
 def scaled_to(mesh: Mesh, size: tuple[float, float, float]) -> Mesh:

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..case import Case, case_json, write_atomic
+from ..case import Case, case_json
+from ..files import write_atomic
 
 XODR_FILE = "road.xodr"
 XOSC_FILE = "scenario.xosc"

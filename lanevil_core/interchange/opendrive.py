@@ -31,7 +31,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..case import Case, Marking, write_atomic
+from ..case import Case, Marking
+from ..files import write_atomic
 from ..world.paint import DOUBLE_LINE_SPACING_M
 from ..world.road_geometry import Piece, ReferenceLine
 from ..world.road_layout import RoadNetwork, build_network, reference_pieces

@@ -12,7 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from ..case import Case, case_json, parse_case, write_atomic
+from ..case import Case, case_json, parse_case
+from ..files import write_atomic
 from ..illusions import REGISTRY
 from ..presets import preset_values
 from ..typed import LineType, SceneKind

@@ -28,10 +28,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .. import images
+from ..images import IMAGE_SUFFIXES
 from ..typed import FloatArray, UInt8Array
 
 ANALYSIS_WIDTH = 1280
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 CANNY_LOW, CANNY_HIGH = 100, 200
 NOISE_FLAT_SHARE = 0.9  # Immerkær's estimate over the pixels whose Sobel gradient is below this quantile
@@ -193,11 +194,8 @@ def image_files(root: str | Path, limit: int | None = None) -> list[Path]:
 
 
 def read_rgb(path: Path) -> UInt8Array:
-    """(H, W, 3) uint8 RGB pixels of an image file (alpha dropped, grey expanded)."""
-    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if bgr is None:
-        raise RealismError(f"{path}: cannot read the image")
-    return np.ascontiguousarray(bgr[..., ::-1])
+    """(H, W, 3) uint8 RGB pixels of an image file (``images.read_rgb``); a ``RealismError`` if unreadable."""
+    return images.read_rgb(path, error=RealismError)
 
 
 def folder_statistics(root: str | Path, limit: int | None = None) -> list[FrameStatistics]:

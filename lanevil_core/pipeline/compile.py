@@ -11,12 +11,12 @@ import numpy as np
 from ..camera import ego_path
 from ..case import Case
 from ..illusions import CompileContext, EgoDrive, MeshFileError
-from ..illusions.traffic import mesh_path
 from ..world.environment import environment_for, in_proportion, is_night
 from ..world.paint import road_paint
 from ..world.road_layout import RoadNetwork, build_network
 from ..world.scene import CompiledScene, Mesh
 from ..world.scenery import roadside_meshes
+from ..world.user_meshes import load_obstacle, mesh_path
 
 
 def roadside_key(case: Case) -> str:
@@ -35,21 +35,37 @@ def _roadside(case: Case, reuse: CompiledScene | None) -> tuple[RoadNetwork, lis
     return network, roadside_meshes(case, network, np.random.default_rng([case.seed, 0]))
 
 
+def _named_meshes(case: Case) -> list[tuple[int, str, str]]:
+    """(illusion index, field path, file name) of every user mesh the case names."""
+    named = [(index, f"illusions.{index}.{illusion.type}.mesh_file", getattr(illusion, "mesh_file", None))
+             for index, illusion in enumerate(case.illusions)]
+    return [(index, field, name) for index, field, name in named if name]
+
+
 def mesh_files(case: Case) -> list[tuple[str, str]]:
     """(field path, file name) of every user mesh the case names (``illusions.N.vehicle.mesh_file``, the path
     pydantic's errors give)."""
-    named = [(f"illusions.{index}.{illusion.type}.mesh_file", getattr(illusion, "mesh_file", None))
-             for index, illusion in enumerate(case.illusions)]
-    return [(field, name) for field, name in named if name]
+    return [(field, name) for _index, field, name in _named_meshes(case)]
 
 
 def check_mesh_files(case: Case, meshes_dir: Path | None) -> None:
     """``MeshFileError`` naming the first ``mesh_file`` that is not a file in ``meshes_dir`` (without loading it)."""
-    for field, name in mesh_files(case):
+    load_user_meshes(case, meshes_dir, read=False)
+
+
+def load_user_meshes(case: Case, meshes_dir: Path | None, read: bool = True) -> dict[int, Mesh]:
+    """Illusion index -> the model its ``mesh_file`` names, read from ``meshes_dir`` (``world.user_meshes``);
+    ``MeshFileError`` naming the field of the first that is missing or unreadable. With ``read=False`` the files
+    are only looked up (and the dict stays empty)."""
+    meshes: dict[int, Mesh] = {}
+    for index, field, name in _named_meshes(case):
         try:
-            mesh_path(meshes_dir, name)
-        except ValueError as error:
+            path = mesh_path(meshes_dir, name)
+            if read:
+                meshes[index] = load_obstacle(path)
+        except (OSError, ValueError) as error:
             raise MeshFileError(field, str(error)) from None
+    return meshes
 
 
 def ego_drive(case: Case) -> EgoDrive:
@@ -69,7 +85,7 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     """
     network, roadside = _roadside(case, reuse)
     ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
-                         meshes_dir=meshes_dir)
+                         user_meshes=load_user_meshes(case, meshes_dir))
     ctx.meshes.extend(roadside)
     case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):

@@ -27,6 +27,7 @@ from ..render import render_frame
 from ..typed import BoolArray, UInt8Array
 from ..world.scene import CompiledScene
 from .compile import compile_scene
+from .frames import evenly_spaced
 
 BAND_RADIUS_FRACTION = 1.0 / 64.0  # band half width as a share of the image width (20 px at 1280)
 CHANGED_LEVEL = 12.0  # a band pixel changed by more than this (of 255) counts towards the share
@@ -109,8 +110,6 @@ def in_view_frames(case: Case, count: int, step: int = 2) -> tuple[int, ...]:
     """``count`` frames of the drive, evenly over those where the illusion changes at least ``IN_VIEW_SHARE``
     of the lane band (every ``step``-th frame tried at ``SHARE_SIZE``); the frames where it changes most when
     fewer show it; the evenly spaced frames of the whole drive when it never does."""
-    from ..dataset.plan import evenly_spaced
-
     candidates, changes = drive_changes(case, step)
     shown = [frame for frame, change in zip(candidates, changes, strict=True) if change.share >= IN_VIEW_SHARE]
     if not shown:

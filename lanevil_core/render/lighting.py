@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+# The irradiance unit, set in world/environment.py beside the daylight models: SUN_SCALE is a clear noon sun's
+# irradiance relative to the sky's ambient unit, SKY_AMBIENT_GAIN the sky's ambient light per unit of its colour.
+from ..world.environment import SKY_AMBIENT_GAIN as SKY_AMBIENT_GAIN
+from ..world.environment import SUN_SCALE as SUN_SCALE
 from ._jit import kernel
 
-SUN_SCALE = 3.2  # irradiance of a clear noon sun relative to the sky's ambient unit
 SKY_SCALE = 1.6
 NORMAL_OFFSET_M = 0.03
 LOBE_FLOOR = 1e-3

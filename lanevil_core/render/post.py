@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..images import linear_to_srgb
 from ._jit import kernel
 from .bands import band_rows, run_bands
 
@@ -13,8 +14,7 @@ CLAMP = 8.0  # bright highlights are clamped before edge blending so a sun glint
 
 
 def _srgb_lut() -> np.ndarray:
-    y = np.linspace(0.0, 1.0, LUT_SIZE)
-    srgb = np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1 / 2.4) - 0.055)
+    srgb = linear_to_srgb(np.linspace(0.0, 1.0, LUT_SIZE))
     return np.clip(np.round(srgb * 255.0), 0, 255).astype(np.uint8)
 
 

@@ -283,7 +283,7 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
     else:
         dev = development(hdr, sensor)
         develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
-                sensor.saturation, _noise_seed(scene.case.seed, frame), dev.lut, rgb, threads, object_id, streaks)
+                sensor.saturation, _noise_seed(scene.ego.seed, frame), dev.lut, rgb, threads, object_id, streaks)
         if sensor.sharpen > 0.0:
             soft = cv2.GaussianBlur(rgb, (0, 0), 1.0)
             rgb = np.asarray(cv2.addWeighted(rgb, 1.0 + sensor.sharpen, soft, -sensor.sharpen, 0.0), np.uint8)

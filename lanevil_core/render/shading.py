@@ -26,6 +26,7 @@ from ._jit import kernel
 from .bands import band_rows
 from .lighting import (
     FOOTPRINT_TAP_TEXELS,
+    SKY_AMBIENT_GAIN,
     SUN_BIAS,
     SUN_OFFSET,
     SUN_SCALE,
@@ -174,7 +175,7 @@ def fog_table(density: float, start_m: float) -> np.ndarray:
 def frame_lighting(env_f: FloatArray, sun_dir: FloatArray, sun_color: FloatArray, zenith: FloatArray,
                    horizon: FloatArray, lights: FloatArray) -> Lighting:
     """The frame's ``Lighting`` with its derived colours: sky ambient, fog colour and sun irradiance."""
-    ambient = env_f[AMBIENT] * (0.5 * horizon + 0.5 * zenith) * 2.2
+    ambient = env_f[AMBIENT] * (0.5 * horizon + 0.5 * zenith) * SKY_AMBIENT_GAIN
     fog_color = horizon * (1.6 * (0.25 + 0.75 * min(env_f[AMBIENT] * 3.0, 1.0)))
     sun = SUN_SCALE * env_f[SUN_I] * sun_color
     return Lighting(env_f, sun_dir, sun_color, zenith, horizon, np.ascontiguousarray(lights, np.float64),
@@ -608,6 +609,6 @@ def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.nda
             n_dot_l = abs(face_normal[f, 0] * sun_dir[0] + face_normal[f, 1] * sun_dir[1]
                           + face_normal[f, 2] * sun_dir[2])
             for c in range(3):
-                amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * 2.2 + lights_rgb_scale
+                amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * SKY_AMBIENT_GAIN + lights_rgb_scale
                 out[row, col, c] = face_color[f, c] * (SUN_SCALE * env_f[SUN_I] * sun_color[c] * n_dot_l + amb) \
                     + face_emission[f, c]

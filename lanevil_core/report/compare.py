@@ -18,7 +18,7 @@ from itertools import combinations
 from pathlib import Path
 from typing import Any
 
-from ..case import write_atomic
+from ..files import write_atomic
 from .interval import Interval, Term, combination_interval
 from .robustness import (
     ALL,

@@ -24,8 +24,8 @@ from dataclasses import field as default_field
 from pathlib import Path
 from typing import Any
 
-from ..case import write_atomic
 from ..export.encode import figure_png
+from ..files import write_atomic
 from ..metrics.evaluate import ScoredImage
 from ..metrics.tusimple import summarize
 from .interval import CaseSums, Interval, gap_interval

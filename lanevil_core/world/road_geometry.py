@@ -14,6 +14,7 @@ import numpy as np
 from ..typed import FloatArray
 
 SAMPLE_STEP_M = 0.1
+NEWTON_STEPS = 4  # refinements of a world point's station in ``road_coordinates``
 
 
 @dataclass(frozen=True)
@@ -127,6 +128,23 @@ class ReferenceLine:
         heading = self._interp(self.heading, s_at)
         t_road = float(np.dot(xy - [x, y], [-np.sin(heading), np.cos(heading)]))
         return s_road, t_road
+
+    def road_coordinates(self, p_world: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """World points (n, 3) -> (s_road, t_road, h_road), each (n,), in this line's road frame.
+
+        The nearest sample of the line seeds ``NEWTON_STEPS`` Newton steps along the horizontal tangent, so points
+        within the bend radius of the line map back exactly (to ``to_world``'s own interpolation). ``station`` is
+        the one-point form the renderer's path keeps (one refinement, no height).
+        """
+        p_world = np.atleast_2d(np.asarray(p_world, np.float64))
+        d2 = ((p_world[:, None, :2] - self.xy[None, :, :]) ** 2).sum(-1)
+        s_road = self.s[np.argmin(d2, axis=1)]
+        for _ in range(NEWTON_STEPS):
+            origin, tangent, _left = self.frame(s_road)
+            flat = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
+            s_road = np.clip(s_road + ((p_world[:, :2] - origin[:, :2]) * flat).sum(1), 0.0, self.length)
+        origin, _tangent, left = self.frame(s_road)
+        return s_road, ((p_world - origin) * left).sum(1), p_world[:, 2] - origin[:, 2]
 
 
 def _curvature_heading(pieces: list[Piece], s: FloatArray, heading0: float) -> tuple[FloatArray, FloatArray]:

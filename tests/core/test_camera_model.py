@@ -177,7 +177,7 @@ def test_sensor_noise_has_the_modelled_sigma_and_independent_channels() -> None:
     expected = np.sqrt(level * shot + read * read)
     assert np.allclose(values.mean(axis=0), level, atol=0.005)
     assert np.allclose(values.std(axis=0), expected, rtol=0.05)
-    correlation = np.corrcoef(values.T)
+    correlation = np.asarray(np.corrcoef(values.T))
     assert np.all(np.abs(correlation[np.triu_indices(3, 1)]) < 0.03)
     again = np.empty_like(out)
     develop(hdr, 1.0, np.ones(3), 0.0, (160.0, 120.0), shot, read, 1.0, 11, linear, again, threads=2)

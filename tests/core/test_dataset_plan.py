@@ -101,7 +101,7 @@ def test_tasks_cover_the_pending_frames_in_chunks(stock: list[SourceCase]) -> No
 def test_renderer_sources_reach_the_render_path_only() -> None:
     names = {path.relative_to(_PACKAGE).as_posix() for path in source_files()}
     assert {"dataset/worker.py", "render/renderer.py", "labels/lanes.py", "pipeline/compile.py",
-            "export/encode.py"} <= names
+            "images.py"} <= names
     assert not any(name.startswith(("cli", "dataset/local", "dataset/run")) for name in names)
 
 

@@ -15,7 +15,7 @@ from lanevil_core.case import Case, load_case
 from lanevil_core.cli import main
 from lanevil_core.detect import DETECTORS, GroundCamera, detect_split
 from lanevil_core.detect.common import lane_columns
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.images import png_bytes
 from lanevil_core.labels.lanes import tusimple_record
 from lanevil_core.metrics.tusimple import score_image, summarize
 from lanevil_core.pipeline.compile import compile_scene

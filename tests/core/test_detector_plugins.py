@@ -81,7 +81,7 @@ def test_named_detectors_from_the_environment_join_every_list(monkeypatch, lane_
     infos = {info.name: info for info in detector_infos()}
     assert infos["mine"].kind == "http" and infos["mine"].available
     assert infos["other"].kind == "onnx" and not infos["other"].available
-    assert "no ONNX model" in infos["other"].reason
+    assert "no ONNX model" in (infos["other"].reason or "")
     with pytest.raises(LaneFileError, match="not available"):
         available_detector("other")
     # the web app takes names only: a source is not a name there
@@ -211,7 +211,7 @@ def test_an_installed_entry_point_is_a_detector(installed_plugin, stripes) -> No
     assert (info.kind, info.available, info.real_trained) == ("plugin", True, True)
     assert info.version == "bright@1.2.0" and info.source == "bright_lanes:BrightColumn"
     broken = detector_info("broken")
-    assert not broken.available and "RuntimeError: no weights file" in broken.reason
+    assert not broken.available and "RuntimeError: no weights file" in (broken.reason or "")
 
 
 def test_lanevil_drive_with_an_http_detector_in_the_loop(tmp_path, make_case, lane_server) -> None:

@@ -13,7 +13,7 @@ from PIL import Image
 
 from lanevil_core.case import Case, load_case
 from lanevil_core.export.case import export_case
-from lanevil_core.export.encode import png_bytes
+from lanevil_core.images import png_bytes
 from lanevil_core.world.paint import dash_spans, paint_mesh
 from lanevil_core.world.road_layout import build_network
 

@@ -35,7 +35,7 @@ def test_unknown_and_missing_detectors_say_so(monkeypatch, tmp_path) -> None:
         detector_info("yolo")
     monkeypatch.setattr(detector_catalog, "SHIPPED_MODELS", tmp_path)
     info = detector_info("ufld")
-    assert not info.available and "no ufld model" in info.reason and info.model is None
+    assert not info.available and "no ufld model" in (info.reason or "") and info.model is None
     with pytest.raises(LaneFileError, match="^detector: ufld is not available"):
         available_detector("ufld")
     assert detector_info("hough").available

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from lanevil_core.cli.frame_range import parse_frame_range
+from lanevil_core.pipeline.frames import parse_frame_range
 
 
 @pytest.mark.parametrize(("text", "expected"), [(":", range(50)), ("10:", range(10, 50)), (":3", range(3)),

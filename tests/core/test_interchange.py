@@ -25,15 +25,15 @@ CM = 0.01
 
 def _geometry_end(geometry: ET.Element) -> tuple[float, float, float]:
     """End pose of one planView geometry, integrated here from its own attributes (independent of the writer)."""
-    x, y, hdg, length = (float(geometry.get(key)) for key in ("x", "y", "hdg", "length"))
+    x, y, hdg, length = (float(geometry.attrib[key]) for key in ("x", "y", "hdg", "length"))
     kind = geometry[0]
     if kind.tag == "line":
         k0 = k1 = 0.0
     elif kind.tag == "arc":
-        k0 = k1 = float(kind.get("curvature"))
+        k0 = k1 = float(kind.attrib["curvature"])
     else:
         assert kind.tag == "spiral"
-        k0, k1 = float(kind.get("curvStart")), float(kind.get("curvEnd"))
+        k0, k1 = float(kind.attrib["curvStart"]), float(kind.attrib["curvEnd"])
     u = np.linspace(0.0, length, 20001)
     heading = hdg + k0 * u + 0.5 * (k1 - k0) / length * u**2
     du = np.diff(u)

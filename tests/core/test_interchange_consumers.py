@@ -49,9 +49,9 @@ def _connecting(root: ET.Element) -> list[ET.Element]:
 
 def _pose(geometry: ET.Element, ds: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """x, y, heading at ``ds`` along one line or arc geometry."""
-    x0, y0, h0 = (float(geometry.get(key)) for key in ("x", "y", "hdg"))
+    x0, y0, h0 = (float(geometry.attrib[key]) for key in ("x", "y", "hdg"))
     shape = geometry[0]
-    k = float(shape.get("curvature")) if shape.tag == "arc" else 0.0
+    k = float(shape.attrib["curvature"]) if shape.tag == "arc" else 0.0
     heading = h0 + k * ds
     if k == 0.0:
         return x0 + ds * math.cos(h0), y0 + ds * math.sin(h0), heading
@@ -61,13 +61,14 @@ def _pose(geometry: ET.Element, ds: np.ndarray) -> tuple[np.ndarray, np.ndarray,
 def _lane_offsets(road: ET.Element) -> dict[int, float]:
     """t of each lane's centre line (constant widths)."""
     section = road.find("lanes/laneSection")
+    assert section is not None
     offsets = {}
     for side, sign in (("left", 1.0), ("right", -1.0)):
-        lanes = sorted(section.findall(f"{side}/lane"), key=lambda lane: abs(int(lane.get("id"))))
+        lanes = sorted(section.findall(f"{side}/lane"), key=lambda lane: abs(int(lane.attrib["id"])))
         edge = 0.0
         for lane in lanes:
-            width = float(lane.find("width").get("a"))
-            offsets[int(lane.get("id"))] = sign * (edge + width / 2)
+            width = float(lane.find("width").attrib["a"])  # type: ignore[union-attr]  # every lane has a width
+            offsets[int(lane.attrib["id"])] = sign * (edge + width / 2)
             edge += width
     return offsets
 

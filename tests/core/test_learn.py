@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -32,7 +33,7 @@ from lanevil_core.labels.lanes import TUSIMPLE_H_SAMPLES, on_tusimple_grid  # no
 from lanevil_core.metrics.tusimple import score_image  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
-TINY_SPEC = {"width": 0.125, "input_size": (128, 72), "anchors": 14, "grid": 32, "hidden": 32}
+TINY_SPEC: dict[str, Any] = {"width": 0.125, "input_size": (128, 72), "anchors": 14, "grid": 32, "hidden": 32}
 
 
 def straight_record(bottoms: tuple[int, ...] = (-300, 350, 930, 1580)) -> dict:

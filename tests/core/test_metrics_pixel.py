@@ -74,7 +74,7 @@ def files(tmp_path):
 def test_the_line_mask_is_the_pixels_near_the_polyline() -> None:
     width = LINE_WIDTH * SIZE[1] / 720
     for record in GT + PRED:
-        mask = lane_mask(record["lanes"], ROWS, SIZE, width)
+        mask = lane_mask(record["lanes"], ROWS, SIZE, width)  # type: ignore[arg-type]
         expected = reference_pixels(record["lanes"], ROWS, SIZE, width)
         assert {(int(c), int(r)) for r, c in zip(*np.nonzero(mask))} == expected
 

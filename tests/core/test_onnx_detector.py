@@ -123,7 +123,7 @@ def constant_model(tmp_path, outputs: dict[str, np.ndarray], sidecar: dict) -> P
     """An ONNX model whose outputs are fixed tensors (the image only touches them times zero), and its sidecar."""
     torch = pytest.importorskip("torch")
 
-    class Constant(torch.nn.Module):
+    class Constant(torch.nn.Module):  # type: ignore[name-defined]
         def __init__(self) -> None:
             super().__init__()
             self.values = torch.nn.ParameterList([torch.nn.Parameter(torch.tensor(v[None], dtype=torch.float32))
@@ -179,7 +179,9 @@ def test_detect_writes_the_mask_model_s_masks_for_the_pixel_metric(mask_model, t
     masks = tmp_path / "masks"
     assert main(["detect", str(split), "--method", f"onnx:{mask_model}", "--out", str(tmp_path / "p.json"),
                  "--masks", str(masks)]) == 0
-    mask = cv2.imread(str(masks / "000000.png"), cv2.IMREAD_GRAYSCALE) > 0
+    written = cv2.imread(str(masks / "000000.png"), cv2.IMREAD_GRAYSCALE)
+    assert written is not None
+    mask = written > 0
     painted = rgb[..., 0] == 255
     seen = painted.copy()
     seen[:45] = False  # the sidecar crops the top quarter

@@ -16,7 +16,7 @@ from lanevil_core.labels import lanes as L
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 from lanevil_core.render.shading import JOINT_SPACING_M, SEALANT_ALBEDO, slab_joints
-from lanevil_core.typed import MATERIALS, SCENE_KINDS
+from lanevil_core.typed import MATERIALS, SCENE_KINDS, SceneKind
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.road_mesh import road_surface
 from lanevil_core.world.scene import ID_ROAD
@@ -25,7 +25,7 @@ GREY = 0.21
 
 
 @pytest.mark.parametrize("kind", SCENE_KINDS)
-def test_concrete_paves_the_carriageway_and_its_flush_shoulder(make_case: Callable[..., Case], kind: str) -> None:
+def test_concrete_paves_the_carriageway_and_its_flush_shoulder(make_case: Callable[..., Case], kind: SceneKind) -> None:
     asphalt = build_network(make_case(scene={"kind": kind}).road, kind)
     concrete = build_network(make_case(scene={"kind": kind}, road={"pavement": "concrete"}).road, kind)
     assert asphalt.main.carriageway == "asphalt" and concrete.main.carriageway == "slab"

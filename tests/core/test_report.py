@@ -12,8 +12,8 @@ import pytest
 
 from lanevil_core.case import load_case
 from lanevil_core.cli import main
-from lanevil_core.export.encode import png_bytes
 from lanevil_core.illusions import REGISTRY
+from lanevil_core.images import png_bytes
 from lanevil_core.labels.lanes import tusimple_record
 from lanevil_core.library.benchmark_layout import CATEGORY_FOLDERS, TYPE_FOLDERS, frame_file
 from lanevil_core.metrics.evaluate import ScoredImage, score_tusimple_files

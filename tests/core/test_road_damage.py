@@ -9,7 +9,7 @@ import pytest
 
 from lanevil_core.case import Case, CaseError, case_json, parse_case
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.illusions.road_damage import MAX_LAYER_TEXELS
+from lanevil_core.illusions.road_damage import MAX_LAYER_TEXELS, GuardRail
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.world.scene import CompiledScene
 
@@ -66,8 +66,8 @@ def test_compiles_deterministically(name: str, level: int) -> None:
     for a, b in zip(first.layers, second.layers):
         assert (a.s0, a.t0, a.texel, a.over_paint) == (b.s0, b.t0, b.texel, b.over_paint)
         assert np.array_equal(a.rgba, b.rgba)
-    for a, b in zip(first.meshes, second.meshes):
-        assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.colors, b.colors)
+    for mesh_a, mesh_b in zip(first.meshes, second.meshes):
+        assert np.array_equal(mesh_a.vertices, mesh_b.vertices) and np.array_equal(mesh_a.colors, mesh_b.colors)
     assert np.array_equal(first.env.sun_dir_world, second.env.sun_dir_world)
     other = compiled({**spec, "seed": 1})
     if name in SURFACE_TYPES:
@@ -182,7 +182,7 @@ def test_guard_rail_sun_throws_its_shadow_across_the_lanes() -> None:
     sun = scene.env.sun_dir_world
     assert sun[1] < 0  # on the right of a road heading +X, so the shadow falls towards +t (onto the road)
     reach = 0.75 * (-sun[1]) / np.hypot(sun[0], sun[1]) / np.tan(np.arcsin(sun[2]))
-    assert reach == pytest.approx(REGISTRY["guard_rail"].SEVERITY[2].shadow_m, rel=0.05)
+    assert reach == pytest.approx(GuardRail.SEVERITY[2].shadow_m, rel=0.05)
 
 
 def test_guard_rail_fields_override_the_table() -> None:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Case
-from lanevil_core.typed import SCENE_KINDS
+from lanevil_core.typed import SCENE_KINDS, SceneKind
 from lanevil_core.world.road_layout import RoadNetwork, RoadPiece, build_network
 from lanevil_core.world.scene import Mesh
 from lanevil_core.world.scenery import corridor_half_width, roadside_meshes
@@ -38,9 +38,9 @@ def intrusions(network: RoadNetwork, meshes: list[Mesh], reach: Callable[[RoadPi
     inside its length, lower than the overhead clearance."""
     if not meshes:
         return set()
-    probes = [np.concatenate([m.vertices, m.vertices[m.faces].mean(1)]) for m in meshes]
-    owner = np.concatenate([np.full(len(p), i) for i, p in enumerate(probes)])
-    probes = np.concatenate(probes)
+    per_mesh = [np.concatenate([m.vertices, m.vertices[m.faces].mean(1)]) for m in meshes]
+    owner = np.concatenate([np.full(len(p), i) for i, p in enumerate(per_mesh)])
+    probes = np.concatenate(per_mesh)
     bad: set[str] = set()
     for piece in network.pieces:
         s, t, h = road_frame(piece, probes)
@@ -49,7 +49,8 @@ def intrusions(network: RoadNetwork, meshes: list[Mesh], reach: Callable[[RoadPi
     return bad
 
 
-def scenery(kind: str, road: str = "straight", density: float = 1.0, seed: int = 0) -> tuple[RoadNetwork, list[Mesh]]:
+def scenery(kind: SceneKind, road: str = "straight", density: float = 1.0,
+            seed: int = 0) -> tuple[RoadNetwork, list[Mesh]]:
     case = Case.model_validate({"scene": {"kind": kind, "density": density}, "road": {"type": road}})
     network = build_network(case.road, kind)
     return network, roadside_meshes(case, network, np.random.default_rng(seed))
@@ -57,7 +58,7 @@ def scenery(kind: str, road: str = "straight", density: float = 1.0, seed: int =
 
 @pytest.mark.parametrize("road", ["straight", "bend", "crossroad"])
 @pytest.mark.parametrize("kind", SCENE_KINDS)
-def test_nothing_stands_on_the_road(kind: str, road: str) -> None:
+def test_nothing_stands_on_the_road(kind: SceneKind, road: str) -> None:
     network, meshes = scenery(kind, road)
     assert meshes
     # Every prop clears the carriageway of every piece (main road and junction arms) ...
@@ -68,7 +69,7 @@ def test_nothing_stands_on_the_road(kind: str, road: str) -> None:
 
 
 @pytest.mark.parametrize("kind", SCENE_KINDS)
-def test_triangle_budget(kind: str) -> None:
+def test_triangle_budget(kind: SceneKind) -> None:
     for density in (1.0, 3.0):
         _, meshes = scenery(kind, "crossroad", density)
         faces = sum(len(mesh.faces) for mesh in meshes)
@@ -88,7 +89,7 @@ def test_scenery_is_deterministic_and_seeded() -> None:
 
 
 @pytest.mark.parametrize("kind", ["urban", "suburban", "rural"])
-def test_density_scales_the_props(kind: str) -> None:
+def test_density_scales_the_props(kind: SceneKind) -> None:
     faces = [sum(len(m.faces) for m in scenery(kind, density=d)[1]) for d in (0.0, 1.0, 3.0)]
     assert faces[0] < faces[1] < faces[2] and faces[0] < faces[2] / 2
 

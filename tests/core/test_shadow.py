@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 import pytest
 from pydantic import ValidationError
 
 from lanevil_core.case import Case, case_json, parse_case
 from lanevil_core.illusions import REGISTRY
-from lanevil_core.illusions.shadow import MIN_FENCE_SUN_DEG
+from lanevil_core.illusions.shadow import MIN_FENCE_SUN_DEG, FenceShadow
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.world.road_geometry import ReferenceLine
 from lanevil_core.world.scene import CompiledScene
@@ -59,7 +62,7 @@ def shadow_points(scene: CompiledScene, upright: bool = False) -> np.ndarray:
 
 @pytest.mark.parametrize("name", SHADOW_TYPES)
 def test_severity_tables_are_monotone(name: str) -> None:
-    table = REGISTRY[name].SEVERITY
+    table: Sequence[Any] = REGISTRY[name].SEVERITY  # each family its own row type
     assert REGISTRY[name].CATEGORY == "shadow"
     assert all(type(row) is type(table[0]) for row in table)
     altitude = [row.sun_altitude for row in table]
@@ -84,10 +87,11 @@ def test_every_level_compiles_deterministically(name: str, severity: int) -> Non
         assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
         assert np.array_equal(a.colors, b.colors) and a.name == b.name
     assert np.array_equal(first.env.sun_dir_world, again.env.sun_dir_world)
-    assert first.env.sun_intensity == REGISTRY[name].SEVERITY[severity - 1].sun_intensity
-    assert first.env.penumbra == REGISTRY[name].SEVERITY[severity - 1].penumbra
+    level: Any = REGISTRY[name].SEVERITY[severity - 1]
+    assert first.env.sun_intensity == level.sun_intensity
+    assert first.env.penumbra == level.penumbra
     altitude = np.degrees(np.arcsin(first.env.sun_dir_world[2]))
-    table_altitude = REGISTRY[name].SEVERITY[severity - 1].sun_altitude
+    table_altitude = level.sun_altitude
     if name == "fence_shadow":  # solved from the road, no higher than the table's
         assert MIN_FENCE_SUN_DEG - 1e-9 <= altitude <= table_altitude + 1e-9
     else:
@@ -100,7 +104,8 @@ def test_json_round_trip(name: str) -> None:
                             "sun_altitude": 33.0, "sun_intensity": 1.2}])
     back = parse_case(case_json(case))
     assert back == case
-    assert back.illusions[0].type == name and back.illusions[0].sun_altitude == 33.0
+    illusion: Any = back.illusions[0]
+    assert illusion.type == name and illusion.sun_altitude == 33.0
     assert parse_case({"illusions": [{"type": name}]}).illusions[0].severity == 3
 
 
@@ -240,6 +245,6 @@ def test_board_fence_lets_lines_of_light_through_parallel_to_the_road() -> None:
     fence_vertices = own_vertices(scene)
     # the boards' heights: every gap between two boards is a line of light at t = t_fence + z / tan(altitude)
     z = np.unique(np.round(fence_vertices[:, 2], 3))
-    gap = REGISTRY["fence_shadow"].SEVERITY[4].gap
+    gap = FenceShadow.SEVERITY[4].gap
     edges = np.diff(z)
     assert np.sum(np.isclose(edges, gap, atol=2e-3)) >= 2  # at least two gaps of the table's size

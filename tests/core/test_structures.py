@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 import pytest
 import trimesh
@@ -70,6 +72,7 @@ def test_streetlight_local_frame() -> None:
 
 def test_streetlight_lamp_offset_sits_under_the_glowing_glass() -> None:
     mesh = streetlight(height=8.0, arm=1.5, emissive=True)
+    assert mesh.emission is not None
     glowing = mesh.emission.sum(1) > 0
     assert 0 < glowing.sum() < len(mesh.faces)
     glass = mesh.vertices[np.unique(mesh.faces[glowing])]
@@ -116,7 +119,7 @@ def test_overhead_rail_keeps_the_span_clear(bend: ReferenceLine) -> None:
 
 
 @pytest.mark.parametrize("slots_along", ["s", "t"])
-def test_overhead_rail_lets_light_through_its_slots(slots_along: str) -> None:
+def test_overhead_rail_lets_light_through_its_slots(slots_along: Literal["s", "t"]) -> None:
     line = build_network(Road(), "suburban").main.line  # straight along +X: road frame = world frame
     mesh = overhead_rail(line, 80.0, span=20.0, deck_width_along_s=16.0, slot_width=0.3, slot_pitch=1.0,
                          slots_along=slots_along)

@@ -4,7 +4,9 @@ path, JSON round trips and user obstacle models."""
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -15,7 +17,7 @@ from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, case_meshes_dir, parse_case
 from lanevil_core.illusions import REGISTRY, CompileContext, MeshFileError
 from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
-from lanevil_core.pipeline.compile import ego_drive
+from lanevil_core.pipeline.compile import ego_drive, load_user_meshes
 from lanevil_core.world.environment import environment_for
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
@@ -28,7 +30,7 @@ def compiled(spec: dict, meshes_dir: Path | None = None, **case: object) -> tupl
     model = Case.model_validate({"illusions": [spec], **case})
     network = build_network(model.road, model.scene.kind)
     ctx = CompileContext(seed=model.seed, drive=ego_drive(model), network=network, env=environment_for(model),
-                         source=0, meshes_dir=meshes_dir)
+                         source=0, user_meshes=load_user_meshes(model, meshes_dir))
     model.illusions[0].compile(ctx)
     return model, ctx
 
@@ -83,7 +85,7 @@ def road_st(ctx: CompileContext, p_world: np.ndarray) -> tuple[np.ndarray, np.nd
 def test_traffic_types_are_registered() -> None:
     for name in TRAFFIC:
         assert REGISTRY[name].CATEGORY == "traffic"
-        rows = REGISTRY[name].SEVERITY
+        rows: Sequence[Any] = REGISTRY[name].SEVERITY  # each family its own row type
         assert len(rows) == 5 and all(type(row) is type(rows[0]) for row in rows)
         counts = [row.count for row in rows]
         distances = [row.distance for row in rows]
@@ -207,7 +209,7 @@ def test_load_obstacle_glb_converts_axes_and_colours(tmp_path: Path) -> None:
     np.testing.assert_allclose(size, (4.0, 2.0, 2.0), atol=1e-5)  # glTF +Z forward -> +X, +Y up -> +Z
     assert mesh.vertices[:, 2].min() == pytest.approx(0.0)
     np.testing.assert_allclose(mesh.vertices.min(0)[:2] + mesh.vertices.max(0)[:2], 0.0, atol=1e-6)
-    red, green = srgb_to_linear([200, 30, 30]), srgb_to_linear([20, 200, 30])
+    red, green = srgb_to_linear(np.array([200.0, 30, 30])), srgb_to_linear(np.array([20.0, 200, 30]))
     assert np.any(np.all(np.isclose(mesh.colors, red, atol=1e-3), axis=1))
     assert np.any(np.all(np.isclose(mesh.colors, green, atol=1e-3), axis=1))
     assert load_obstacle(path, up="z").vertices[:, 2].max() == pytest.approx(4.0)

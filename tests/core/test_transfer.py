@@ -91,7 +91,7 @@ def test_randomised_training_records_its_ingredients(tiny_dataset, tmp_path):  #
     assert summary["randomise"] is True and summary["photometric"] is True
 
 
-def _torchvision_state(depth: str) -> dict[str, torch.Tensor]:
+def _torchvision_state(depth: str) -> dict:
     """A state dict in torchvision's ResNet layout: the backbone's names, random values, and its classifier."""
     generator = torch.Generator().manual_seed(0)
     state = {name: torch.randn(tensor.shape, generator=generator) if tensor.is_floating_point() else tensor

@@ -42,8 +42,8 @@ def page(client) -> PageParser:
 
 def static_references(parser: PageParser) -> set[str]:
     """``/static/...`` URLs of the page, of the ES modules it imports (transitively) and of its stylesheets."""
-    found = {a[key] for _, a in parser.tags for key in ("src", "href")
-             if (a.get(key) or "").startswith("/static/")}
+    found = {url for _, a in parser.tags for key in ("src", "href")
+             if (url := a.get(key) or "").startswith("/static/")}
     pending = list(found)
     while pending:
         url = pending.pop()

@@ -10,6 +10,7 @@ import threading
 import time
 import zipfile
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import pytest
@@ -21,6 +22,7 @@ from app.editor.preview import PreviewRequest, PreviewResult, PreviewWorker
 from app.editor.session import CaseSession
 from app.frames import FrameService
 from app.state import AppState
+from app.store import CaseRecord
 from lanevil_core.case import parse_case
 from lanevil_core.detect import catalog as detector_catalog
 from lanevil_core.detect.split import METHODS
@@ -159,8 +161,12 @@ def test_a_save_is_never_reported_as_a_version_stored_elsewhere(tab: EditorTab, 
 def test_a_session_takes_its_new_version_before_store_listeners_hear_of_it(state: AppState) -> None:
     session = CaseSession(state.store.get(SHADOW))
     heard: list[tuple[int, bool, int | None]] = []
-    state.store.subscribe(lambda kind, case_id, record: heard.append(
-        (session.version, session.stored_change(record), session.remote_version)))
+
+    def hear(kind: str, case_id: str, record: CaseRecord | None) -> None:
+        assert record is not None  # a save
+        heard.append((session.version, session.stored_change(record), session.remote_version))
+
+    state.store.subscribe(hear)
     edited = session.case.model_copy(update={"title": "edited"})
     session.apply(edited, "title")
     assert session.save(state.store).version == 2
@@ -211,7 +217,8 @@ def test_pavement_dropdown_paves_the_road_with_concrete_and_undo_takes_it_back(t
 def test_sun_sliders_override_a_shadow_illusions_own_sun(tab: EditorTab) -> None:
     open_shadow(tab)
     tab.panel.sun_altitude.value = 20.0
-    assert tab.case.illusions[0].sun_altitude == 20.0
+    shadow: Any = tab.case.illusions[0]
+    assert shadow.sun_altitude == 20.0
 
 
 def test_frame_slider_and_overlay_toggle(tab: EditorTab) -> None:
@@ -280,13 +287,15 @@ def test_gizmo_move_and_parameter_inputs(tab: EditorTab) -> None:
     settle(tab)
     line = tab.view.network.main.line
     tab.move_selected(line.to_world(70.0, 11.0, 0.3))  # where a drag of the handle ends
-    fence = tab.case.illusions[0]
+    fence: Any = tab.case.illusions[0]
     assert fence.s == pytest.approx(70.0, abs=0.01) and fence.side == "left"
     assert fence.offset == pytest.approx(11.0 - roadside_t(tab.view.network.main, 0.0, 1.0), abs=0.01)
     tab.panel.params.handles["offset"].value = 2.0
-    assert tab.case.illusions[0].offset == 2.0
+    fence = tab.case.illusions[0]
+    assert fence.offset == 2.0
     tab.panel.params.handles["length"].value = "abc"  # not a number: reported with the field name
-    assert "length" in tab.message and tab.case.illusions[0].length is None
+    fence = tab.case.illusions[0]
+    assert "length" in tab.message and fence.length is None
     tab.panel.delete.value = True
     assert tab.case.illusions == [] and tab.selected is None and tab.panel.delete.disabled
 
@@ -349,8 +358,8 @@ def test_partial_recompile_equals_a_full_compile(illusion: dict) -> None:
     for a, b in zip(partial.meshes, full.meshes):
         np.testing.assert_array_equal(a.vertices, b.vertices)
         np.testing.assert_array_equal(a.colors, b.colors)
-    for a, b in zip(partial.layers, full.layers):
-        np.testing.assert_array_equal(a.rgba, b.rgba)
+    for layer_a, layer_b in zip(partial.layers, full.layers):
+        np.testing.assert_array_equal(layer_a.rgba, layer_b.rgba)
     np.testing.assert_allclose(partial.env.sun_dir_world, full.env.sun_dir_world)
     assert partial.env.sun_intensity == full.env.sun_intensity and len(partial.lights) == len(full.lights)
 
@@ -415,7 +424,8 @@ def test_upload_mesh_stores_the_model_and_sets_the_vehicles_mesh_file(tab: Edito
     glb = trimesh.Scene(trimesh.creation.box((4.0, 2.0, 1.5))).export(file_type="glb")
     assert tab.upload_mesh("../My Van.glb", glb) == "My_Van.glb"
     settle(tab)
-    assert tab.case.illusions[0].mesh_file == "My_Van.glb"
+    obstacle: Any = tab.case.illusions[0]
+    assert obstacle.mesh_file == "My_Van.glb"
     assert (state.meshes_dir / "My_Van.glb").read_bytes() == glb
     assert "⚠" not in tab.panel.status.content
     with pytest.raises(EditError, match="mesh not stored"):

@@ -6,11 +6,16 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
 from app.editor import Editor, launch_editor
+from app.editor.preview import PreviewResult
 from app.state import AppState
+
+if TYPE_CHECKING:
+    from playwright.sync_api import Dialog
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -67,7 +72,7 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, edit
     time.sleep(3)
     page.screenshot(path=str(screenshot_dir / "editor_2_placed.png"), timeout=SHOT_MS)
     before = preview.screenshot(timeout=SHOT_MS)
-    placed = tab.case.illusions[-1]
+    placed: Any = tab.case.illusions[-1]  # an illusion placed on the road: it has an s
     assert tab.selected == len(tab.case.illusions) - 1 and 10.0 < placed.s < 80.0
 
     drag_thumb(page, page.locator("[role=slider][aria-valuemax='5']"), 300)  # to the right end
@@ -97,7 +102,7 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     seen = [before]
     for current, name in (("none", "hough"), ("hough", "ufld")):
         pick(page, current, name)
-        wait_for(lambda name=name: tab.panel.detector.value == name, f"the Detector dropdown at {name}")
+        wait_for(lambda name=name: bool(tab.panel.detector.value == name), f"the Detector dropdown at {name}")
         assert tab.preview.wait_idle(WAIT_S)
         score = page.get_by_text(f"{name} (magenta):").first
         score.wait_for(timeout=WAIT_S * 1000)
@@ -144,7 +149,12 @@ def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, editor
         update={"title": INJECTION, "description": INJECTION}), case_id="injected")
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     dialogs: list[str] = []
-    page.on("dialog", lambda dialog: (dialogs.append(dialog.message), dialog.dismiss()))
+
+    def dismiss(dialog: Dialog) -> None:
+        dialogs.append(dialog.message)
+        dialog.dismiss()
+
+    page.on("dialog", dismiss)
     page.goto(editor_url)
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
     tab = editor.tab(timeout=WAIT_S)
@@ -185,7 +195,12 @@ def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Edi
     assert tab.preview.wait_idle(WAIT_S) and tab.panel.quality.value == "draft"
     shown: list[bool] = []  # whether each pushed preview was a draft
     publish = tab.preview._publish
-    tab.preview._publish = lambda result: (shown.append(result.request.draft), publish(result))
+
+    def publish_and_note(result: PreviewResult) -> None:
+        shown.append(result.request.draft)
+        publish(result)
+
+    tab.preview._publish = publish_and_note
     altitude = page.locator("[role=slider][aria-valuemax='90']")  # Sun altitude, -10 to 90 degrees
     drag_thumb(page, altitude, -120)
     wait_for(lambda: tab.case.sun.altitude != 45.0, "the sun to move")

@@ -44,6 +44,7 @@ def test_the_drive_plot_is_titled_after_the_edited_case(tab: EditorTab) -> None:
     tab.drive.seconds.value = 1.0
     job = tab.drive.start()
     assert job is not None and job.finished.wait(WAIT_S) and job.status == "done", job.error
+    assert job.result is not None
     summary = json.loads((job.result / SUMMARY_FILE).read_text())
     assert summary["title"] == "Edited, not saved"  # what the deviation plot's title starts with
     _wait_for_playback(tab)

@@ -39,9 +39,9 @@ def test_foreign_origins_are_refused_and_own_ones_taken(bare_editor: Editor) -> 
     for origin in ("http://evil.example", f"http://evil.example:{port}", "null", "http://127.0.0.1:1",
                    f"file://127.0.0.1:{port}"):
         assert handshake_status(port, origin) == 403, origin
-    for origin in (f"http://127.0.0.1:{port}", f"http://localhost:{port}", "http://localhost:8123",
-                   f"http://[::1]:{port}", None):
-        assert handshake_status(port, origin) == 101, origin
+    for own in (f"http://127.0.0.1:{port}", f"http://localhost:{port}", "http://localhost:8123",
+                f"http://[::1]:{port}", None):
+        assert handshake_status(port, own) == 101, own
 
 
 def test_the_page_itself_is_still_served(bare_editor: Editor) -> None:
@@ -51,7 +51,7 @@ def test_the_page_itself_is_still_served(bare_editor: Editor) -> None:
 
 
 def test_allowed_origins_setting_and_listening_everywhere() -> None:
-    settings = Settings(allowed_origins="http://studio.example:8080, https://other.example")  # type: ignore[arg-type]
+    settings = Settings(allowed_origins="http://studio.example:8080, https://other.example")
     assert settings.allowed_origins == ["http://studio.example:8080", "https://other.example"]
     check = OriginCheck("127.0.0.1", lambda: {8080}, settings.allowed_origins)
     assert check.allows("http://studio.example:8080") and not check.allows("http://studio.example:9000")

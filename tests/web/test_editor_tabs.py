@@ -116,5 +116,6 @@ def test_each_tab_drives_its_own_edited_case(editor_server: Editor, state: AppSt
         titles = []
         for job in jobs:
             assert job is not None and job.finished.wait(WAIT_S) and job.status == "done", job.error
+            assert job.result is not None
             titles.append(json.loads((job.result / SUMMARY_FILE).read_text())["title"])
         assert titles == ["Edited in the first tab", state.store.get(SHADOW).case.title]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from pydantic import ValidationError
@@ -21,11 +22,12 @@ SCENES = Path(__file__).resolve().parents[2] / "scenes"
 def test_sun_override_moves_a_shadow_illusions_own_sun() -> None:
     case = load_case(SCENES / "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json")
     moved = apply_overrides(case, severity=5, sun_azimuth=120.0, sun_altitude=0.0)
-    illusion = moved.illusions[0]
+    illusion: Any = moved.illusions[0]  # a fence shadow
     assert illusion.severity == 5 and illusion.sun_azimuth == 120.0
     assert illusion.sun_altitude == REGISTRY["fence_shadow"].model_fields["sun_altitude"].metadata[0].ge
     assert moved.sun.azimuth == 120.0 and moved.sun.altitude == 0.0
-    assert case.illusions[0].sun_azimuth is None  # the stored case is untouched
+    stored: Any = case.illusions[0]
+    assert stored.sun_azimuth is None  # the stored case is untouched
 
 
 def test_sun_override_leaves_illusions_without_sun_fields_alone() -> None:

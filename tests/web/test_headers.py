@@ -19,7 +19,8 @@ def test_every_response_carries_the_security_headers(client, method: str, path: 
         assert headers[name] == SECURITY_HEADERS[name], name
     policy = headers["Content-Security-Policy"]
     assert "default-src 'self'" in policy and "frame-ancestors 'none'" in policy
-    assert "unsafe-inline" not in re.search(r"script-src ([^;]*)", policy).group(1)
+    script_src = re.search(r"script-src ([^;]*)", policy)
+    assert script_src is not None and "unsafe-inline" not in script_src.group(1)
 
 
 def test_a_413_carries_them_too(client) -> None:
@@ -31,7 +32,9 @@ def test_a_413_carries_them_too(client) -> None:
 @pytest.mark.parametrize("path", ["/docs", "/redoc", "/docs/oauth2-redirect"])
 def test_docs_pages_allow_exactly_their_inline_scripts(client, path: str) -> None:
     response = client.get(path)
-    script_src = re.search(r"script-src ([^;]*)", response.headers["Content-Security-Policy"]).group(1)
+    found = re.search(r"script-src ([^;]*)", response.headers["Content-Security-Policy"])
+    assert found is not None
+    script_src = found.group(1)
     inline = re.findall(r"<script>", response.text)
     assert "unsafe-inline" not in script_src
     assert script_src.count("'sha256-") == len(inline)

@@ -59,7 +59,7 @@ def test_an_identical_job_is_shared_and_failed_ones_are_not(tmp_path: Path) -> N
         release.set()
         assert first.finished.wait(10) and first.status == "done"
         assert manager.submit("export", 3, _blocked(release), key="same", client="a") is first  # finished: reused
-        failing = manager.submit("export", 1, lambda job, progress: 1 / 0, key="broken")
+        failing = manager.submit("export", 1, lambda job, progress: Path(str(1 / 0)), key="broken")
         assert failing.finished.wait(10) and failing.status == "failed"
         assert manager.submit("export", 1, _blocked(release), key="broken") is not failing
     finally:

@@ -10,7 +10,7 @@ import pytest
 
 from app.store import CaseExists, CaseNotFound, CaseStore, InvalidId, VersionConflict, check_id, slugify, stock_id
 from lanevil_core.case import Case
-from lanevil_core.illusions import REGISTRY
+from lanevil_core.illusions.shadow import FenceShadow
 
 
 @pytest.fixture
@@ -19,7 +19,7 @@ def store(tmp_path: Path) -> CaseStore:
 
 
 def shadow_case(severity: int = 2) -> Case:
-    return Case(title="Fence shadow", illusions=[REGISTRY["fence_shadow"](severity=severity)])
+    return Case(title="Fence shadow", illusions=[FenceShadow(severity=severity)])
 
 
 def test_create_writes_an_envelope_and_no_temp_files(store: CaseStore) -> None:
