@@ -9,10 +9,12 @@ whose process is gone. Files of a process that still runs are never touched, so 
 from __future__ import annotations
 
 import errno
+import json
 import os
 import re
 import tempfile
 from pathlib import Path
+from typing import Any
 
 TEMP_SUFFIX = ".tmp"
 # .<target name>.<pid>.<mkstemp's random part>.tmp
@@ -98,3 +100,13 @@ def remove_stale_temps(folder: Path, recursive: bool = False) -> list[Path]:
                 path.unlink(missing_ok=True)
                 removed.append(path)
     return removed
+
+
+def read_json(path: Path, where: str, error: type[Exception] = ValueError) -> Any:
+    """The JSON value of the file ``path``; ``error`` says in one line, after ``where``, why it cannot be read."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except OSError as failure:
+        raise error(f"{where}: cannot read it ({failure.strerror})") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as failure:
+        raise error(f"{where}: not JSON ({failure})") from None

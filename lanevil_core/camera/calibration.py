@@ -39,6 +39,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ..case import Camera
+from ..files import read_json
 from .lens import undistort
 
 SQUARE_TOLERANCE = 0.01
@@ -180,12 +181,7 @@ def labelled_vanishing_point(labels: Path) -> tuple[float, float]:
 def load_camera(path: str | Path) -> Camera:
     """The case camera described by the calibration file ``path``; raises ``CalibrationError``."""
     path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise CalibrationError(f"--camera {path}: cannot read it ({error.strerror})") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise CalibrationError(f"--camera {path}: not JSON ({error})") from None
+    data = read_json(path, f"--camera {path}", CalibrationError)
     try:
         calibration = Calibration.model_validate(data)
         if calibration.lane_labels is not None:

@@ -22,7 +22,6 @@ or ``-``; a built-in method's name, ``gt`` and ``none`` are taken.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import threading
@@ -30,6 +29,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, Literal
 
+from ..files import read_json
 from ..metrics.formats import LaneFileError
 from .split import METHODS, Detector, builtin_detector
 
@@ -93,12 +93,7 @@ def source_spec(source: str, name: str | None = None, where: str = "--method", *
 
 def _file_specs(path: Path) -> list[PluginSpec]:
     where = f"{ENV_DETECTORS_FILE} {path}"
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise LaneFileError(f"{where}: cannot read it ({error.strerror})") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise LaneFileError(f"{where}: not JSON ({error})") from None
+    data = read_json(path, where, LaneFileError)
     entries = data.get("detectors") if isinstance(data, dict) else None
     if not isinstance(entries, dict):
         raise LaneFileError(f"{where}: expected {{\"detectors\": {{NAME: {{\"source\": ...}}, ...}}}}")
