@@ -93,21 +93,9 @@ def _run_train(args: argparse.Namespace) -> int:
         raise UsageError(f"--init {args.init}: no such file")
     if args.backbone_weights is not None and not args.backbone_weights.is_file():
         raise UsageError(f"--backbone-weights {args.backbone_weights}: no such file")
-    if args.backbone_weights is not None and args.width != 1.0:
-        raise UsageError(f"--backbone-weights: ImageNet ResNet weights need --width 1.0 (not {args.width})")
-    if args.time_limit is not None and args.time_limit <= 0:
-        raise UsageError(f"--time-limit {args.time_limit:g}: must be positive")
     for data in args.val_data:
         if not data.is_dir():
             raise UsageError(f"--val-data {data}: no such folder")
-    if args.aam_keep_paint and args.augment != "aam":
-        raise UsageError(f"--aam-keep-paint: only with --augment aam (not {args.augment})")
-    if args.min_epochs and args.patience is None:
-        raise UsageError("--min-epochs: only with --patience")
-    if args.min_epochs > args.epochs:
-        raise UsageError(f"--min-epochs {args.min_epochs}: more than --epochs {args.epochs}")
-    if not 0.0 <= args.val_fraction < 1.0:
-        raise UsageError(f"--val {args.val_fraction}: must lie in [0, 1)")
     try:
         spec = ModelSpec(family=args.model, backbone=args.backbone, width=args.width, input_size=args.size)
         settings = TrainSettings(data=tuple(args.data), out=args.out, spec=spec, epochs=args.epochs, batch=args.batch,

@@ -47,6 +47,7 @@ from .models import Deployed, LaneNet, build_model
 from .pgd import PgdSettings, pgd_batch
 
 CHECKPOINT_FILE = "checkpoint.pt"
+AUGMENT_NAMES = (*AUGMENTS, "aam", "pgd")
 AAM_BANK_FILE = "aam_bank.pt"
 WARMUP_STEPS = 100
 
@@ -88,6 +89,23 @@ class TrainSettings:
     val_data: tuple[Path, ...] = ()
     loader_workers: int = 0  # DataLoader processes (a GPU waits on one process's augmentation)
     time_limit: float | None = None  # seconds of training after which no new epoch starts (--time-limit)
+
+    def __post_init__(self) -> None:
+        """The rules between settings, each broken one named as the command line names it (``TrainError``)."""
+        if self.augment not in AUGMENT_NAMES:
+            raise TrainError(f"--augment {self.augment}: choose from {', '.join(AUGMENT_NAMES)}")
+        if self.aam.keep_paint and self.augment != "aam":
+            raise TrainError(f"--aam-keep-paint: only with --augment aam (not {self.augment})")
+        if self.min_epochs and self.patience is None:
+            raise TrainError("--min-epochs: only with --patience")
+        if self.min_epochs > self.epochs:
+            raise TrainError(f"--min-epochs {self.min_epochs}: more than --epochs {self.epochs}")
+        if not 0.0 <= self.val_fraction < 1.0:
+            raise TrainError(f"--val {self.val_fraction}: must lie in [0, 1)")
+        if self.backbone_weights is not None and self.spec.width != 1.0:
+            raise TrainError(f"--backbone-weights: ImageNet ResNet weights need --width 1.0 (not {self.spec.width})")
+        if self.time_limit is not None and self.time_limit <= 0:
+            raise TrainError(f"--time-limit {self.time_limit:g}: must be positive")
 
 
 def pick_device(name: str) -> torch.device:
@@ -210,14 +228,31 @@ def _validation_set(settings: TrainSettings, frames: list[tuple[Path, dict[str, 
     return LabelledFrames(frames, settings.spec, val_idx, train=False) if val_idx else None
 
 
-def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]:
-    """Train, export and describe a model in ``settings.out``; returns the ``training.json`` content."""
-    from tqdm import tqdm
+@dataclass
+class _TrainData:
+    """What one run reads: the train frames and their identity, the training and validation sets."""
 
-    torch.manual_seed(settings.seed)
-    torch.set_num_threads(settings.threads or os.cpu_count() or 1)
-    device = pick_device(settings.device)
-    spec = settings.spec
+    frames: list[tuple[Path, dict[str, Any]]]
+    sha256: str
+    train_set: LabelledFrames
+    val_set: LabelledFrames | None
+
+
+@dataclass
+class _Run:
+    """The state of a run between epochs (what ``checkpoint.pt`` holds)."""
+
+    model: LaneNet
+    optimizer: torch.optim.Optimizer
+    steps_per_epoch: int
+    total_steps: int
+    history: list[dict[str, Any]] = field(default_factory=list)
+    start_epoch: int = 0
+    best: dict[str, Any] | None = None  # {"epoch", "model"} of the best validation accuracy (with --patience)
+
+
+def _read_data(settings: TrainSettings) -> _TrainData:
+    """The train splits, read once, split into training and validation frames (case folders held out whole)."""
     try:
         frames, data_sha = read_splits(settings.data)
     except ValueError as error:
@@ -226,16 +261,19 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
     groups = [f"{split_dir}:{Path(record['raw_file']).parent}" for split_dir, record in frames]
     val_fraction = 0.0 if settings.val_data else settings.val_fraction
     train_idx, val_idx = split_indices(len(frames), groups, val_fraction, settings.seed)
-    augment = AUGMENTS.get(settings.augment)
-    train_set = LabelledFrames(frames, spec, train_idx, train=True, augment=augment, seed=settings.seed,
-                               affine=settings.affine, randomised=settings.randomise,
+    train_set = LabelledFrames(frames, settings.spec, train_idx, train=True, augment=AUGMENTS.get(settings.augment),
+                               seed=settings.seed, affine=settings.affine, randomised=settings.randomise,
                                photometric=settings.photometric)
     val_set = _validation_set(settings, frames, val_idx)
     if settings.patience is not None and val_set is None:
         raise TrainError("--patience: no validation frames to watch (--val is 0 or the split has one case folder)")
+    return _TrainData(frames, data_sha, train_set, val_set)
 
-    out = settings.out
-    out.mkdir(parents=True, exist_ok=True)
+
+def _start(settings: TrainSettings, train_frames: int, data_sha: str, device: torch.device) -> _Run:
+    """The network (ImageNet backbone, ``--init`` tensors), its optimiser and schedule, resumed from the checkpoint
+    where asked."""
+    spec = settings.spec
     model = build_model(spec)
     if settings.backbone_weights is not None:
         try:
@@ -248,14 +286,11 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         if copied == 0:
             raise TrainError(f"--init {settings.init}: no tensor matches the {spec.family} network")
     optimizer = torch.optim.AdamW(model.parameters(), lr=settings.lr, weight_decay=settings.weight_decay)
-    steps_per_epoch = math.ceil(len(train_set) / settings.batch)
+    steps_per_epoch = math.ceil(train_frames / settings.batch)
     if settings.max_steps is not None:
         steps_per_epoch = min(steps_per_epoch, settings.max_steps)
-    total_steps = steps_per_epoch * settings.epochs
-    history: list[dict[str, Any]] = []
-    start_epoch = 0
-    best: dict[str, Any] | None = None  # {"epoch", "model"} of the best validation accuracy (with --patience)
-    checkpoint_path = out / CHECKPOINT_FILE
+    run = _Run(model, optimizer, steps_per_epoch, steps_per_epoch * settings.epochs)
+    checkpoint_path = settings.out / CHECKPOINT_FILE
     if settings.resume and checkpoint_path.is_file():
         checkpoint = torch.load(checkpoint_path, map_location=device, weights_only=False)
         if checkpoint["data_sha256"] != data_sha or checkpoint["spec"] != asdict(spec):
@@ -263,85 +298,133 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
                              "use a new --out folder")
         model.load_state_dict(checkpoint["model"])
         optimizer.load_state_dict(checkpoint["optimizer"])
-        history = checkpoint["history"]
-        start_epoch = checkpoint["epoch"] + 1
-        best = checkpoint.get("best")
-    write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
+        run.history = checkpoint["history"]
+        run.start_epoch = checkpoint["epoch"] + 1
+        run.best = checkpoint.get("best")
+    return run
 
-    bank = aam_bank(settings, frames, data_sha) if settings.augment == "aam" else []
+
+def _hard_examples(run: _Run, bank: list, settings: TrainSettings, device: torch.device) -> list:
+    """AAM's hard examples for the next epoch: the bank scored by the model as it is now."""
+    scores = predict_on(run.model, np.stack([p.image for p in bank]), [p.record for p in bank],
+                        [p.frame_size for p in bank], device)
+    for patch, (pred, gt, rows) in zip(bank, scores, strict=True):
+        patch.accuracy = score_image(pred, gt, rows, 0.0).accuracy
+    update_attention_areas(run.model, bank, settings.aam)
+    return hard_patches(bank, settings.aam.hard_share)
+
+
+def _train_epoch(run: _Run, train_set: LabelledFrames, hard: list, settings: TrainSettings, epoch: int,
+                 device: torch.device, show_progress: bool) -> list[float]:
+    """One epoch of optimiser steps; the batches' losses."""
+    from tqdm import tqdm
+
+    model, spec = run.model, settings.spec
+    train_set.epoch = epoch
+    generator = torch.Generator().manual_seed(settings.seed * 1000 + epoch)
+    loader = DataLoader(train_set, batch_size=settings.batch, shuffle=True, generator=generator, drop_last=True,
+                        num_workers=settings.loader_workers, persistent_workers=False)
+    bar = tqdm(total=run.steps_per_epoch, desc=f"epoch {epoch + 1}/{settings.epochs}", disable=not show_progress,
+               unit="batch", dynamic_ncols=True)
+    losses: list[float] = []
+    for step, batch in enumerate(loader):
+        if step >= run.steps_per_epoch:
+            break
+        for group in run.optimizer.param_groups:
+            group["lr"] = _lr_at(epoch * run.steps_per_epoch + step, run.total_steps, settings.lr)
+        if hard:
+            batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step, batch["mask"])
+        if settings.augment == "pgd":
+            batch["image"] = pgd_batch(model, spec.family, batch, settings.pgd, settings.seed, epoch, step)
+        batch = {k: v.to(device) for k, v in batch.items()}
+        loss, terms = detector_loss(spec.family, model(batch["image"]), batch)
+        run.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        run.optimizer.step()
+        losses.append(float(loss.detach()))
+        bar.set_postfix(loss=f"{np.mean(losses[-20:]):.3f}", **{k: f"{v:.3f}" for k, v in terms.items()})
+        bar.update()
+    bar.close()
+    return losses
+
+
+def _end_epoch(run: _Run, data: _TrainData, settings: TrainSettings, epoch: int, losses: list[float], hard: list,
+               seconds: float, device: torch.device, show_progress: bool) -> None:
+    """Validate, record the epoch, keep the best weights (``--patience``) and write the checkpoint."""
+    val_set = data.val_set
+    val_accuracy = tusimple_accuracy(predict_lanes(run.model, val_set, device)) if val_set is not None else None
+    run.history.append({"epoch": epoch + 1, "loss": float(np.mean(losses)) if losses else None,
+                        "val_accuracy": val_accuracy, "seconds": round(seconds, 2),
+                        **({"aam": hard_summary(hard)} if hard else {})})
+    if show_progress:
+        shown = "n/a" if val_accuracy is None else f"{100 * val_accuracy:.2f} %"
+        print(f"epoch {epoch + 1}: loss {run.history[-1]['loss']:.4f}  val accuracy {shown}", flush=True)
+    best = run.best
+    if settings.patience is not None and val_accuracy is not None and (
+            best is None or val_accuracy > run.history[best["epoch"] - 1]["val_accuracy"]):
+        run.best = {"epoch": epoch + 1,
+                    "model": {k: v.detach().cpu().clone() for k, v in run.model.state_dict().items()}}
+    _save({"model": run.model.state_dict(), "optimizer": run.optimizer.state_dict(), "epoch": epoch,
+           "history": run.history, "data_sha256": data.sha256, "spec": asdict(settings.spec), "best": run.best},
+          settings.out / CHECKPOINT_FILE)
+
+
+def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]:
+    """Train, export and describe a model in ``settings.out``; returns the ``training.json`` content."""
+    torch.manual_seed(settings.seed)
+    torch.set_num_threads(settings.threads or os.cpu_count() or 1)
+    device = pick_device(settings.device)
+    data = _read_data(settings)
+    settings.out.mkdir(parents=True, exist_ok=True)
+    run = _start(settings, len(data.train_set), data.sha256, device)
+    write_atomic(settings.out / CONFIG_FILE, settings.spec.to_json().encode("utf-8"))
+    bank = aam_bank(settings, data.frames, data.sha256) if settings.augment == "aam" else []
     hard: list = []
-
-    model.train()
+    run.model.train()
     training_started = time.perf_counter()
-    for epoch in range(start_epoch, settings.epochs):
-        if _patience_spent(best, epoch, settings.patience, settings.min_epochs):
+    for epoch in range(run.start_epoch, settings.epochs):
+        if _patience_spent(run.best, epoch, settings.patience, settings.min_epochs):
             break  # a resumed run that had already stopped
         if settings.time_limit is not None and time.perf_counter() - training_started > settings.time_limit:
             if show_progress:
                 print(f"--time-limit {settings.time_limit:g} s reached: no epoch {epoch + 1}", flush=True)
             break
         if bank and epoch >= 1:  # the model's attention means something after one epoch
-            scores = predict_on(model, np.stack([p.image for p in bank]), [p.record for p in bank],
-                                [p.frame_size for p in bank], device)
-            for patch, (pred, gt, rows) in zip(bank, scores, strict=True):
-                patch.accuracy = score_image(pred, gt, rows, 0.0).accuracy
-            update_attention_areas(model, bank, settings.aam)
-            hard = hard_patches(bank, settings.aam.hard_share)
+            hard = _hard_examples(run, bank, settings, device)
         started = time.perf_counter()
-        train_set.epoch = epoch
-        generator = torch.Generator().manual_seed(settings.seed * 1000 + epoch)
-        loader = DataLoader(train_set, batch_size=settings.batch, shuffle=True, generator=generator, drop_last=True,
-                            num_workers=settings.loader_workers, persistent_workers=False)
-        bar = tqdm(total=steps_per_epoch, desc=f"epoch {epoch + 1}/{settings.epochs}", disable=not show_progress,
-                   unit="batch", dynamic_ncols=True)
-        losses = []
-        for step, batch in enumerate(loader):
-            if step >= steps_per_epoch:
-                break
-            for group in optimizer.param_groups:
-                group["lr"] = _lr_at(epoch * steps_per_epoch + step, total_steps, settings.lr)
-            if hard:
-                batch["image"] = aam_batch(model, batch["image"], hard, settings, epoch, step, batch["mask"])
-            if settings.augment == "pgd":
-                batch["image"] = pgd_batch(model, spec.family, batch, settings.pgd, settings.seed, epoch, step)
-            batch = {k: v.to(device) for k, v in batch.items()}
-            loss, terms = detector_loss(spec.family, model(batch["image"]), batch)
-            optimizer.zero_grad(set_to_none=True)
-            loss.backward()
-            optimizer.step()
-            losses.append(float(loss.detach()))
-            bar.set_postfix(loss=f"{np.mean(losses[-20:]):.3f}", **{k: f"{v:.3f}" for k, v in terms.items()})
-            bar.update()
-        bar.close()
-        val_accuracy = tusimple_accuracy(predict_lanes(model, val_set, device)) if val_set is not None else None
-        history.append({"epoch": epoch + 1, "loss": float(np.mean(losses)) if losses else None,
-                        "val_accuracy": val_accuracy, "seconds": round(time.perf_counter() - started, 2),
-                        **({"aam": hard_summary(hard)} if hard else {})})
-        if show_progress:
-            shown = "n/a" if val_accuracy is None else f"{100 * val_accuracy:.2f} %"
-            print(f"epoch {epoch + 1}: loss {history[-1]['loss']:.4f}  val accuracy {shown}", flush=True)
-        if settings.patience is not None and val_accuracy is not None and (
-                best is None or val_accuracy > history[best["epoch"] - 1]["val_accuracy"]):
-            best = {"epoch": epoch + 1, "model": {k: v.detach().cpu().clone() for k, v in model.state_dict().items()}}
-        _save({"model": model.state_dict(), "optimizer": optimizer.state_dict(), "epoch": epoch,
-               "history": history, "data_sha256": data_sha, "spec": asdict(spec), "best": best}, checkpoint_path)
-        if _patience_spent(best, epoch + 1, settings.patience, settings.min_epochs):
+        losses = _train_epoch(run, data.train_set, hard, settings, epoch, device, show_progress)
+        _end_epoch(run, data, settings, epoch, losses, hard, time.perf_counter() - started, device, show_progress)
+        if _patience_spent(run.best, epoch + 1, settings.patience, settings.min_epochs):
             if show_progress:
                 print(f"no gain for {settings.patience} epochs: keeping the best epoch", flush=True)
             break
+    return _finish(run, data, settings, device)
 
-    if best is not None:
-        model.load_state_dict(best["model"])
-    model = model.cpu().eval()
-    _save({k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}, out / WEIGHTS_FILE)
-    export_onnx(model, out / ONNX_FILE)
+
+def _finish(run: _Run, data: _TrainData, settings: TrainSettings, device: torch.device) -> dict[str, Any]:
+    """The kept weights (the best epoch's with ``--patience``) written in half precision and as ONNX, and
+    ``training.json``; returns its content."""
+    if run.best is not None:
+        run.model.load_state_dict(run.best["model"])
+    model = run.model.cpu().eval()
+    _save({k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()},
+          settings.out / WEIGHTS_FILE)
+    export_onnx(model, settings.out / ONNX_FILE)
+    summary = _summary(run, data, settings, device)
+    write_atomic(settings.out / TRAINING_FILE, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
+    return summary
+
+
+def _summary(run: _Run, data: _TrainData, settings: TrainSettings, device: torch.device) -> dict[str, Any]:
+    """The content of ``training.json``: the data, the settings, the time and every epoch."""
+    history, best = run.history, run.best
     seconds = [h["seconds"] for h in history]
-    summary = {
-        "spec": asdict(spec),
-        "data": "+".join(data.name for data in settings.data),
-        "data_sha256": data_sha,
-        "train_frames": len(train_set),
-        "val_frames": 0 if val_set is None else len(val_set),
+    return {
+        "spec": asdict(settings.spec),
+        "data": "+".join(folder.name for folder in settings.data),
+        "data_sha256": data.sha256,
+        "train_frames": len(data.train_set),
+        "val_frames": 0 if data.val_set is None else len(data.val_set),
         "epochs": settings.epochs,
         "batch": settings.batch,
         "lr": settings.lr,
@@ -351,7 +434,7 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "randomise": settings.randomise,
         "photometric": settings.photometric,
         "backbone_weights": None if settings.backbone_weights is None else settings.backbone_weights.name,
-        "val_data": [data.name for data in settings.val_data],
+        "val_data": [folder.name for folder in settings.val_data],
         "time_limit": settings.time_limit,
         "seed": settings.seed,
         "device": device.type,
@@ -368,5 +451,3 @@ def train(settings: TrainSettings, show_progress: bool = True) -> dict[str, Any]
         "history": history,
         "torch": torch.__version__,
     }
-    write_atomic(out / TRAINING_FILE, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
-    return summary

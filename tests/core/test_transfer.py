@@ -5,6 +5,7 @@ checkpoints in torchvision's layout load into the backbone (and wrong ones are r
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -186,3 +187,19 @@ def test_adapt_errors_exit_2(tmp_path, capsys):
     assert main(["adapt", "--weights", str(tmp_path / "nowhere"), "--frames", str(tmp_path),
                  "--out", str(tmp_path / "o")]) == 2
     assert "no such model folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"min_epochs": 2}, "--min-epochs: only with --patience"),
+    ({"min_epochs": 5, "patience": 2, "epochs": 3}, "more than --epochs 3"),
+    ({"val_fraction": 1.0}, r"--val 1.0: must lie in \[0, 1\)"),
+    ({"backbone_weights": Path("r18.pth")}, "need --width 1.0"),
+    ({"time_limit": 0.0}, "--time-limit 0: must be positive"),
+    ({"augment": "blur"}, "--augment blur: choose from"),
+])
+def test_train_settings_hold_their_own_rules(tmp_path, changes, message):
+    from lanevil_core.learn.train import TrainError, TrainSettings
+
+    with pytest.raises(TrainError, match=message):
+        TrainSettings(data=(tmp_path,), out=tmp_path / "m", **changes)
+    TrainSettings(data=(tmp_path,), out=tmp_path / "m")  # the defaults hold every rule
