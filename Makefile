@@ -30,7 +30,7 @@ test: lint test-fast test-slow test-browser
 # ruff (pycodestyle, pyflakes, isort, bugbear, pyupgrade) over the code and its tests; mypy over lanevil_core, app
 # and tests; typos over every tracked text file (British English in the Markdown; config in pyproject.toml).
 lint: $(STAMP)
-	$(PY) -m ruff check lanevil_core app tests bench scripts
+	$(PY) -m ruff check lanevil_core app tests bench experiments scripts
 	$(PY) -m mypy
 	$(VENV)/bin/typos
 

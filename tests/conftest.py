@@ -42,7 +42,7 @@ def make_case() -> Callable[..., Case]:
 
 @pytest.fixture(scope="session")
 def load_script() -> Callable[[str], ModuleType]:
-    """Importer of a script of the repository that is not a package module (``bench/defences.py``,
+    """Importer of a script of the repository that is not a package module (``experiments/defences.py``,
     ``scripts/carla_run.py``), by its path from the repository root; registered under its file name."""
 
     def load(relative: str) -> ModuleType:

@@ -544,7 +544,7 @@ def test_affine_shift_keeps_each_lane_in_its_slot_beside_the_ego():
 
 @pytest.mark.slow
 def test_defence_bench_fine_tunes_every_run_from_the_given_weights(tiny_dataset, tmp_path, load_script):
-    defences = load_script("bench/defences.py")
+    defences = load_script("experiments/defences.py")
     cases = tmp_path / "cases" / "30_shadow" / "fence_shadow" / "00_uphill_rural_noon"
     cases.mkdir(parents=True)
     for name in ("00_original.json", "01_level1.json"):

@@ -1,6 +1,7 @@
-"""``bench/real_footage.py`` without the footage: its label loader, the split files it writes and ego scoring on them.
+"""``experiments/real_footage.py`` without the footage: its label loader, the split files it writes and ego scoring
+on them.
 
-A tiny synthetic label file stands in for ``bench/real_labels.json``; the committed file itself is checked for
+A tiny synthetic label file stands in for ``experiments/real_labels.json``; the committed file itself is checked for
 shape (two ego lines per frame, one either side of the centre), never downloaded or decoded.
 """
 
@@ -18,12 +19,12 @@ from lanevil_core.metrics.ego import ego_lanes
 from lanevil_core.metrics.evaluate import evaluate
 from lanevil_core.metrics.formats import LaneRecord
 
-BENCH = Path(__file__).resolve().parents[2] / "bench"
+BENCH = Path(__file__).resolve().parents[2] / "experiments"
 
 
 @pytest.fixture(scope="module")
 def real_footage(load_script):
-    return load_script("bench/real_footage.py")
+    return load_script("experiments/real_footage.py")
 
 
 def straight(rows: list[int], bottom_x: float, slope: float, top: int) -> list[int]:
@@ -98,7 +99,7 @@ def test_the_committed_labels_have_an_ego_pair_in_every_frame(real_footage):
 
 
 def test_the_label_fit_finds_two_painted_lines_on_a_synthetic_road():
-    """``bench/real_labels_fit.py`` on a grey road with a yellow left line and a dashed white right line."""
+    """``experiments/real_labels_fit.py`` on a grey road with a yellow left line and a dashed white right line."""
     sys.path.insert(0, str(BENCH))
     try:
         import real_labels_fit as fit

@@ -1,4 +1,5 @@
-"""The semi-automatic fit that made ``bench/real_labels.json``: the ego lane's two lines of each chosen real frame.
+"""The semi-automatic fit that made ``experiments/real_labels.json``: the ego lane's two lines of each chosen real
+frame.
 
 Per frame and line: a paint mask (bright thin structures by a white top-hat of HLS lightness, plus yellow by hue
 and a saturation top-hat), a seed line near the bottom (the strongest paint directions either side of the camera
@@ -12,10 +13,10 @@ paint was seen. A few lines are hand-placed
 points instead (the tracker lost them), some are cut at a row (a motorbike or a sharp bend above), and frames
 whose lines cannot be told in the glare are left out. Every overlay (``--overlays DIR``) was then checked by eye.
 
-    .venv/bin/python bench/real_footage.py frames --all        # every candidate frame into CACHE/candidates
-    .venv/bin/python bench/real_labels_fit.py [--cache out/real_footage] [--overlays out/real_footage/fit]
+    .venv/bin/python experiments/real_footage.py frames --all        # every candidate frame into CACHE/candidates
+    .venv/bin/python experiments/real_labels_fit.py [--cache out/real_footage] [--overlays out/real_footage/fit]
 
-It rewrites ``bench/real_labels.json``; with the same frames it gives the same labels.
+It rewrites ``experiments/real_labels.json``; with the same frames it gives the same labels.
 """
 
 from __future__ import annotations
@@ -256,7 +257,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cache", type=Path, default=ROOT / "out" / "real_footage")
     parser.add_argument("--overlays", type=Path, default=None)
-    parser.add_argument("--labels", type=Path, default=ROOT / "bench" / "real_labels.json")
+    parser.add_argument("--labels", type=Path, default=ROOT / "experiments" / "real_labels.json")
     args = parser.parse_args()
     header = {key: value for key, value in json.loads(args.labels.read_text()).items() if key != "frames"}
     frames = []
@@ -265,7 +266,8 @@ def main() -> None:
             continue
         bgr = cv2.imread(str(args.cache / "candidates" / f"{stem}.png"))
         if bgr is None:
-            raise SystemExit(f"{args.cache / 'candidates'}: no {stem}.png; run bench/real_footage.py frames --all")
+            raise SystemExit(f"{args.cache / 'candidates'}: no {stem}.png; "
+                             "run experiments/real_footage.py frames --all")
         hand = HELP.get(stem, {})
         rows, lanes = fit_frame(bgr, camera, hand)
         frames.append({"split": split_of(source), "source": source, "image_size": [bgr.shape[1], bgr.shape[0]],

