@@ -17,7 +17,7 @@ import shutil
 import sys
 import tempfile
 import time
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 
@@ -27,10 +27,11 @@ sys.path.insert(0, str(REPO))
 from app.editor import EditorTab, HeadlessTab, launch_editor  # noqa: E402
 from app.settings import Settings  # noqa: E402
 from app.state import AppState  # noqa: E402
+from app.store import stock_id  # noqa: E402
 
 CASES = ["00_clean/00_straight_urban.json", "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json",
          "20_traffic/vehicle/00_straight_highway_noon/03_level3.json"]
-CASE_ID = "fence_shadow-03_level3"
+SHADOW_CASE = 1  # the case of CASES whose severity and sun are changed
 BURST_GAP_S = 0.02  # a slider dragged at 50 updates per second
 
 
@@ -82,12 +83,16 @@ def main() -> int:
             (scenes / relative).parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(REPO / "scenes" / relative, scenes / relative)
         state = AppState.open(Settings(data_dir=Path(tmp) / "data", scenes_dir=scenes, port=0, editor_port=0))
+        case_id = stock_id(PurePosixPath(CASES[SHADOW_CASE]))  # the store's id of that file, as seeding names it
+        if case_id not in state.store:
+            raise SystemExit(f"{CASES[SHADOW_CASE]} was not seeded as {case_id!r}; the store holds "
+                             f"{', '.join(record.id for record in state.store.list())}")
         server = launch_editor(state, host="127.0.0.1", port=0)
         try:
             with HeadlessTab(server, timeout=300) as editor:
                 p = editor.panel
                 p.quality.value = "full"
-                p.case_id.value = CASE_ID
+                p.case_id.value = case_id
                 editor.preview.wait_idle(300)
                 p.selected.value = p.selected.options[1]
                 editor.preview.wait_idle(300)

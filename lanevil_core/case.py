@@ -60,6 +60,12 @@ def default_markings(lanes_per_direction: int) -> list[Marking]:
     return [Marking(type=name) for name in names]
 
 
+def _default_of_other_count(markings: list[Marking]) -> bool:
+    """Whether ``markings`` are exactly the defaults of some lane count (then a changed count re-derives them)."""
+    lanes, odd = divmod(len(markings) - 1, 2)
+    return odd == 0 and lanes >= 1 and markings == default_markings(lanes)
+
+
 class Road(_Model):
     """Road layout: a reference line (line/arc/clothoid pieces), an elevation profile, lanes and paint.
 
@@ -77,7 +83,8 @@ class Road(_Model):
     markings: list[Marking] = Field(
         default_factory=list,
         description="paint of every lane boundary, left to right as seen by the ego "
-        "(2 * lanes_per_direction + 1 entries; empty = defaults)",
+        "(2 * lanes_per_direction + 1 entries; empty = defaults; the defaults of another lane count are "
+        "re-derived for this one)",
     )
     pavement: Pavement = Field(
         "asphalt",
@@ -93,7 +100,8 @@ class Road(_Model):
     @model_validator(mode="after")
     def _fill_markings(self) -> Road:
         expected = 2 * self.lanes_per_direction + 1
-        if not self.markings:
+        if not self.markings or _default_of_other_count(self.markings):
+            # the defaults of another lane count (a case whose lanes changed): the defaults of this one
             object.__setattr__(self, "markings", default_markings(self.lanes_per_direction))
         elif len(self.markings) != expected:
             raise ValueError(

@@ -212,10 +212,22 @@ def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: I
     current = state.store.get(case_id)
     if version is not None and version != current.version:
         raise VersionConflict(case_id, version, current.version)
+    patch = lane_count_patch(patch, current.case.road.lanes_per_direction)
     merged = merge_patch(current.case.model_dump(mode="json"), patch)
     case = validate_case(merged, "case" if "case" in body else "", state)
     # the patch applies to ``current``: only write if nobody changed the case since it was read
     return record_response(state.store.update(case_id, case, expected_version=current.version))
+
+
+def lane_count_patch(patch: Any, lanes_per_direction: int) -> Any:
+    """``patch``, resetting the road's markings to the new lane count's defaults when it changes
+    ``road.lanes_per_direction`` without giving ``road.markings`` (the old markings have the wrong count)."""
+    road = patch.get("road") if isinstance(patch, dict) else None
+    if not isinstance(road, dict) or road.get("lanes_per_direction", lanes_per_direction) == lanes_per_direction:
+        return patch
+    if "markings" in road:
+        return patch
+    return {**patch, "road": {**road, "markings": None}}
 
 
 @router.delete("/{case_id}", status_code=204, summary="Delete a case", responses={**NOT_FOUND, **CONFLICT})

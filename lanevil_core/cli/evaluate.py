@@ -8,9 +8,16 @@ import sys
 from pathlib import Path
 
 from ..case import write_atomic
-from ..metrics.formats import LaneFileError
+from ..metrics.formats import LaneFileError, split_note
 from ..metrics.tusimple import F1_VARIANTS
 from .base import Command, UsageError
+
+
+def _note_split(path: Path) -> None:
+    """Say on stderr when a dataset folder stands for a split other than its test split."""
+    note = split_note(path)
+    if note is not None:
+        print(f"note: {note}", file=sys.stderr)
 
 METRIC_CHOICES = ("tusimple", "culane", "ego")
 
@@ -43,6 +50,7 @@ def _format_eval(result: dict) -> str:
 def _run_eval(args: argparse.Namespace) -> int:
     from ..metrics.evaluate import evaluate
 
+    _note_split(args.gt)
     try:
         result = evaluate(args.gt, args.pred, args.metric, args.f1)
     except LaneFileError as error:
@@ -53,7 +61,8 @@ def _run_eval(args: argparse.Namespace) -> int:
 
 def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or "
-                                                 "images; a dataset folder stands for its test split")
+                                                 "images; a dataset folder stands for its test split (for its only "
+                                                 "split, with a note, when it has no test split)")
     from ..detect.split import METHODS
 
     parser.add_argument("--method", choices=METHODS, required=True, action="append",
@@ -83,6 +92,7 @@ def _run_detect(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {args.out}: with several --method, a folder (it is a file)")
     if not several and args.out.is_dir():
         raise UsageError(f"--out {args.out}: with one --method, a predictions file (it is a folder)")
+    _note_split(args.split)
     try:
         by_method = detect_split_methods(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:
@@ -123,6 +133,7 @@ def _run_report(args: argparse.Namespace) -> int:
     if len(set(names)) != len(names):
         raise UsageError("--pred: two detectors have the same name; give each a --name")
     detectors = []
+    _note_split(args.gt)
     try:
         gt = split_labels(args.gt)
         for name, pred in zip(names, args.pred, strict=True):

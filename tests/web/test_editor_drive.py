@@ -19,7 +19,7 @@ def test_drive_button_runs_the_open_case_and_plays_it(tab: EditorTab) -> None:
     assert job.finished.wait(WAIT_S) and job.status == "done", job.error
     _wait_for_playback(tab)
     assert len(tab.drive.frames) == 10 and tab.drive.frames[0].shape == (360, 640, 3)
-    assert "no success" in tab.drive.status.content and not tab.drive.replay.disabled
+    assert "**LANE KEPT**" in tab.drive.status.content and not tab.drive.replay.disabled
 
 
 def test_drive_uses_the_preview_detector(tab: EditorTab) -> None:
