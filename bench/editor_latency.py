@@ -90,23 +90,22 @@ def main() -> int:
         server = launch_editor(state, host="127.0.0.1", port=0)
         try:
             with HeadlessTab(server, timeout=300) as editor:
-                p = editor.panel
-                p.quality.value = "full"
-                p.case_id.value = case_id
+                editor.display.quality.value = "full"
+                editor.cases.case_id.value = case_id
                 editor.preview.wait_idle(300)
-                p.selected.value = p.selected.options[1]
+                editor.illusions.selected.value = editor.illusions.selected.options[1]
                 editor.preview.wait_idle(300)
                 n = args.repeats
                 frames = [(i * 7) % 90 + 1 for i in range(n)]
                 severities = [(i % 5) + 1 for i in range(n)]
                 altitudes = [10.0 + 5 * (i % 12) for i in range(n)]
-                single(editor, p.frame, [0, 1])  # warm the kernels and caches
+                single(editor, editor.display.frame, [0, 1])  # warm the kernels and caches
                 results = {
-                    "frame": stats(single(editor, p.frame, frames)),
-                    "severity": stats(single(editor, p.severity, severities)),
-                    "sun_altitude": stats(single(editor, p.sun_altitude, altitudes)),
-                    "frame_drag": stats(burst(editor, p.frame, list(range(10, 10 + 2 * n)))),
-                    "sun_drag": stats(burst(editor, p.sun_altitude, [20.0 + i for i in range(2 * n)])),
+                    "frame": stats(single(editor, editor.display.frame, frames)),
+                    "severity": stats(single(editor, editor.illusions.severity, severities)),
+                    "sun_altitude": stats(single(editor, editor.sun.altitude, altitudes)),
+                    "frame_drag": stats(burst(editor, editor.display.frame, list(range(10, 10 + 2 * n)))),
+                    "sun_drag": stats(burst(editor, editor.sun.altitude, [20.0 + i for i in range(2 * n)])),
                     "renders_dropped_by_coalescing": editor.preview.dropped,
                     "compiles": {"full": state.frames.full_compiles, "partial": state.frames.partial_compiles},
                 }

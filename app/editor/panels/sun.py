@@ -1,0 +1,84 @@
+"""The Sun & weather folder: the sun's direction and strength, weather presets, the pavement."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import viser
+
+from lanevil_core.case import Case
+from lanevil_core.presets import PRESET_NAMES, preset_values
+from lanevil_core.typed import PAVEMENTS
+
+from ..placement import field_bounds
+from ..session import CaseSession
+from .base import EditError, described, set_clipped, set_value, wrap_degrees
+
+if TYPE_CHECKING:
+    from ..tab import EditorTab
+
+SUN_FIELDS = ("azimuth", "altitude", "intensity")
+CUSTOM_WEATHER = "(as in the case)"
+
+
+class SunPanel:
+    """The sun, the weather and the pavement."""
+
+    def __init__(self, tab: EditorTab, gui: viser.GuiApi) -> None:
+        self.tab = tab
+        guarded = tab.guarded
+        with gui.add_folder("Sun & weather"):
+            self.azimuth = gui.add_slider("Sun azimuth", -180.0, 180.0, 1.0, 30.0,
+                                          hint="degrees counter-clockwise from the road's start heading (90 = left)")
+            self.azimuth.on_update(guarded(lambda e: self.set_sun(azimuth=float(e.target.value))))
+            self.altitude = gui.add_slider("Sun altitude", -10.0, 90.0, 1.0, 45.0, hint="degrees above the horizon")
+            self.altitude.on_update(guarded(lambda e: self.set_sun(altitude=float(e.target.value))))
+            self.intensity = gui.add_slider("Sun intensity", 0.0, 3.0, 0.05, 1.0, hint="1 = clear noon")
+            self.intensity.on_update(guarded(lambda e: self.set_sun(intensity=float(e.target.value))))
+            self.weather = gui.add_dropdown("Weather preset", [CUSTOM_WEATHER, *PRESET_NAMES],
+                                            hint="fills cloud, rain, puddles, fog and the sun's height")
+            self.weather.on_update(guarded(lambda e: self.set_weather_preset(str(e.target.value))))
+            self.pavement = gui.add_dropdown("Pavement", list(PAVEMENTS), initial_value="asphalt",
+                                             hint="asphalt, or jointed concrete slabs with sealed joints")
+            self.pavement.on_update(guarded(lambda e: self.set_pavement(str(e.target.value))))
+
+    def set_sun(self, azimuth: float | None = None, altitude: float | None = None,
+                intensity: float | None = None) -> None:
+        """Move the case's sun; illusions that set the sun themselves (shadows) get the same value as override."""
+        tab = self.tab
+        data = tab.data()
+        changes = {name: value for name, value in zip(SUN_FIELDS, (azimuth, altitude, intensity)) if value is not None}
+        data["sun"].update(changes)
+        for illusion, spec in zip(tab.case.illusions, data["illusions"]):
+            for name, value in changes.items():
+                field = f"sun_{name}"
+                if field in type(illusion).model_fields:
+                    low, high = field_bounds(type(illusion), field)
+                    spec[field] = float(np.clip(value, low, high))
+        tab.edit(data, f"sun {described(changes)}")
+
+    def set_weather_preset(self, name: str) -> None:
+        if name == CUSTOM_WEATHER:
+            return
+        try:
+            values = preset_values(name)
+        except KeyError as error:
+            raise EditError(f"weather: {error.args[0]}") from None
+        data = self.tab.data()
+        data["weather"].update(values["weather"])
+        data["sun"].update({k: v for k, v in values["sun"].items() if k != "azimuth"})
+        self.tab.edit(data, f"weather {name}")
+
+    def set_pavement(self, pavement: str) -> None:
+        """Pave the carriageway with ``pavement`` (asphalt or concrete slabs; the case model refuses others)."""
+        data = self.tab.data()
+        data["road"]["pavement"] = pavement
+        self.tab.edit(data, f"pavement {pavement}")
+
+    def sync(self, case: Case, session: CaseSession) -> None:
+        """The case's sun and pavement."""
+        set_value(self.azimuth, wrap_degrees(case.sun.azimuth))
+        set_clipped(self.altitude, case.sun.altitude)
+        set_value(self.intensity, case.sun.intensity)
+        set_value(self.pavement, case.road.pavement)
