@@ -60,6 +60,18 @@ def default_markings(lanes_per_direction: int) -> list[Marking]:
     return [Marking(type=name) for name in names]
 
 
+def resize_markings(markings: list[Marking], lanes_per_direction: int) -> list[Marking]:
+    """``markings`` (left to right) for another lane count, keeping what they paint: both edges, the centre line,
+    and each side's lane-line style (its line nearest the centre; the default where a side had no lane line).
+    The defaults of one count become the defaults of the other."""
+    old = (len(markings) - 1) // 2
+    n = lanes_per_direction
+    lane_line = default_markings(2)[1]
+    left = markings[old - 1] if old > 1 else lane_line
+    right = markings[old + 1] if old > 1 else lane_line
+    return [markings[0], *[left] * (n - 1), markings[old], *[right] * (n - 1), markings[-1]]
+
+
 def _default_of_other_count(markings: list[Marking]) -> bool:
     """Whether ``markings`` are exactly the defaults of some lane count (then a changed count re-derives them)."""
     lanes, odd = divmod(len(markings) - 1, 2)

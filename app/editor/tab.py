@@ -32,7 +32,17 @@ from lanevil_core.world.scene import CompiledScene
 from ..state import AppState
 from ..store import StoreError
 from .drive_panel import DrivePanel
-from .panels import CameraPanel, CasePanel, DisplayPanel, EditError, ExportPanel, IllusionsPanel, SunPanel
+from .panels import (
+    CameraPanel,
+    CasePanel,
+    DisplayPanel,
+    EditError,
+    ExportPanel,
+    IllusionsPanel,
+    RoadPanel,
+    ScenePanel,
+    SunPanel,
+)
 from .placement import anchor_road
 from .preview import DRAFT_SIZE, PreviewRequest, PreviewResult, PreviewWorker
 from .scene_view import SceneView
@@ -78,10 +88,12 @@ class EditorTab:
         self.display = DisplayPanel(self, gui)
         self.cases = CasePanel(self, gui)
         self.illusions = IllusionsPanel(self, gui)
+        self.road = RoadPanel(self, gui)
+        self.scene = ScenePanel(self, gui)
         self.sun = SunPanel(self, gui)
         self.camera = CameraPanel(self, gui)
         self.exports = ExportPanel(self, gui)
-        self.panels = (self.display, self.cases, self.illusions, self.sun, self.camera)
+        self.panels = (self.display, self.cases, self.illusions, self.road, self.scene, self.sun, self.camera)
         self.drive = DrivePanel(gui, state, lambda: (self.current().case_id, self.case),
                                 self.display.chosen_detector)
         self._unsubscribe = state.store.subscribe(self.cases.stored)

@@ -196,16 +196,16 @@ def test_sun_sliders_and_weather_preset(tab: EditorTab) -> None:
     assert tab.case.sun.intensity == 0.5
 
 
-def test_pavement_dropdown_paves_the_road_with_concrete_and_undo_takes_it_back(tab: EditorTab) -> None:
+def test_road_pavement_input_paves_the_road_with_concrete_and_undo_takes_it_back(tab: EditorTab) -> None:
     before = settle(tab)
-    assert tab.sun.pavement.value == tab.case.road.pavement == "asphalt"
-    tab.sun.pavement.value = "concrete"
+    assert tab.road.section.inputs.handles["pavement"].value == tab.case.road.pavement == "asphalt"
+    tab.road.section.inputs.handles["pavement"].value = "concrete"
     after = settle(tab)
     assert tab.case.road.pavement == "concrete"
     assert after.astype(float).mean() > before.astype(float).mean() + 5  # pale slabs fill the lower frame
     tab.cases.undo()
     settle(tab)
-    assert tab.case.road.pavement == "asphalt" and tab.sun.pavement.value == "asphalt"
+    assert tab.case.road.pavement == "asphalt" and tab.road.section.inputs.handles["pavement"].value == "asphalt"
 
 
 def test_sun_sliders_override_a_shadow_illusions_own_sun(tab: EditorTab) -> None:

@@ -6,6 +6,8 @@ from .case import CasePanel
 from .display import DisplayPanel
 from .exports import ExportPanel
 from .illusions import IllusionsPanel
+from .sections import RoadPanel, ScenePanel
 from .sun import SunPanel
 
-__all__ = ["CameraPanel", "CasePanel", "DisplayPanel", "EditError", "ExportPanel", "IllusionsPanel", "SunPanel"]
+__all__ = ["CameraPanel", "CasePanel", "DisplayPanel", "EditError", "ExportPanel", "IllusionsPanel", "RoadPanel",
+           "ScenePanel", "SunPanel"]

@@ -11,11 +11,13 @@ from lanevil_core.presets import CAMERA_PRESET_NAMES, camera_preset_values
 
 from ..session import CaseSession
 from .base import EditError, described, set_clipped, set_value
+from .sections import SectionInputs
 
 if TYPE_CHECKING:
     from ..tab import EditorTab
 
 CUSTOM_CAMERA = "(the case's camera)"
+SLIDER_FIELDS = ("fov", "z", "pitch", "roll")  # the camera's fields with a slider of their own
 
 
 class CameraPanel:
@@ -49,6 +51,8 @@ class CameraPanel:
             self.exposure.on_update(guarded(lambda e: self.set_sensor(bias=float(e.target.value))))
             self.noise = gui.add_slider("Sensor noise", 0.0, 4.0, 0.1, 1.0, hint="1 = a typical small sensor")
             self.noise.on_update(guarded(lambda e: self.set_sensor(noise=float(e.target.value))))
+            self.more = SectionInputs(tab, gui, "camera", gui.add_folder("More camera fields", expand_by_default=False),
+                                      skip=SLIDER_FIELDS)
 
     def set_preset(self, name: str) -> None:
         """See the case through a named camera (its mount, field of view, lens, bonnet and sensor)."""
@@ -90,8 +94,12 @@ class CameraPanel:
         fields.update(changes)
         self.tab.edit(data, f"{part or 'camera'} {described(changes)}")
 
+    def field_paths(self) -> set[tuple[str, ...]]:
+        return {("camera", name) for name in SLIDER_FIELDS} | self.more.field_paths()
+
     def sync(self, case: Case, session: CaseSession) -> None:
-        """The case's camera on the sliders (clipped to their ranges)."""
+        """The case's camera on the sliders (clipped to their ranges) and in its other fields."""
+        self.more.sync(case, session)
         camera = case.camera
         for handle, value in ((self.fov, camera.hfov), (self.height, camera.z), (self.pitch, camera.pitch),
                               (self.roll, camera.roll), (self.k1, camera.lens.k1)):

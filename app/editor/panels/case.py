@@ -36,6 +36,10 @@ class CasePanel:
             self.case_id.on_update(guarded(lambda e: self.open_case(str(e.target.value))))
             self.title = gui.add_text("Title", "", hint="the case's title (saved with it)")
             self.title.on_update(guarded(lambda e: self.set_title(str(e.target.value))))
+            self.description = gui.add_text("Description", "", multiline=True,
+                                            hint="what the case shows (saved with it)")
+            self.description.on_update(guarded(lambda e: self.tab.edit({**self.tab.data(), "description":
+                                                                        str(e.target.value)}, "description")))
             self.save_button = gui.add_button("Save", icon=viser.Icon.DEVICE_FLOPPY,
                                               hint="write to the store (version-checked)")
             self.save_button.on_click(guarded(lambda e: self.save()))
@@ -148,8 +152,12 @@ class CasePanel:
 
     # ------------------------------------------------------------------------------------------ sync
 
+    def field_paths(self) -> set[tuple[str, ...]]:
+        return {("title",), ("description",)}
+
     def sync(self, case: Case, session: CaseSession) -> None:
-        """The open case's id, title and what Undo / Redo can do."""
+        """The open case's id, title, description and what Undo / Redo can do."""
+        set_value(self.description, case.description)
         if session.case_id not in self.case_id.options:
             self.case_id.options = self.tab.case_ids()
         set_value(self.case_id, session.case_id)

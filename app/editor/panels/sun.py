@@ -1,4 +1,4 @@
-"""The Sun & weather folder: the sun's direction and strength, weather presets, the pavement."""
+"""The Sun & weather folder: the sun's direction and strength, weather presets and the weather's numbers."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import viser
 
 from lanevil_core.case import Case
 from lanevil_core.presets import PRESET_NAMES, preset_values
-from lanevil_core.typed import PAVEMENTS
 
 from ..placement import field_bounds
 from ..session import CaseSession
 from .base import EditError, described, set_clipped, set_value, wrap_degrees
+from .sections import SectionInputs
 
 if TYPE_CHECKING:
     from ..tab import EditorTab
@@ -23,7 +23,7 @@ CUSTOM_WEATHER = "(as in the case)"
 
 
 class SunPanel:
-    """The sun, the weather and the pavement."""
+    """The sun and the weather."""
 
     def __init__(self, tab: EditorTab, gui: viser.GuiApi) -> None:
         self.tab = tab
@@ -39,9 +39,7 @@ class SunPanel:
             self.weather = gui.add_dropdown("Weather preset", [CUSTOM_WEATHER, *PRESET_NAMES],
                                             hint="fills cloud, rain, puddles, fog and the sun's height")
             self.weather.on_update(guarded(lambda e: self.set_weather_preset(str(e.target.value))))
-            self.pavement = gui.add_dropdown("Pavement", list(PAVEMENTS), initial_value="asphalt",
-                                             hint="asphalt, or jointed concrete slabs with sealed joints")
-            self.pavement.on_update(guarded(lambda e: self.set_pavement(str(e.target.value))))
+            self.weather_numbers = SectionInputs(tab, gui, "weather", gui.add_folder("Weather numbers"))
 
     def set_sun(self, azimuth: float | None = None, altitude: float | None = None,
                 intensity: float | None = None) -> None:
@@ -70,15 +68,12 @@ class SunPanel:
         data["sun"].update({k: v for k, v in values["sun"].items() if k != "azimuth"})
         self.tab.edit(data, f"weather {name}")
 
-    def set_pavement(self, pavement: str) -> None:
-        """Pave the carriageway with ``pavement`` (asphalt or concrete slabs; the case model refuses others)."""
-        data = self.tab.data()
-        data["road"]["pavement"] = pavement
-        self.tab.edit(data, f"pavement {pavement}")
+    def field_paths(self) -> set[tuple[str, ...]]:
+        return {("sun", name) for name in SUN_FIELDS} | self.weather_numbers.field_paths()
 
     def sync(self, case: Case, session: CaseSession) -> None:
-        """The case's sun and pavement."""
+        """The case's sun and weather."""
         set_value(self.azimuth, wrap_degrees(case.sun.azimuth))
         set_clipped(self.altitude, case.sun.altitude)
         set_value(self.intensity, case.sun.intensity)
-        set_value(self.pavement, case.road.pavement)
+        self.weather_numbers.sync(case, session)
