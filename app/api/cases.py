@@ -21,6 +21,7 @@ from pydantic import BaseModel, Field, ValidationError
 
 from lanevil_core.case import Case
 from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
+from lanevil_core.library.benchmark_layout import MIXED_CATEGORY
 from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..state import AppState
@@ -31,7 +32,7 @@ from .params import VERSION_PATTERN, etag_matches, parse_version
 
 router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
-LISTING_CATEGORIES = ("clean", *CATEGORIES)
+LISTING_CATEGORIES = ("clean", *CATEGORIES, MIXED_CATEGORY)
 ENVELOPE_KEYS = frozenset({"id", "version", "case", "created_at", "updated_at", "origin"})
 CONFLICT: dict[int | str, dict[str, Any]] = {
     409: {"model": ErrorBody, "description": "stale version (the message says the current one)"}}

@@ -32,6 +32,7 @@ from lanevil_core.world.scene import CompiledScene
 from ..state import AppState
 from ..store import StoreError
 from .drive_panel import DrivePanel
+from .page import BrowserWebGL
 from .panels import (
     CameraPanel,
     CasePanel,
@@ -64,7 +65,8 @@ HELP = """**LanEvil editor** — build a lane-detection test case in 3D.
 class EditorTab:
     """The editor as one viser client (browser tab) sees it, over the backend's ``AppState``."""
 
-    def __init__(self, state: AppState, client: viser.ClientHandle, case_id: str | None = None) -> None:
+    def __init__(self, state: AppState, client: viser.ClientHandle, case_id: str | None = None,
+                 webgl: BrowserWebGL | None = None) -> None:
         self.state = state
         self.client = client
         self.sessions = SessionRegistry(state.store)  # this tab's sessions: its unsaved edits are its own
@@ -85,7 +87,7 @@ class EditorTab:
         with gui.add_folder("Help", expand_by_default=False):
             gui.add_markdown(HELP)
         self.status = gui.add_markdown("Opening…")
-        self.display = DisplayPanel(self, gui)
+        self.display = DisplayPanel(self, gui, webgl or BrowserWebGL())
         self.cases = CasePanel(self, gui)
         self.illusions = IllusionsPanel(self, gui)
         self.road = RoadPanel(self, gui)
@@ -224,8 +226,11 @@ class EditorTab:
         self.push_log.append((result.request.seq, time.perf_counter()))
         self.display.publish(result)
         self.last_result = result
-        if result.request.draft:
-            return
+        if not result.request.draft and self.view.mode != "off":  # a draft's state is about to be replaced
+            self.show_3d(result)
+
+    def show_3d(self, result: PreviewResult) -> None:
+        """Bring the 3D view up to the state of an exact preview."""
         case, scene = result.request.case, result.scene
         selected = self.selected if self.selected is not None and self.selected < len(case.illusions) else None
         road_key = roadside_key(case)

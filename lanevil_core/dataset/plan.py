@@ -30,8 +30,6 @@ from ..camera.variation import random_camera
 from ..case import Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
 from ..library.benchmark_layout import (
-    CATEGORY_FOLDERS,
-    TYPE_FOLDERS,
     case_folder,
     case_illusion_type,
     case_name,
@@ -264,12 +262,12 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
     if illusion_type is None:
         raise PlanError(f"{source.relative}: a clean case has no test folder")
     folder = case_folder(case, case_name(source.relative), source.folder_type)
+    category, type_folder = folder.parts[0], folder.parts[1]  # case_filing's folders
     severity = case.illusions[0].severity if case.illusions else 0
     return PlannedCase(
         split=TEST_SPLIT, folder=folder, case_text=case_json(case),
         frames=frames if frames is not None else evenly_spaced(case.ego.frames, frames_per_case),
-        illusion_type=illusion_type,
-        category=CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY], type_folder=TYPE_FOLDERS[illusion_type],
+        illusion_type=illusion_type, category=category, type_folder=type_folder,
         severity=severity, source={"file": str(source.relative)},
     )
 

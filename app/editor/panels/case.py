@@ -53,7 +53,8 @@ class CasePanel:
             self.save_copy_button = gui.add_button("Save as new case", hint="store your edits under a new id")
             self.save_copy_button.on_click(guarded(lambda e: self.save_as_new()))
         with gui.add_folder("New case", expand_by_default=False):
-            self.template = gui.add_dropdown("Road", list(ROAD_TYPES), initial_value="straight", hint="road template")
+            self.template = gui.add_dropdown("Road template", list(ROAD_TYPES), initial_value="straight",
+                                            hint="the road of the new case")
             self.scene_kind = gui.add_dropdown("Roadside", list(SCENE_KINDS), initial_value="suburban")
             self.create_button = gui.add_button("Create and open", icon=viser.Icon.PLUS)
             self.create_button.on_click(guarded(lambda e: self.new_case(str(self.template.value),

@@ -17,24 +17,45 @@ from lanevil_core.case import Case
 from lanevil_core.metrics.formats import LaneFileError
 
 from ..detection import DETECTOR_CHOICES, NO_DETECTOR, chosen_detector, detection_text, unavailable_text
+from ..page import BrowserWebGL
 from ..preview import PREVIEW_SIZE, QUALITIES, PreviewRequest, PreviewResult
+from ..scene_view import VIEW_MODES, ViewMode
 from ..session import CaseSession
+from ..text import escape_markdown
 from .base import EditError, set_value
 
 if TYPE_CHECKING:
     from ..tab import EditorTab
 
+# Where the page reports software WebGL, the tab starts with this 3D view: each frame of the road scene costs the
+# browser about two CPU seconds in software, and viser redraws about once a second even when nothing moves.
+SOFTWARE_VIEW_MODE: ViewMode = "off"
+
+
+def software_note(renderer: str) -> str:
+    """The line under the preview when the browser draws 3D in software."""
+    return (f"⚙ This browser draws 3D in software (*{escape_markdown(renderer)}*): the 3D view starts "
+            f"*{SOFTWARE_VIEW_MODE}* and the camera preview is the main view. **3D view** turns it back on.")
+
 
 class DisplayPanel:
     """What the preview shows, and the frame player."""
 
-    def __init__(self, tab: EditorTab, gui: viser.GuiApi) -> None:
+    def __init__(self, tab: EditorTab, gui: viser.GuiApi, webgl: BrowserWebGL) -> None:
         self.tab = tab
         guarded = tab.guarded
         self.image = gui.add_image(np.full((PREVIEW_SIZE[1], PREVIEW_SIZE[0], 3), 200, np.uint8),
                                    label="Camera preview", format="jpeg", jpeg_quality=90)
         self.info = gui.add_markdown("")
         self.detection = gui.add_markdown("")
+        mode: ViewMode = SOFTWARE_VIEW_MODE if webgl.software else "full"
+        self.view_mode = gui.add_dropdown("3D view", list(VIEW_MODES), initial_value=mode,
+                                          hint="full: shadows and an environment map; light: neither (for a "
+                                               "browser without a graphics card); off: the camera preview alone")
+        self.view_mode.on_update(guarded(lambda e: self.set_view_mode(str(e.target.value))))
+        self.gl_note = gui.add_markdown(software_note(webgl.renderer) if webgl.software else "")
+        if mode != "full":
+            tab.view.set_mode(mode)
         with gui.add_folder("Frame"):
             self.frame = gui.add_slider("Frame", 0, 99, 1, 0, hint="frame of the ego drive shown in the preview")
             self.frame.on_update(guarded(lambda e: self.set_frame(int(e.target.value))))
@@ -85,6 +106,19 @@ class DisplayPanel:
         with self.tab.syncing():
             set_value(self.quality, quality)
         self.request_preview()
+
+    def set_view_mode(self, mode: str) -> None:
+        """Draw the 3D view ``full``, ``light`` or ``off`` (the preview image stays either way)."""
+        chosen = next((m for m in VIEW_MODES if m == mode), None)
+        if chosen is None:
+            raise EditError(f"3D view: choose one of {', '.join(VIEW_MODES)}, not {mode!r}")
+        was_off = self.tab.view.mode == "off"
+        self.tab.view.set_mode(chosen)
+        with self.tab.syncing():
+            set_value(self.view_mode, chosen)
+        result = self.tab.last_result
+        if was_off and chosen != "off" and result is not None and not result.request.draft:
+            self.tab.show_3d(result)  # the view skipped every state while it was off
 
     def set_playing(self, on: bool) -> None:
         (self._playing.set if on else self._playing.clear)()
