@@ -226,7 +226,10 @@ class EditorTab:
         self.push_log.append((result.request.seq, time.perf_counter()))
         self.display.publish(result)
         self.last_result = result
-        if not result.request.draft and self.view.mode != "off":  # a draft's state is about to be replaced
+        if result.request.draft:  # a draft's state is about to be replaced or refined
+            return
+        self.sun.show_owner(result.request.case, result.scene.env.sun_set_by)
+        if self.view.mode != "off":
             self.show_3d(result)
 
     def show_3d(self, result: PreviewResult) -> None:

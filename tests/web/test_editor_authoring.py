@@ -109,3 +109,33 @@ def test_editing_without_an_open_case_says_what_to_do(tab: EditorTab) -> None:
     tab.session = None
     with pytest.raises(EditError, match="open a case first"):
         tab.road.set_field(("length",), 500.0)
+
+
+SHADOW = "fence_shadow-00_uphill_rural_noon-03_level3"
+
+
+def settled(tab: EditorTab) -> None:
+    assert tab.preview.wait_idle(120.0)
+
+
+def owner_note(tab: EditorTab) -> str:
+    """The sun panel's line as it reads (markdown escapes removed)."""
+    return tab.sun.owner.content.replace("\\", "")
+
+
+def test_one_sun_the_panel_says_who_sets_it_and_asks_before_an_illusion_overrides_it(tab: EditorTab) -> None:
+    tab.cases.case_id.value = SHADOW  # a fence shadow: its own sun, which the sliders set
+    settled(tab)
+    assert "Sun set by illusion **0: fence_shadow** (the sliders set its sun)" in owner_note(tab)
+    assert not tab.sun.altitude.disabled
+    assert tab.illusions.place("sunlight_reflection", 60.0, -1.75) is None  # asked first, nothing placed yet
+    assert tab.illusions.pending_sun is not None and len(tab.case.illusions) == 1
+    assert tab.illusions.answer_sun(False) is None and len(tab.case.illusions) == 1  # Cancel keeps the case
+    tab.illusions.place("sunlight_reflection", 60.0, -1.75)
+    assert tab.illusions.answer_sun(True) == 1 and [i.type for i in tab.case.illusions] == [
+        "fence_shadow", "sunlight_reflection"]
+    settled(tab)
+    note = owner_note(tab)
+    assert "Sun set by illusion **1: sunlight_reflection**" in note and "overrides the sun of 0: fence_shadow" in note
+    assert tab.sun.altitude.disabled and tab.sun.azimuth.disabled  # they would not move the rendered sun
+    assert tab.illusions.place("road_crack", 80.0, -1.75) == 2  # no sun of its own: placed at once

@@ -47,9 +47,11 @@ def place_and_move(page, tab: EditorTab, pick, wait_for, illusion_type: str, s: 
     count = len(tab.case.illusions)
     wait_for(lambda: tab.view.surface is not None and tab.preview.wait_idle(WAIT_S), "the road in the 3D view")
     time.sleep(3)  # the page has drawn the road from the new view
-    page.screenshot(path=str(SCREENSHOTS / f"editor_authored_0_{illusion_type}.png"), timeout=SLOW_MS)
     page.mouse.click(*ROAD_CLICK)
     wait_for(lambda: len(tab.case.illusions) == count + 1, f"the placed {illusion_type}")
+    position = page.get_by_label("s", exact=True).first
+    if not position.is_visible():
+        open_folder(page, "Parameters")  # the selected illusion's own fields
     type_number(page, "s", s)
     wait_for(lambda: tab.case.illusions[count].s == s, f"the {illusion_type} at s = {s}")
 

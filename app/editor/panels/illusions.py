@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import viser
+from viser._gui_handles import GuiModalHandle  # not re-exported by viser 1.x
 
 from lanevil_core.case import Case
 from lanevil_core.illusions import ILLUSION_TYPES, REGISTRY, Illusion
@@ -53,6 +54,8 @@ class IllusionsPanel:
                      "stored in the server's uploads folder")
             self.upload_button.on_upload(guarded(lambda e: self.upload_mesh(e.target.value.name,
                                                                             e.target.value.content)))
+            self.pending_sun: tuple[str, float, float] | None = None  # an illusion waiting for ask_sun's answer
+            self._modal: GuiModalHandle | None = None
             self.params = ParamInputs(gui, gui.add_folder("Parameters", expand_by_default=False),
                                       guarded(self.set_field))
 
@@ -71,12 +74,18 @@ class IllusionsPanel:
         data["illusions"][index] = {**data["illusions"][index], **changes}
         self.tab.edit(data, label)
 
-    def place(self, illusion_type: str, s_road: float, t_road: float) -> int:
-        """Add an illusion of ``illusion_type`` at road coordinates (s, t) and select it; returns its index."""
+    def place(self, illusion_type: str, s_road: float, t_road: float, confirmed: bool = False) -> int | None:
+        """Add an illusion of ``illusion_type`` at road coordinates (s, t) and select it; returns its index. One
+        that sets the sun where another already does is placed only once the user confirms (``ask_sun``; None
+        until then)."""
         tab = self.tab
         model = REGISTRY.get(illusion_type)
         if model is None:
             raise EditError(f"type: unknown illusion type {illusion_type!r}")
+        rivals = [f"{i}: {other.type}" for i, other in enumerate(tab.case.illusions) if type(other).SETS_SUN]
+        if model.SETS_SUN and rivals and not confirmed:
+            self.ask_sun(illusion_type, s_road, t_road, rivals)
+            return None
         fields = placement_fields(model, tab.network(), s_road, t_road)
         data = tab.data()
         data["illusions"].append({"type": illusion_type, **fields})
@@ -85,6 +94,31 @@ class IllusionsPanel:
             tab.selected = len(data["illusions"]) - 1
         tab.changed(f"placed {illusion_type} at s = {fields['s']:.1f} m")
         return tab.selected
+
+    def ask_sun(self, illusion_type: str, s_road: float, t_road: float, rivals: list[str]) -> None:
+        """Ask before a new illusion's sun overrides the sun of those already in the case."""
+        self.pending_sun = (illusion_type, s_road, t_road)
+        gui = self.tab.client.gui
+        with gui.add_modal("One sun for the whole case") as modal:
+            gui.add_markdown(f"**{illusion_type}** places the sun itself, and so does {', '.join(rivals)}. A case "
+                             f"has one sun: the illusion placed last sets it, and the others' shadows or glare "
+                             f"follow it.")
+            place = gui.add_button("Place it: its sun wins", color="orange")
+            cancel = gui.add_button("Cancel")
+        self._modal = modal
+        place.on_click(self.tab.guarded(lambda e: self.answer_sun(True)))
+        cancel.on_click(self.tab.guarded(lambda e: self.answer_sun(False)))
+
+    def answer_sun(self, place: bool) -> int | None:
+        """The answer to ``ask_sun``: place the pending illusion (its index) or drop it."""
+        pending, self.pending_sun = self.pending_sun, None
+        if self._modal is not None:
+            self._modal.close()
+            self._modal = None
+        if pending is None or not place:
+            self.tab.report("not placed: the case keeps its sun")
+            return None
+        return self.place(*pending, confirmed=True)
 
     def select(self, index: int | None) -> None:
         if index is not None:

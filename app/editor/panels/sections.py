@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from ..tab import EditorTab
 
 FieldPath = tuple[str, ...]
+LAST = 1e9  # viser order: after every input of the folder
 FieldSetter = Callable[[FieldPath, Any], None]
 
 
@@ -82,7 +83,7 @@ class RoadPanel:
         self.section = SectionInputs(tab, gui, "road", gui.add_folder("Road", expand_by_default=False),
                                      skip=("markings",), setter=self.set_field)
         with self.section.inputs.folder:
-            self.markings = gui.add_folder("Markings", expand_by_default=False)
+            self.markings = gui.add_folder("Markings", expand_by_default=False, order=LAST)
         with self.markings:
             self.lines_folder = gui.add_folder("All lines", expand_by_default=False)
         self.lines = ModelInputs(gui, self.lines_folder, tab.guarded(self.set_lines), skip=("type",))

@@ -8,10 +8,12 @@ import numpy as np
 import viser
 
 from lanevil_core.case import Case
+from lanevil_core.illusions import Illusion
 from lanevil_core.presets import PRESET_NAMES, preset_values
 
 from ..placement import field_bounds
 from ..session import CaseSession
+from ..text import escape_markdown
 from .base import EditError, described, set_clipped, set_value, wrap_degrees
 from .sections import SectionInputs
 
@@ -22,6 +24,28 @@ SUN_FIELDS = ("azimuth", "altitude", "intensity")
 CUSTOM_WEATHER = "(as in the case)"
 
 
+def has_sun_fields(illusion: Illusion) -> bool:
+    """Whether the sun sliders reach an illusion's sun (its ``sun_*`` overrides)."""
+    return all(f"sun_{name}" in type(illusion).model_fields for name in SUN_FIELDS)
+
+
+def sun_owner_text(case: Case, sun_set_by: tuple[int, ...]) -> str:
+    """Who sets the sun the preview shows, and which illusions' own suns it overrides (markdown)."""
+    if not sun_set_by:
+        return "☀ The sun is the case's: these sliders set it."
+    owner = sun_set_by[-1]
+    illusion = case.illusions[owner]
+    how = ("the sliders set its sun" if has_sun_fields(illusion)
+           else "its severity table places it, so the sliders are off while it is in the case")
+    text = f"☀ Sun set by illusion **{owner}: {escape_markdown(illusion.type)}** ({how})."
+    others = [f"{i}: {escape_markdown(other.type)}" for i, other in enumerate(case.illusions)
+              if i != owner and type(other).SETS_SUN]
+    if others:
+        text += (f" ⚠ It overrides the sun of {', '.join(others)}: their shadows or glare follow this sun, "
+                 "not their own.")
+    return text
+
+
 class SunPanel:
     """The sun and the weather."""
 
@@ -29,6 +53,7 @@ class SunPanel:
         self.tab = tab
         guarded = tab.guarded
         with gui.add_folder("Sun & weather"):
+            self.owner = gui.add_markdown("")
             self.azimuth = gui.add_slider("Sun azimuth", -180.0, 180.0, 1.0, 30.0,
                                           hint="degrees counter-clockwise from the road's start heading (90 = left)")
             self.azimuth.on_update(guarded(lambda e: self.set_sun(azimuth=float(e.target.value))))
@@ -67,6 +92,13 @@ class SunPanel:
         data["weather"].update(values["weather"])
         data["sun"].update({k: v for k, v in values["sun"].items() if k != "azimuth"})
         self.tab.edit(data, f"weather {name}")
+
+    def show_owner(self, case: Case, sun_set_by: tuple[int, ...]) -> None:
+        """Say who sets the rendered sun (from the compiled scene); where an illusion's severity table places it,
+        the sliders would not move it and are disabled."""
+        self.owner.content = sun_owner_text(case, sun_set_by)
+        fixed = bool(sun_set_by) and not has_sun_fields(case.illusions[sun_set_by[-1]])
+        self.azimuth.disabled = self.altitude.disabled = self.intensity.disabled = fixed
 
     def field_paths(self) -> set[tuple[str, ...]]:
         return {("sun", name) for name in SUN_FIELDS} | self.weather_numbers.field_paths()
