@@ -320,6 +320,8 @@ def test_illusions_registry(client) -> None:
     assert fence["parameters"]["severity"]["maximum"] == 5 and "default" in fence["parameters"]["severity"]
     assert body["categories"]["shadow"] == [name for name, cls in REGISTRY.items() if cls.CATEGORY == "shadow"]
     assert "illusions" in body["case_schema"]["properties"]
+    suns = {info["name"]: info["sun"] for info in body["data"]}  # what the demo's sun sliders may do per type
+    assert (suns["fence_shadow"], suns["sunlight_reflection"], suns["road_crack"]) == ("overrides", "table", "case")
 
 
 def test_multipart_uploads_have_their_own_limit(settings, state) -> None:

@@ -17,8 +17,7 @@ pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 WAIT_S = 90.0
 SLOW_MS = 180_000  # SwiftShader draws slowly on a busy machine
-ROAD_CLICK = (470, 660)
-SCREENSHOTS = Path(__file__).parent / "_screenshots"  # on the ego's carriageway in the start view of a new straight road
+ROAD_CLICK = (470, 660)  # on the ego's carriageway in the start view of a new straight road
 
 
 def open_page(browser, editor: Editor, url: str):
@@ -34,8 +33,13 @@ def open_folder(page, title: str) -> None:
     page.get_by_text(title, exact=True).first.click()
 
 
+def labelled_input(page, label: str):
+    """The input beside the panel label ``label`` (viser ties number inputs to their labels, text inputs not)."""
+    return page.locator(f"xpath=//label[normalize-space(.)='{label}']/ancestor::*[.//input][1]//input").first
+
+
 def type_number(page, label: str, value: float) -> None:
-    box = page.get_by_label(label, exact=True).first
+    box = labelled_input(page, label)
     box.fill(f"{value:g}")
     box.press("Tab")
 
@@ -49,8 +53,7 @@ def place_and_move(page, tab: EditorTab, pick, wait_for, illusion_type: str, s: 
     time.sleep(3)  # the page has drawn the road from the new view
     page.mouse.click(*ROAD_CLICK)
     wait_for(lambda: len(tab.case.illusions) == count + 1, f"the placed {illusion_type}")
-    position = page.get_by_label("s", exact=True).first
-    if not position.is_visible():
+    if not labelled_input(page, "s").is_visible():
         open_folder(page, "Parameters")  # the selected illusion's own fields
     type_number(page, "s", s)
     wait_for(lambda: tab.case.illusions[count].s == s, f"the {illusion_type} at s = {s}")
