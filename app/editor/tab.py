@@ -42,6 +42,7 @@ from .panels import (
     IllusionsPanel,
     RoadPanel,
     ScenePanel,
+    StartScreen,
     SunPanel,
 )
 from .placement import anchor_road
@@ -104,6 +105,8 @@ class EditorTab:
         ids = self.case_ids()
         if case_id is not None or ids:
             self.cases.open_case(case_id if case_id is not None else ids[0])
+        # A tab opened on no particular case starts on the start screen (the first case open behind it).
+        self.start = StartScreen(self, gui) if case_id is None else None
 
     @property
     def client_id(self) -> int:

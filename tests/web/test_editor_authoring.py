@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 
 from app.editor import EditError, EditorTab
+from app.editor.panels.start import matching, recent
 from lanevil_core.case import Marking, case_schema, default_markings, resize_markings
 
 SKIPPED = {("schema_version",), ("illusions",)}  # fixed, and the Illusions panel's own inputs
@@ -139,3 +140,30 @@ def test_one_sun_the_panel_says_who_sets_it_and_asks_before_an_illusion_override
     assert "Sun set by illusion **1: sunlight_reflection**" in note and "overrides the sun of 0: fence_shadow" in note
     assert tab.sun.altitude.disabled and tab.sun.azimuth.disabled  # they would not move the rendered sun
     assert tab.illusions.place("road_crack", 80.0, -1.75) == 2  # no sun of its own: placed at once
+
+
+def test_the_start_screen_offers_new_recent_and_a_searchable_library(tab: EditorTab) -> None:
+    start = tab.start
+    assert start is not None and start.modal is not None
+    rows = {row.case_id: row for row in start.rows}
+    shadow = rows[SHADOW]
+    assert (shadow.category, shadow.type, shadow.original) == ("shadow", "fence_shadow", "00_uphill_rural_noon")
+    assert rows["clean-00_straight_urban"].original == "-"
+    start.category.value = "shadow"
+    assert list(start.type.options) == ["(any)", "fence_shadow"]
+    start.search.value = "level3 uphill"
+    assert [label.split(" — ")[0] for label in start.case.options] == [SHADOW]
+    start.open(start._chosen())
+    assert tab.session is not None and tab.session.case_id == SHADOW and start.modal is None
+    tab.cases.title.value = "touched"
+    tab.cases.save()
+    assert recent(tab.state.store.list())[0].id == SHADOW  # the case saved last comes first
+
+
+def test_the_start_screen_creates_a_new_case(tab: EditorTab) -> None:
+    start = tab.start
+    assert start is not None
+    start.road.value = "bend"
+    case_id = start.new_case()
+    assert tab.session is not None and tab.session.case_id == case_id and tab.case.road.type == "bend"
+    assert matching(start.rows, "(any)", "(any)", "no-such-words") == []

@@ -30,7 +30,7 @@ def open_page(browser, editor: Editor, url: str):
 
 
 def open_folder(page, title: str) -> None:
-    page.get_by_text(title, exact=True).first.click()
+    page.get_by_text(title, exact=True).locator("visible=true").first.click()  # not the words in the Help text
 
 
 def labelled_input(page, label: str):

@@ -7,7 +7,8 @@ from .display import DisplayPanel
 from .exports import ExportPanel
 from .illusions import IllusionsPanel
 from .sections import RoadPanel, ScenePanel
+from .start import StartScreen
 from .sun import SunPanel
 
 __all__ = ["CameraPanel", "CasePanel", "DisplayPanel", "EditError", "ExportPanel", "IllusionsPanel", "RoadPanel",
-           "ScenePanel", "SunPanel"]
+           "ScenePanel", "StartScreen", "SunPanel"]
