@@ -30,6 +30,7 @@ class ExportPanel:
 
     def _send(self, name: str, data: bytes) -> None:
         self.tab.client.send_file_download(name, data, save_immediately=True)
+        self.tab.client.flush()  # viser windows outgoing messages: without this the file waited for the next one
 
     def export_case(self) -> tuple[str, bytes]:
         """Download the edited case's JSON in this tab."""
