@@ -14,7 +14,7 @@ string). For each 3D view mode (``off``: what such a tab starts with, ``light``,
 
 Prints p50 / p95 in milliseconds and cores per mode.
 
-    python bench/editor_browser.py [--modes off light full] [--changes 10] [--idle-s 10] [--json]
+    python bench/editor_browser.py [--modes off light full] [--changes 10] [--idle-s 10] [--screenshots DIR] [--json]
 """
 
 from __future__ import annotations
@@ -139,6 +139,9 @@ def measure(args: argparse.Namespace, tmp: Path) -> dict:
                 tab.display.set_view_mode(mode)
                 settle(tab)
                 time.sleep(3.0)  # meshes sent to the page when the view came on are drawn
+                if args.screenshots is not None:
+                    args.screenshots.mkdir(parents=True, exist_ok=True)
+                    page.screenshot(path=str(args.screenshots / f"editor_view_{mode}.png"))
                 idle = idle_cores(args.idle_s)
                 latencies = slider_latencies(page, tab, args.changes)
                 results[mode] = {**idle, **{name: stats(values) for name, values in latencies.items()}}
@@ -153,6 +156,7 @@ def main() -> int:
     parser.add_argument("--modes", nargs="+", choices=("off", "light", "full"), default=["off", "light", "full"])
     parser.add_argument("--changes", type=int, default=10, help="slider changes per mode")
     parser.add_argument("--idle-s", type=float, default=10.0, help="seconds of idle CPU measured per mode")
+    parser.add_argument("--screenshots", type=Path, default=None, help="folder for a screenshot per mode")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     if not Path(CHROMIUM).exists():

@@ -126,8 +126,8 @@ class SceneView:
     """Keeps the viser scene in step with the edited case; rebuilds only the parts whose inputs changed.
 
     ``mode``: ``full`` (viser's lights with shadow maps and its environment map), ``light`` (no shadow maps, no
-    environment map: far cheaper where the browser draws in software) or ``off`` (nothing drawn; the camera
-    preview is the view)."""
+    environment map: far cheaper where the browser draws in software) or ``off`` (no scene drawn; the camera
+    preview fills the view as its background image)."""
 
     def __init__(self, scene: viser.SceneApi) -> None:
         self.scene = scene
@@ -146,11 +146,17 @@ class SceneView:
         """Draw the view in ``mode`` (see the class)."""
         self.mode = mode
         self.root.visible = mode != "off"
+        if mode != "off":
+            self.scene.set_background_image(None)
         if mode == "full":
             self.scene.configure_environment_map()
         else:
             self.scene.configure_environment_map(hdri=None)
         self.scene.configure_default_lights(enabled=True, cast_shadow=mode == "full")
+
+    def show_backdrop(self, rgb: np.ndarray) -> None:
+        """With the view off: the camera preview ``rgb`` (H, W, 3) uint8 fills the 3D view's place."""
+        self.scene.set_background_image(rgb, format="jpeg", jpeg_quality=85)
 
     def show(self, compiled: CompiledScene, road_key: str, illusion_keys: list[str], selected: int | None) -> None:
         """Show ``compiled``: the road and roadside when ``road_key`` changed, each illusion whose key changed."""

@@ -228,6 +228,8 @@ class EditorTab:
         self.display.image.image = result.rgb
         self.push_log.append((result.request.seq, time.perf_counter()))
         self.display.publish(result)
+        if self.view.mode == "off":  # the camera preview is the main view
+            self.view.show_backdrop(result.rgb)
         self.last_result = result
         if result.request.draft:  # a draft's state is about to be replaced or refined
             return

@@ -262,7 +262,7 @@ def test_detector_lanes_and_accuracy_captions(page, live_server, screenshot_dir)
 
     page.locator(f"{CARD} input[data-control=azimuth]").fill("150")  # a slider moves the score with the frame
     assert wait_scored(page, "original", "sun_azimuth=150").startswith("hough · accuracy\xa0")
-    assert "sun 150°" in page.locator(f'{CARD} figure[data-role="original"] .frame__label').inner_text()
+    assert "sun azimuth 150°" in page.locator(f'{CARD} figure[data-role="original"] .frame__label').inner_text()
 
     select.select_option("")
     plain = wait_new(page, PERTURBED, hough["url"])

@@ -12,7 +12,6 @@ from pathlib import Path
 import pytest
 
 from app.editor import Editor, launch_editor
-from app.editor.scene_view import VIEW_MODES
 from app.state import AppState
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -40,8 +39,9 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
 
 def dropdowns(page) -> list[str]:
     """The values the page's dropdowns show, but the 3D view's (the test fixture switches it as the tab opens)."""
-    values = page.locator("input[role=combobox]").evaluate_all("(inputs) => inputs.map((i) => i.value)")
-    return [value for value in values if value not in VIEW_MODES]
+    return page.locator("input[role=combobox]").evaluate_all(
+        "(inputs) => inputs.filter((i) => !i.closest('.mantine-Flex-root')?.querySelector('label')?.textContent"
+        "  ?.startsWith('3D view')).map((i) => i.value)")
 
 
 def open_tab(browser, editor: Editor, url: str):
