@@ -131,3 +131,25 @@ def test_arrow_keys_on_a_focused_slider_never_move_the_3d_camera(browser, editor
     time.sleep(2)
     assert tuple(tab.client.camera.position) == pytest.approx(camera, abs=1e-6)
     page.close()
+
+
+def test_a_second_sun_is_placed_only_once_confirmed_and_its_owner_is_named(browser, editor: Editor, editor_url: str,
+                                                                         pick, wait_for, screenshot_dir: Path) -> None:
+    page, tab = open_page(browser, editor, editor_url)
+    tab.cases.open_case("fence_shadow-00_uphill_rural_noon-03_level3")  # a fence shadow: it places the sun
+    wait_for(lambda: tab.view.surface is not None and tab.preview.wait_idle(WAIT_S), "the fence case")
+    page.get_by_text("Sun set by illusion").first.wait_for()
+    pick(page, "(pick a type, then click the road)", "sunlight_reflection")
+    wait_for(lambda: tab.illusions.place_type.value == "sunlight_reflection", "the Place dropdown")
+    time.sleep(3)  # the page has drawn the fence case's road
+    page.mouse.click(*ROAD_CLICK)
+    wait_for(lambda: tab.illusions.pending_sun is not None, "the question")
+    assert len(tab.case.illusions) == 1  # nothing placed before the answer
+    page.get_by_text("One sun for the whole case").first.wait_for()
+    page.screenshot(path=str(screenshot_dir / "editor_sun_question.png"), timeout=SLOW_MS)
+    page.get_by_role("button", name="Place it: its sun wins").click()
+    wait_for(lambda: [i.type for i in tab.case.illusions] == ["fence_shadow", "sunlight_reflection"], "the placing")
+    assert tab.preview.wait_idle(WAIT_S)
+    page.get_by_text("overrides the sun of 0: fence").first.wait_for()
+    assert tab.sun.altitude.disabled and tab.sun.azimuth.disabled
+    page.close()

@@ -15,6 +15,7 @@ from ...meshes import MeshUploadError, store_mesh
 from ..params import ParamInputs
 from ..placement import anchor_road, placement_fields, ray_surface_hit, road_coordinates
 from ..session import CaseSession
+from ..text import escape_markdown
 from .base import EditError, set_value
 
 if TYPE_CHECKING:
@@ -100,9 +101,9 @@ class IllusionsPanel:
         self.pending_sun = (illusion_type, s_road, t_road)
         gui = self.tab.client.gui
         with gui.add_modal("One sun for the whole case") as modal:
-            gui.add_markdown(f"**{illusion_type}** places the sun itself, and so does {', '.join(rivals)}. A case "
-                             f"has one sun: the illusion placed last sets it, and the others' shadows or glare "
-                             f"follow it.")
+            gui.add_markdown(f"**{escape_markdown(illusion_type)}** places the sun itself, and so does "
+                             f"{escape_markdown(', '.join(rivals))}. A case has one sun: the illusion placed last "
+                             "sets it, and the others' shadows or glare follow it.")
             place = gui.add_button("Place it: its sun wins", color="orange")
             cancel = gui.add_button("Cancel")
         self._modal = modal
