@@ -153,6 +153,11 @@ def test_the_start_screen_offers_new_recent_and_a_searchable_library(tab: Editor
     assert list(start.type.options) == ["(any)", "fence_shadow"]
     start.search.value = "level3 uphill"
     assert [label.split(" — ")[0] for label in start.case.options] == [SHADOW]
+    thumbnail = start.show_thumbnail()
+    assert thumbnail is not None
+    thumbnail.join(120)
+    assert start.thumbnail.image is not None and start.thumbnail.image.shape == (180, 320, 3)
+    assert start.thumbnail.image.std() > 10  # a rendered road, not the grey placeholder
     start.open(start._chosen())
     assert tab.session is not None and tab.session.case_id == SHADOW and start.modal is None
     tab.cases.title.value = "touched"

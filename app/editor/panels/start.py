@@ -3,11 +3,13 @@ type, original) with a search box. Choosing closes it; *Close* keeps the case th
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import PurePosixPath
 from typing import TYPE_CHECKING
 
+import numpy as np
 import viser
 from viser._gui_handles import GuiModalHandle  # not re-exported by viser 1.x
 
@@ -23,6 +25,7 @@ if TYPE_CHECKING:
 ANY = "(any)"
 NONE_FOUND = "(no case matches)"
 RECENT_COUNT = 8
+THUMBNAIL_SIZE = (320, 180)
 
 
 @dataclass(frozen=True)
@@ -86,6 +89,9 @@ class StartScreen:
             self.type = gui.add_dropdown("Type", [ANY])
             self.case = gui.add_dropdown("Case", [NONE_FOUND])
             self.found = gui.add_markdown("")
+            self.thumbnail = gui.add_image(np.full((THUMBNAIL_SIZE[1], THUMBNAIL_SIZE[0], 3), 200, np.uint8),
+                                           label="First frame", format="jpeg", jpeg_quality=80)
+            self.case.on_update(guarded(lambda e: self.show_thumbnail()))
             for handle in (self.search, self.category, self.type):
                 handle.on_update(guarded(lambda e: self.filter()))
             gui.add_button("Open from the library").on_click(guarded(lambda e: self.open(self._chosen())))
@@ -104,7 +110,25 @@ class StartScreen:
         with self.tab.syncing():
             self.case.options = [row.label for row in rows] or [NONE_FOUND]
         self.found.content = f"{len(rows)} of {len(self.rows)} cases"
+        self.show_thumbnail()
         return rows
+
+    def show_thumbnail(self) -> threading.Thread | None:
+        """Show the first frame of the chosen case, small (a draft render, cached by the frame service), once a
+        background thread has rendered it; returns that thread."""
+        case_id = self._chosen()
+        if case_id == NONE_FOUND or case_id not in self.tab.state.store:
+            return None
+        case = self.tab.state.store.get(case_id).case
+
+        def render() -> None:
+            rgb = self.tab.state.frames.draft(case, 0, THUMBNAIL_SIZE).rgb
+            if self._chosen() == case_id:  # still the chosen case
+                self.thumbnail.image = rgb
+
+        thread = threading.Thread(target=render, name="lanevil-editor-thumbnail", daemon=True)
+        thread.start()
+        return thread
 
     def _chosen(self) -> str:
         return str(self.case.value).split(" — ", 1)[0]
