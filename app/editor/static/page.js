@@ -3,7 +3,7 @@
 //    viser for a lower pixel ratio (?fixedDpr), and tells the editor in a cookie sent with the websocket
 //    handshake, so the tab starts with its 3D view off (the camera preview is the main view).
 // 2. Arrow keys on a focused slider move the slider, never the 3D camera (viser's camera keys listen on the
-//    document; this listener is added first and stops them for keys aimed at a form control).
+//    document; this listener is added first and stops those keys, and only those, aimed at a form control).
 (() => {
   const SOFTWARE = /swiftshader|llvmpipe|softpipe|software|basic render|mesa offscreen/i;
   let renderer = "none";
@@ -30,7 +30,9 @@
     window.history.replaceState(null, "", `${window.location.pathname}?${params}${window.location.hash}`);
   }
   const FORM = '[role="slider"], input, textarea, select, [contenteditable="true"]';
+  const CAMERA_KEYS = /^(Arrow(Up|Down|Left|Right)|Key[WASDQE])$/;  // viser's camera keys; Ctrl+Z still undoes
   document.addEventListener("keydown", (event) => {
-    if (event.target instanceof Element && event.target.closest(FORM)) event.stopImmediatePropagation();
+    const aimed = event.target instanceof Element && event.target.closest(FORM);
+    if (aimed && CAMERA_KEYS.test(event.code) && !event.ctrlKey && !event.metaKey) event.stopImmediatePropagation();
   });
 })();
