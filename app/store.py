@@ -22,8 +22,7 @@ from typing import Any, Literal
 
 from lanevil_core.case import Case, CaseError, case_json, load_case, parse_case
 from lanevil_core.files import remove_stale_temps, write_atomic
-from lanevil_core.illusions import REGISTRY
-from lanevil_core.library.benchmark_layout import case_illusion_type, case_name, folder_type
+from lanevil_core.library.benchmark_layout import case_illusion_type, case_name, case_types, folder_type, type_category
 from lanevil_core.library.stock import CATEGORY_FOLDERS as STOCK_FOLDERS
 
 from .meshes import legacy_mesh_files
@@ -77,14 +76,20 @@ class CaseRecord:
 
     @property
     def illusion_type(self) -> str | None:
-        """The case's first illusion type, or for a stock original the type its folder names."""
+        """The case's illusion type (several joined by ``+``: a mixed case), or for a stock original the type its
+        folder names."""
         return case_illusion_type(self.case, _origin_type(self.origin))
 
     @property
+    def illusion_types(self) -> tuple[str, ...]:
+        """Every illusion type the case holds (its folder's for a stock original)."""
+        return case_types(self.case, _origin_type(self.origin))
+
+    @property
     def category(self) -> str:
-        """``road_damage`` / ``traffic`` / ``shadow`` / ``reflection``, or ``clean``."""
+        """``road_damage`` / ``traffic`` / ``shadow`` / ``reflection``, ``mixed`` (several types), or ``clean``."""
         illusion_type = self.illusion_type
-        return REGISTRY[illusion_type].CATEGORY if illusion_type else "clean"
+        return type_category(illusion_type) if illusion_type else "clean"
 
     @property
     def severity(self) -> int:
@@ -200,7 +205,7 @@ class CaseStore:
         if category is not None:
             records = [record for record in records if record.category == category]
         if illusion_type is not None:
-            records = [record for record in records if record.illusion_type == illusion_type]
+            records = [record for record in records if illusion_type in (record.illusion_type, *record.illusion_types)]
         return records
 
     def get(self, case_id: str) -> CaseRecord:

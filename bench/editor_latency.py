@@ -16,19 +16,20 @@ import json
 import shutil
 import tempfile
 import time
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 
 from app.editor import EditorTab, HeadlessTab, launch_editor
 from app.settings import Settings
 from app.state import AppState
+from app.store import stock_id
 
 REPO = Path(__file__).resolve().parents[1]
 
 CASES = ["00_clean/00_straight_urban.json", "30_shadow/fence_shadow/00_uphill_rural_noon/03_level3.json",
          "20_traffic/vehicle/00_straight_highway_noon/03_level3.json"]
-CASE_ID = "fence_shadow-03_level3"
+SHADOW_CASE = 1  # the case of CASES whose severity and sun are changed
 BURST_GAP_S = 0.02  # a slider dragged at 50 updates per second
 
 
@@ -80,26 +81,29 @@ def main() -> int:
             (scenes / relative).parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(REPO / "scenes" / relative, scenes / relative)
         state = AppState.open(Settings(data_dir=Path(tmp) / "data", scenes_dir=scenes, port=0, editor_port=0))
+        case_id = stock_id(PurePosixPath(CASES[SHADOW_CASE]))  # the store's id of that file, as seeding names it
+        if case_id not in state.store:
+            raise SystemExit(f"{CASES[SHADOW_CASE]} was not seeded as {case_id!r}; the store holds "
+                             f"{', '.join(record.id for record in state.store.list())}")
         server = launch_editor(state, host="127.0.0.1", port=0)
         try:
             with HeadlessTab(server, timeout=300) as editor:
-                p = editor.panel
-                p.quality.value = "full"
-                p.case_id.value = CASE_ID
+                editor.display.quality.value = "full"
+                editor.cases.case_id.value = case_id
                 editor.preview.wait_idle(300)
-                p.selected.value = p.selected.options[1]
+                editor.illusions.selected.value = editor.illusions.selected.options[1]
                 editor.preview.wait_idle(300)
                 n = args.repeats
                 frames = [(i * 7) % 90 + 1 for i in range(n)]
                 severities = [(i % 5) + 1 for i in range(n)]
                 altitudes = [10.0 + 5 * (i % 12) for i in range(n)]
-                single(editor, p.frame, [0, 1])  # warm the kernels and caches
+                single(editor, editor.display.frame, [0, 1])  # warm the kernels and caches
                 results = {
-                    "frame": stats(single(editor, p.frame, frames)),
-                    "severity": stats(single(editor, p.severity, severities)),
-                    "sun_altitude": stats(single(editor, p.sun_altitude, altitudes)),
-                    "frame_drag": stats(burst(editor, p.frame, list(range(10, 10 + 2 * n)))),
-                    "sun_drag": stats(burst(editor, p.sun_altitude, [20.0 + i for i in range(2 * n)])),
+                    "frame": stats(single(editor, editor.display.frame, frames)),
+                    "severity": stats(single(editor, editor.illusions.severity, severities)),
+                    "sun_altitude": stats(single(editor, editor.sun.altitude, altitudes)),
+                    "frame_drag": stats(burst(editor, editor.display.frame, list(range(10, 10 + 2 * n)))),
+                    "sun_drag": stats(burst(editor, editor.sun.altitude, [20.0 + i for i in range(2 * n)])),
                     "renders_dropped_by_coalescing": editor.preview.dropped,
                     "compiles": {"full": state.frames.full_compiles, "partial": state.frames.partial_compiles},
                 }

@@ -68,12 +68,12 @@ def drag(tab: EditorTab, handle, values) -> list[float]:
 
 def scrubs(tab: EditorTab, steps: int, fresh: float) -> dict[str, list[float]]:
     """Severity dragged up and down through its levels, then the sun's altitude, from a new sun azimuth."""
-    p = tab.panel
-    p.sun_azimuth.value = fresh  # a state no cache has seen
+    tab.sun.azimuth.value = fresh  # a state no cache has seen
     assert tab.preview.wait_idle(WAIT_S)
     severities = [1 + (i % 8 if i % 8 < 5 else 8 - i % 8) for i in range(steps)]  # 1 2 3 4 5 4 3 2 1 ...
     altitudes = [20.0 + fresh / 10.0 + 2.0 * i for i in range(steps)]
-    return {"severity": drag(tab, p.severity, severities), "sun": drag(tab, p.sun_altitude, altitudes)}
+    return {"severity": drag(tab, tab.illusions.severity, severities),
+            "sun": drag(tab, tab.sun.altitude, altitudes)}
 
 
 def stats(values: list[float]) -> tuple[float, float]:
@@ -97,15 +97,15 @@ def main() -> int:
         try:
             with HeadlessTab(editor, timeout=WAIT_S) as tab:
                 for case_id, _relative, _camera in CASES:  # warm: kernels, roadside, first compile of each case
-                    tab.panel.case_id.value = case_id
+                    tab.cases.case_id.value = case_id
                     assert tab.preview.wait_idle(WAIT_S)
                     scrubs(tab, 3, fresh=-170.0)
                 fresh = -160.0
                 for run in range(args.runs):
                     for quality in QUALITIES if run % 2 == 0 else QUALITIES[::-1]:
-                        tab.panel.quality.value = quality
+                        tab.display.quality.value = quality
                         for case_id, _relative, _camera in CASES:
-                            tab.panel.case_id.value = case_id
+                            tab.cases.case_id.value = case_id
                             assert tab.preview.wait_idle(WAIT_S)
                             fresh += 7.0
                             for slider, latencies in scrubs(tab, args.steps, fresh).items():

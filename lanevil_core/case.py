@@ -63,6 +63,24 @@ def default_markings(lanes_per_direction: int) -> list[Marking]:
     return [Marking(type=name) for name in names]
 
 
+def resize_markings(markings: list[Marking], lanes_per_direction: int) -> list[Marking]:
+    """``markings`` (left to right) for another lane count, keeping what they paint: both edges, the centre line,
+    and each side's lane-line style (its line nearest the centre; the default where a side had no lane line).
+    The defaults of one count become the defaults of the other."""
+    old = (len(markings) - 1) // 2
+    n = lanes_per_direction
+    lane_line = default_markings(2)[1]
+    left = markings[old - 1] if old > 1 else lane_line
+    right = markings[old + 1] if old > 1 else lane_line
+    return [markings[0], *[left] * (n - 1), markings[old], *[right] * (n - 1), markings[-1]]
+
+
+def _default_of_other_count(markings: list[Marking]) -> bool:
+    """Whether ``markings`` are exactly the defaults of some lane count (then a changed count re-derives them)."""
+    lanes, odd = divmod(len(markings) - 1, 2)
+    return odd == 0 and lanes >= 1 and markings == default_markings(lanes)
+
+
 class Road(_Model):
     """Road layout: a reference line (line/arc/clothoid pieces), an elevation profile, lanes and paint.
 
@@ -80,7 +98,8 @@ class Road(_Model):
     markings: list[Marking] = Field(
         default_factory=list,
         description="paint of every lane boundary, left to right as seen by the ego "
-        "(2 * lanes_per_direction + 1 entries; empty = defaults)",
+        "(2 * lanes_per_direction + 1 entries; empty = defaults; the defaults of another lane count are "
+        "re-derived for this one)",
     )
     pavement: Pavement = Field(
         "asphalt",
@@ -96,7 +115,8 @@ class Road(_Model):
     @model_validator(mode="after")
     def _fill_markings(self) -> Road:
         expected = 2 * self.lanes_per_direction + 1
-        if not self.markings:
+        if not self.markings or _default_of_other_count(self.markings):
+            # the defaults of another lane count (a case whose lanes changed): the defaults of this one
             object.__setattr__(self, "markings", default_markings(self.lanes_per_direction))
         elif len(self.markings) != expected:
             raise ValueError(

@@ -21,6 +21,7 @@ from pydantic import BaseModel, Field, ValidationError
 
 from lanevil_core.case import Case
 from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
+from lanevil_core.library.benchmark_layout import MIXED_CATEGORY
 from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..state import AppState
@@ -31,7 +32,7 @@ from .params import VERSION_PATTERN, etag_matches, parse_version
 
 router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
-LISTING_CATEGORIES = ("clean", *CATEGORIES)
+LISTING_CATEGORIES = ("clean", *CATEGORIES, MIXED_CATEGORY)
 ENVELOPE_KEYS = frozenset({"id", "version", "case", "created_at", "updated_at", "origin"})
 CONFLICT: dict[int | str, dict[str, Any]] = {
     409: {"model": ErrorBody, "description": "stale version (the message says the current one)"}}
@@ -212,10 +213,22 @@ def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: I
     current = state.store.get(case_id)
     if version is not None and version != current.version:
         raise VersionConflict(case_id, version, current.version)
+    patch = lane_count_patch(patch, current.case.road.lanes_per_direction)
     merged = merge_patch(current.case.model_dump(mode="json"), patch)
     case = validate_case(merged, "case" if "case" in body else "", state)
     # the patch applies to ``current``: only write if nobody changed the case since it was read
     return record_response(state.store.update(case_id, case, expected_version=current.version))
+
+
+def lane_count_patch(patch: Any, lanes_per_direction: int) -> Any:
+    """``patch``, resetting the road's markings to the new lane count's defaults when it changes
+    ``road.lanes_per_direction`` without giving ``road.markings`` (the old markings have the wrong count)."""
+    road = patch.get("road") if isinstance(patch, dict) else None
+    if not isinstance(road, dict) or road.get("lanes_per_direction", lanes_per_direction) == lanes_per_direction:
+        return patch
+    if "markings" in road:
+        return patch
+    return {**patch, "road": {**road, "markings": None}}
 
 
 @router.delete("/{case_id}", status_code=204, summary="Delete a case", responses={**NOT_FOUND, **CONFLICT})

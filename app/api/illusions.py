@@ -23,6 +23,8 @@ class IllusionInfo(BaseModel):
     description: str
     parameters: dict[str, dict[str, Any]] = Field(description="field -> type, range, default, description")
     severity: list[dict[str, Any]] = Field(description="the five-row severity table, level 1 first")
+    sun: str = Field(description="case: the type leaves the sun alone; overrides: it places the sun and its sun_* "
+                                 "fields (the sun sliders) move it; table: its severity table places the sun")
 
 
 class IllusionRegistry(BaseModel):

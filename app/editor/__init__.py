@@ -6,6 +6,7 @@ tab that connects gets its own ``EditorTab`` (panel, 3D view, preview and case s
 
 from .editor import Editor, launch_editor
 from .headless import HeadlessTab
-from .tab import EditError, EditorTab
+from .panels import EditError
+from .tab import EditorTab
 
 __all__ = ["EditError", "Editor", "EditorTab", "HeadlessTab", "launch_editor"]

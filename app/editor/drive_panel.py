@@ -22,6 +22,7 @@ from lanevil_core.drive.controllers import CONTROLLERS
 from lanevil_core.drive.detectors import GROUND_TRUTH
 from lanevil_core.drive.loop import DEFAULT_SIZE, DriveSettings
 from lanevil_core.drive.outputs import SUMMARY_FILE, TRACE_PLOT_FILE
+from lanevil_core.drive.summary import verdict
 
 from ..jobs import Job, drive_job
 from ..state import AppState
@@ -59,8 +60,8 @@ def video_frames(folder: Path, limit: int = MAX_FRAMES) -> list[np.ndarray]:
 def verdict_text(summary: dict) -> str:
     """Markdown: the paper's criterion on the drive, max deviation, departures."""
     exceed = f"at {summary['t_exceed']:.1f} s" if summary.get("t_exceed") is not None else "never"
-    verdict = "**illusion succeeded**" if summary["success"] else "no success"
-    return (f"{verdict} (|deviation| > 0.285 m within 2.5 s of coming into view) · > 0.285 m {exceed} · "
+    phrase = verdict(summary["success"], summary.get("illusion_span") is not None, summary["max_abs_deviation"])
+    return (f"**{phrase}** (attack: |deviation| > 0.285 m within 2.5 s of coming into view) · > 0.285 m {exceed} · "
             f"max {summary['max_abs_deviation']:.3f} m · lane departure {'yes' if summary['lane_departure'] else 'no'}"
             f" · off road {'yes' if summary['off_road'] else 'no'} · {escape_markdown(summary['detector'])} + "
             f"{escape_markdown(summary['controller'])}")

@@ -14,7 +14,8 @@ import time
 import viser
 
 from ..state import AppState
-from .origins import OriginCheck, checking_origins
+from .origins import OriginCheck, hooking_requests
+from .page import browser_webgl, serve_page
 from .tab import EditError, EditorTab
 
 
@@ -71,7 +72,7 @@ class Editor:
     def _connect(self, client: viser.ClientHandle) -> None:
         with self._changed:
             case_id, self._next_case = self._next_case, None
-        tab = EditorTab(self.state, client, case_id)
+        tab = EditorTab(self.state, client, case_id, browser_webgl(self.server, client.client_id))
         with self._changed:
             if self._stopped or client.client_id in self._gone:
                 self._gone.discard(client.client_id)
@@ -101,7 +102,7 @@ def launch_editor(state: AppState, host: str = "127.0.0.1", port: int = 8080, ap
     bound: list[int] = []
     ports = {state.settings.port if api_port is None else api_port}
     check = OriginCheck(host, lambda: {*bound, *ports}, state.settings.allowed_origins)
-    with checking_origins(check):
+    with hooking_requests([check.process_request, serve_page]):
         server = viser.ViserServer(host=host, port=port, label="LanEvil editor", verbose=False)
     bound.append(server.get_port())
     return Editor(state, server)

@@ -5,9 +5,10 @@ check any web site a user visits could drive the editor on ``localhost:8080``. A
 own ports on loopback names and the bound host, same-origin pages when the server listens on every interface, and
 ``Settings.allowed_origins`` (``*`` = any). A handshake without ``Origin`` (not a browser) is let through.
 
-viser 1.x builds its ``websockets`` server inside ``ViserServer()`` with no option for this, so ``checking_origins``
-wraps ``websockets.asyncio.server.serve`` while that server starts, adding the check in front of viser's own
-``process_request`` (which serves the client files); nothing else of viser changes.
+viser 1.x builds its ``websockets`` server inside ``ViserServer()`` with no option for this, so ``hooking_requests``
+wraps ``websockets.asyncio.server.serve`` while that server starts, adding hooks (this check, and ``page.py``'s page
+with the editor's script) in front of viser's own ``process_request`` (which serves the client files); nothing else
+of viser changes.
 """
 
 from __future__ import annotations
@@ -62,24 +63,34 @@ class OriginCheck:
         return connection.respond(http.HTTPStatus.FORBIDDEN, "this page's origin may not open the editor\n")
 
 
+RequestHook = Callable[[ServerConnection, Request], Response | None]
+
+
 @contextmanager
-def checking_origins(check: OriginCheck) -> Iterator[None]:
-    """While the block runs, websocket servers started through ``websockets.asyncio.server.serve`` check origins
-    with ``check`` before their own ``process_request``."""
+def hooking_requests(hooks: list[RequestHook]) -> Iterator[None]:
+    """While the block runs, websocket servers started through ``websockets.asyncio.server.serve`` pass every
+    HTTP request (page, files, websocket handshake) through ``hooks`` in order before their own
+    ``process_request``; the first response a hook gives is the answer."""
     serve = websockets.asyncio.server.serve
 
-    def checked_serve(*args: Any, process_request: Any = None, **kwargs: Any) -> Any:
+    def hooked_serve(*args: Any, process_request: Any = None, **kwargs: Any) -> Any:
         def process(connection: ServerConnection, request: Request) -> Any:
-            refused = check.process_request(connection, request)
-            if refused is not None or process_request is None:
-                return refused
-            return process_request(connection, request)
+            for hook in hooks:
+                answer = hook(connection, request)
+                if answer is not None:
+                    return answer
+            return None if process_request is None else process_request(connection, request)
 
         return serve(*args, process_request=process, **kwargs)
 
     with _patch_lock:
-        websockets.asyncio.server.serve = checked_serve  # type: ignore[misc,assignment]
+        websockets.asyncio.server.serve = hooked_serve  # type: ignore[misc,assignment]
         try:
             yield
         finally:
             websockets.asyncio.server.serve = serve  # type: ignore[misc]
+
+
+def checking_origins(check: OriginCheck) -> Any:
+    """``hooking_requests`` with the origin check alone."""
+    return hooking_requests([check.process_request])

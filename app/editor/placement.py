@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any, get_args
 
 import numpy as np
+from pydantic import BaseModel
 
 from lanevil_core.case import Case
 from lanevil_core.illusions import Illusion
@@ -93,7 +94,7 @@ def _literal_options(model: type[Illusion], name: str) -> tuple[Any, ...]:
     return tuple(get_args(annotation))
 
 
-def field_bounds(model: type[Illusion], name: str) -> tuple[float, float]:
+def field_bounds(model: type[BaseModel], name: str) -> tuple[float, float]:
     """(low, high) of a numeric field from its ge/gt/le/lt constraints (infinite where unbounded)."""
     low, high = -np.inf, np.inf
     for meta in model.model_fields[name].metadata:

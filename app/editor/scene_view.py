@@ -16,6 +16,7 @@ written as glTF vertex colours (linear by the glTF spec), so the view matches th
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -112,11 +113,22 @@ def road_pose(network: RoadNetwork, s_road: float, t_road: float, lift: float = 
     return wxyz_of(R_world_local), line.to_world(s_road, t_road, lift)
 
 
+WORLD = "/world"  # every node of the view hangs under this frame, so hiding it hides the view
+ViewMode = Literal["full", "light", "off"]
+VIEW_MODES: tuple[ViewMode, ...] = ("full", "light", "off")
+
+
 class SceneView:
-    """Keeps the viser scene in step with the edited case; rebuilds only the parts whose inputs changed."""
+    """Keeps the viser scene in step with the edited case; rebuilds only the parts whose inputs changed.
+
+    ``mode``: ``full`` (viser's lights with shadow maps and its environment map), ``light`` (no shadow maps, no
+    environment map: far cheaper where the browser draws in software) or ``off`` (no scene drawn; the camera
+    preview fills the view as its background image)."""
 
     def __init__(self, scene: viser.SceneApi) -> None:
         self.scene = scene
+        self.mode: ViewMode = "full"
+        self.root = scene.add_frame(WORLD, show_axes=False)
         self._road_key: str | None = None
         self._illusion_keys: list[str] = []
         self._selected: int | None = None
@@ -126,6 +138,22 @@ class SceneView:
         self._on_move: MoveHandler | None = None
         self._frustum: viser.CameraFrustumHandle | None = None
 
+    def set_mode(self, mode: ViewMode) -> None:
+        """Draw the view in ``mode`` (see the class)."""
+        self.mode = mode
+        self.root.visible = mode != "off"
+        if mode != "off":
+            self.scene.set_background_image(None)
+        if mode == "full":
+            self.scene.configure_environment_map()
+        else:
+            self.scene.configure_environment_map(hdri=None)
+        self.scene.configure_default_lights(enabled=True, cast_shadow=mode == "full")
+
+    def show_backdrop(self, rgb: np.ndarray) -> None:
+        """With the view off: the camera preview ``rgb`` (H, W, 3) uint8 fills the 3D view's place."""
+        self.scene.set_background_image(rgb, format="jpeg", jpeg_quality=85)
+
     def show(self, compiled: CompiledScene, road_key: str, illusion_keys: list[str], selected: int | None) -> None:
         """Show ``compiled``: the road and roadside when ``road_key`` changed, each illusion whose key changed."""
         if road_key != self._road_key:
@@ -133,7 +161,7 @@ class SceneView:
             self.surface = road_surface(compiled.network)
             roadside = [m for m in compiled.meshes if m.source < 0]
             parts = road_parts(self.surface, compiled.network, compiled.case) + mesh_parts(roadside)
-            self.scene.add_mesh_trimesh("/road", flat_trimesh(*merged(parts)), cast_shadow=False)
+            self.scene.add_mesh_trimesh(f"{WORLD}/road", flat_trimesh(*merged(parts)), cast_shadow=False)
             self._show_trajectory(compiled.case, compiled.network)
             self._road_key = road_key
             self._illusion_keys = []
@@ -143,13 +171,13 @@ class SceneView:
             if stale or (index == selected) != (index == self._selected):
                 self._show_illusion(compiled, index, index == selected)
         for index in range(len(illusion_keys), len(self._illusion_keys)):
-            self.scene.remove_by_name(f"/illusions/{index:02d}")
+            self.scene.remove_by_name(f"{WORLD}/illusions/{index:02d}")
         self._illusion_keys = list(illusion_keys)
         self._selected = selected
         self._show_sun(compiled)
 
     def _show_illusion(self, compiled: CompiledScene, index: int, selected: bool) -> None:
-        name = f"/illusions/{index:02d}"
+        name = f"{WORLD}/illusions/{index:02d}"
         self.scene.remove_by_name(name)
         self.scene.add_frame(name, show_axes=False)
         parts = mesh_parts([m for m in compiled.meshes if m.source == index])
@@ -165,7 +193,7 @@ class SceneView:
     def _show_trajectory(self, case: Case, network: RoadNetwork) -> None:
         frames = range(0, case.ego.frames, max(1, case.ego.frames // 50))
         points = np.array([ego_camera(case, network, frame).p_world_camera for frame in frames])
-        self.scene.add_spline_catmull_rom("/trajectory", points, thickness=3.0, thickness_units="screen",
+        self.scene.add_spline_catmull_rom(f"{WORLD}/trajectory", points, thickness=3.0, thickness_units="screen",
                                           color=TRAJECTORY_COLOR)
 
     def _show_sun(self, compiled: CompiledScene) -> None:
@@ -174,9 +202,9 @@ class SceneView:
         base = line.to_world(s_mid, 0.0, 0.5)
         tip = base + compiled.env.sun_dir_world * SUN_ARROW_M
         color = SUN_COLOR if compiled.env.sun_intensity > 0 and not compiled.env.night else (120, 120, 160)
-        self.scene.add_line_segments("/sun/ray", np.array([[base, tip]]), colors=color, thickness=3.0,
+        self.scene.add_line_segments(f"{WORLD}/sun/ray", np.array([[base, tip]]), colors=color, thickness=3.0,
                                      thickness_units="screen")
-        self.scene.add_icosphere("/sun/ball", radius=1.5, color=color, position=tip, cast_shadow=False)
+        self.scene.add_icosphere(f"{WORLD}/sun/ball", radius=1.5, color=color, position=tip, cast_shadow=False)
 
     def show_camera(self, camera: PinholeCamera) -> None:
         """The ego camera's frustum at the current frame."""
@@ -184,9 +212,9 @@ class SceneView:
         fov_vertical = 2.0 * float(np.arctan(0.5 * k.height / k.fy))
         wxyz, position = wxyz_of(camera.R_world_camera), camera.p_world_camera
         if self._frustum is None:
-            self._frustum = self.scene.add_camera_frustum("/camera", fov=fov_vertical, aspect=k.width / k.height,
-                                                          scale=1.6, color=FRUSTUM_COLOR, thickness=2.5,
-                                                          thickness_units="screen",
+            self._frustum = self.scene.add_camera_frustum(f"{WORLD}/camera", fov=fov_vertical,
+                                                          aspect=k.width / k.height, scale=1.6, color=FRUSTUM_COLOR,
+                                                          thickness=2.5, thickness_units="screen",
                                                           wxyz=wxyz, position=position)
         else:
             self._frustum.fov, self._frustum.aspect = fov_vertical, k.width / k.height
@@ -201,7 +229,7 @@ class SceneView:
         wxyz, position = road_pose(self.network, anchor[0], anchor[1], GIZMO_LIFT_M)
         if self._gizmo is None:
             self._gizmo = self.scene.add_transform_controls(
-                "/gizmo", scale=4.0, disable_rotations=True, active_axes=(True, True, False),
+                f"{WORLD}/gizmo", scale=4.0, disable_rotations=True, active_axes=(True, True, False),
                 depth_test=False, wxyz=wxyz, position=position)
 
             @self._gizmo.on_update

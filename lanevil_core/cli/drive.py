@@ -104,9 +104,8 @@ def _drive(args: argparse.Namespace) -> int:
     if args.json:
         print(summary_json(summary), end="")
     else:
-        verdict = "SUCCESS" if summary.success else "no success"
         exceed = f"{summary.t_exceed:.1f} s" if summary.t_exceed is not None else "never"
-        print(f"{verdict}: max |deviation| {summary.max_abs_deviation:.3f} m, > 0.285 m at {exceed}, "
+        print(f"{summary.verdict}: max |deviation| {summary.max_abs_deviation:.3f} m, > 0.285 m at {exceed}, "
               f"lane departure {'yes' if summary.lane_departure else 'no'}, "
               f"off road {'yes' if summary.off_road else 'no'}; {summary.steps} steps "
               f"({summary.steps_per_second:.1f}/s)")

@@ -10,11 +10,18 @@ import sys
 from pathlib import Path
 
 from ..files import write_atomic
-from ..metrics.formats import LaneFileError
+from ..metrics.formats import LaneFileError, split_note
 from ..metrics.tusimple import F1_VARIANTS
 from .base import Command, UsageError
 
 METRIC_CHOICES = ("tusimple", "culane", "ego", "pixel")
+
+
+def _note_split(path: Path) -> None:
+    """Say on stderr when a dataset folder stands for a split other than its test split."""
+    note = split_note(path)
+    if note is not None:
+        print(f"note: {note}", file=sys.stderr)
 
 
 def _eval_arguments(parser: argparse.ArgumentParser) -> None:
@@ -57,6 +64,7 @@ def _run_eval(args: argparse.Namespace) -> int:
 
     if args.line_width is not None and args.metric != "pixel":
         raise UsageError("--line-width: only with --metric pixel")
+    _note_split(args.gt)
     try:
         result = evaluate(args.gt, args.pred, args.metric, args.f1,
                           args.line_width if args.line_width is not None else LINE_WIDTH_720)
@@ -68,7 +76,8 @@ def _run_eval(args: argparse.Namespace) -> int:
 
 def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or "
-                                                 "images; a dataset folder stands for its test split")
+                                                 "images; a dataset folder stands for its test split (for its only "
+                                                 "split, with a note, when it has no test split)")
     from ..detect.split import METHODS
 
     parser.add_argument("--method", required=True, action="append", metavar="METHOD",
@@ -124,6 +133,7 @@ def _run_detect(args: argparse.Namespace) -> int:
     if several and len(set(stems)) < len(stems) == len(set(args.method)):  # (a method named twice: said below)
         raise UsageError(f"--method: two methods would write the same file in --out ({', '.join(args.method)}); "
                          "name them in LANEVIL_DETECTORS")
+    _note_split(args.split)
     try:
         by_method = detect_split_methods(args.split, args.method, progress, args.fixed_run_time, args.weights)
     except LaneFileError as error:
@@ -193,6 +203,7 @@ def _run_report(args: argparse.Namespace) -> int:
     if len(set(names)) != len(names):
         raise UsageError("--pred: two detectors have the same name; give each a --name")
     detectors = []
+    _note_split(args.gt)
     try:
         gt = split_labels(args.gt)
         for name, pred in zip(names, args.pred, strict=True):

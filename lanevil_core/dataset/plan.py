@@ -31,8 +31,6 @@ from ..camera.variation import random_camera
 from ..case import END_MARGIN_M, Case, case_json, load_case, parse_case
 from ..illusions import REGISTRY
 from ..library.benchmark_layout import (
-    CATEGORY_FOLDERS,
-    TYPE_FOLDERS,
     case_folder,
     case_illusion_type,
     case_name,
@@ -255,12 +253,12 @@ def planned_test_case(source: SourceCase, frames_per_case: int | None,
     if illusion_type is None:
         raise PlanError(f"{source.relative}: a clean case has no test folder")
     folder = case_folder(case, case_name(source.relative), source.folder_type)
+    category, type_folder = folder.parts[0], folder.parts[1]  # case_filing's folders
     severity = case.illusions[0].severity if case.illusions else 0
     return PlannedCase(
         split=TEST_SPLIT, folder=folder, case_text=case_json(case),
         frames=frames if frames is not None else evenly_spaced(case.ego.frames, frames_per_case),
-        illusion_type=illusion_type,
-        category=CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY], type_folder=TYPE_FOLDERS[illusion_type],
+        illusion_type=illusion_type, category=category, type_folder=type_folder,
         severity=severity, source={"file": str(source.relative)},
     )
 
@@ -397,15 +395,29 @@ def _check_unique(cases: list[PlannedCase]) -> None:
         seen[key] = where
 
 
-def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = threads_map) -> DatasetPlan:
-    """The test split from the typed cases, the train split from variations of the clean ones (in-view frames
-    found with ``mapper``)."""
+def split_sources(sources: list[SourceCase], settings: Settings) -> tuple[list[SourceCase], list[SourceCase]]:
+    """(typed, clean): the cases of the test split and the bases of the train split; raises ``PlanError`` for a
+    run that would write nothing or ignore a setting (``--frames-per-case`` with no test case). Cheap: a run
+    checks this before it starts its workers."""
     if not sources:
         raise PlanError("no case files (*.json) found")
     typed = [s for s in sources if case_illusion_type(s.case, s.folder_type) is not None]
     clean = [s for s in sources if case_illusion_type(s.case, s.folder_type) is None]
     if settings.sampling not in SAMPLINGS:
         raise PlanError(f"sampling: {settings.sampling!r} is not one of {', '.join(SAMPLINGS)}")
+    if not typed and settings.frames_per_case is not None:
+        raise PlanError(f"--frames-per-case {settings.frames_per_case}: no test case under --cases (a test case has "
+                        f"an illusion, or sits in an illusion type's folder); the {len(clean)} clean case(s) only "
+                        "seed the train split, sized by --train-frames")
+    if not typed and settings.train_frames <= 0:
+        raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
+    return typed, clean
+
+
+def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = threads_map) -> DatasetPlan:
+    """The test split from the typed cases, the train split from variations of the clean ones (in-view frames
+    found with ``mapper``)."""
+    typed, clean = split_sources(sources, settings)
     chosen = in_view_by_folder(typed, settings.frames_per_case, mapper) if settings.sampling == "in_view" else {}
     planned = [planned_test_case(source, settings.frames_per_case,
                                  chosen.get(str(source.relative.parent))) for source in typed]
@@ -419,8 +431,6 @@ def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = t
             raise PlanError(str(error)) from None
         planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, camera, label)
                    for case in planned]
-    if not planned:
-        raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
     _check_unique(planned)
     return DatasetPlan(settings, tuple(planned))
 

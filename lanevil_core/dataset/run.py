@@ -25,6 +25,7 @@ from .plan import (
     build_plan,
     discover_cases,
     render_tasks,
+    split_sources,
     threads_map,
 )
 from .progress import planning_bar, progress_bar
@@ -131,10 +132,12 @@ def generate_dataset(cases_dir: Path, out_dir: Path, settings: Settings, executo
                      show_progress: bool = True) -> RunSummary:
     """Render the dataset of the cases under ``cases_dir`` into ``out_dir``; frames verified on disk are kept."""
     start = time.perf_counter()
+    sources = discover_cases(cases_dir)
+    split_sources(sources, settings)  # a run that cannot be planned fails before any worker starts
     getattr(executor, "start", lambda: None)()  # e.g. LocalPool: workers start up while the plan is made
     try:
         mapper = counted(getattr(executor, "map", threads_map), show_progress)
-        plan = build_plan(discover_cases(cases_dir), settings, mapper)
+        plan = build_plan(sources, settings, mapper)
         versions = software_versions()  # the render-path sources are hashed before any frame is rendered
         folder = DatasetFolder(out_dir, settings.suffix)
         sidecars = _Sidecars(plan, folder, versions)

@@ -32,8 +32,7 @@ def plots_available() -> bool:
 
 
 def _title(summary: DriveSummary) -> str:
-    verdict = "success" if summary.success else "no success"
-    return f"{summary.title or 'case'}: {summary.detector} + {summary.controller} ({verdict})"
+    return f"{summary.title or 'case'}: {summary.detector} + {summary.controller} ({summary.verdict})"
 
 
 def trace_plot(trace: DriveTrace, summary: DriveSummary) -> bytes:

@@ -18,7 +18,7 @@ from pathlib import Path, PurePosixPath
 from ..case import Case, load_case
 from ..files import write_atomic
 from ..illusions import CATEGORIES, REGISTRY
-from ..library.benchmark_layout import case_illusion_type, folder_type
+from ..library.benchmark_layout import MIXED_CATEGORY, case_illusion_type, folder_type, type_category
 from .loop import DriveSettings
 from .outputs import drive_to_folder
 from .summary import DriveSummary
@@ -48,7 +48,7 @@ def case_group(case: Case, path: Path) -> tuple[str, str, int]:
     if illusion_type is None:
         return CLEAN, case.road.type, 0
     level = max((illusion.severity for illusion in case.illusions), default=0)
-    return REGISTRY[illusion_type].CATEGORY, illusion_type, level
+    return type_category(illusion_type), illusion_type, level
 
 
 def suite_cases(root: Path) -> list[Path]:
@@ -122,8 +122,10 @@ def markdown(entries: list[SuiteEntry], settings: DriveSettings) -> str:
     lines += ["", "## Every drive: success and max |deviation| (m); D = lane departure, X = off the road", "",
               "| category | type | original | L1 | L2 | L3 | L4 | L5 | ASR L1-5 |",
               "|---|---|---|---|---|---|---|---|---|"]
+    order = [*CATEGORIES, MIXED_CATEGORY]  # mixed cases after every category, their types by name
     types = sorted({(e.category, e.type) for e in illusion_entries},
-                   key=lambda key: (CATEGORIES.index(key[0]), list(REGISTRY).index(key[1])))
+                   key=lambda key: (order.index(key[0]), list(REGISTRY).index(key[1]) if key[1] in REGISTRY else 0,
+                                    key[1]))
     for category, type_name in types:
         group = [e for e in illusion_entries if e.type == type_name]
         cells = [_cell([e for e in group if e.level == level]) for level in LEVELS]

@@ -20,6 +20,17 @@ DEVIATION_THRESHOLD_M = 0.285  # the margin between a 3.6 m lane and a 1.8 m wid
 SUCCESS_WINDOW_S = 2.5
 
 
+def verdict(success: bool, illusion: bool, max_abs_deviation: float) -> str:
+    """One phrase for a drive: whether the illusion succeeded, or the car kept its lane (a clean case's "success"
+    is the detector's own failure, named so)."""
+    if success:
+        return "ATTACK SUCCEEDED" if illusion else "LANE LOST (no illusion: the detector's own failure)"
+    if max_abs_deviation <= DEVIATION_THRESHOLD_M:
+        return "LANE KEPT (attack failed)" if illusion else "LANE KEPT"
+    window = f"over {DEVIATION_THRESHOLD_M} m only outside the {SUCCESS_WINDOW_S} s window"
+    return f"ATTACK FAILED (deviation {window})" if illusion else f"LANE KEPT at first (deviation {window})"
+
+
 @dataclass(frozen=True)
 class DriveSummary:
     """One drive in numbers (m, s, radians; None where a moment never came)."""
@@ -44,6 +55,11 @@ class DriveSummary:
     off_road: bool
     t_off_road: float | None
     steps_per_second: float | None
+
+    @property
+    def verdict(self) -> str:
+        """The drive in one phrase (``verdict``)."""
+        return verdict(self.success, self.illusion_span is not None, self.max_abs_deviation)
 
     def as_dict(self) -> dict[str, Any]:
         data = asdict(self)

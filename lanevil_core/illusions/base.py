@@ -90,6 +90,9 @@ class Illusion(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     CATEGORY: ClassVar[Category]
+    # Whether the type places the sun itself (a shadow across the lanes, glare on water, night): of several such
+    # illusions in one case the last one's sun is rendered (``Environment.sun_set_by`` names who set it).
+    SETS_SUN: ClassVar[bool] = False
     # Five rows, level 1 (subtle) to 5 (most deceptive): what each level sets.
     SEVERITY: ClassVar[tuple[Level, ...]]
 

@@ -20,4 +20,13 @@ def illusion_info(cls: type[Illusion]) -> dict[str, Any]:
         parameters[field] = {key: spec[key] for key in keys if key in spec}
     return {"name": cls.model_fields["type"].default, "category": cls.CATEGORY,
             "description": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()), "parameters": parameters,
-            "severity": [dataclasses.asdict(row) for row in cls.SEVERITY]}
+            "severity": [dataclasses.asdict(row) for row in cls.SEVERITY], "sun": sun_control(cls)}
+
+
+def sun_control(cls: type[Illusion]) -> str:
+    """How a type's sun relates to the case's: ``case`` (it leaves the sun alone), ``overrides`` (it places the
+    sun itself, and its ``sun_*`` fields, which sun sliders set, move it) or ``table`` (its severity table places
+    the sun; no slider moves it)."""
+    if not cls.SETS_SUN:
+        return "case"
+    return "overrides" if all(f"sun_{name}" in cls.model_fields for name in ("azimuth", "altitude")) else "table"

@@ -92,6 +92,7 @@ class SunlightReflection(Illusion):
     """Driving into a low sun on a wet road: specular glare and puddle mirrors wash out the lines."""
 
     CATEGORY: ClassVar[Category] = "reflection"
+    SETS_SUN: ClassVar[bool] = True
     SEVERITY: ClassVar[tuple[SunlightReflectionLevel, ...]] = (
         SunlightReflectionLevel(sun_altitude=24.0, sun_intensity=1.0, wetness=0.35, puddles=0.08),
         SunlightReflectionLevel(sun_altitude=17.0, sun_intensity=1.15, wetness=0.5, puddles=0.16),
@@ -137,6 +138,7 @@ class StreetlightReflection(Illusion):
     """Dusk to night, white or yellow street lamps, a wet road: long light streaks run down the asphalt."""
 
     CATEGORY: ClassVar[Category] = "reflection"
+    SETS_SUN: ClassVar[bool] = True
     # daylight: what is left of the day's sky light (1 = the case's day, 0 = full night). The level takes the scene
     # from late dusk to deep night while the road gets wetter and the lamps denser, so the streaks of the lamps
     # stand out ever more against the darkening road and the paint.
@@ -207,6 +209,7 @@ class VehicleReflection(Illusion):
     """Glossy vehicles ahead mirrored in a wet road, their paint catching a low sun."""
 
     CATEGORY: ClassVar[Category] = "reflection"
+    SETS_SUN: ClassVar[bool] = True
     SEVERITY: ClassVar[tuple[VehicleReflectionLevel, ...]] = (
         VehicleReflectionLevel(count=1, gloss=0.55, wetness=0.4, puddles=0.08, sun_altitude=30.0),
         VehicleReflectionLevel(count=2, gloss=0.65, wetness=0.55, puddles=0.15, sun_altitude=24.0),

@@ -430,6 +430,7 @@ class GuardRail(Illusion):
     """W-beam guard rails along the road edge whose bright top edge and shadow run parallel to the lane lines."""
 
     CATEGORY: ClassVar[Category] = "road_damage"
+    SETS_SUN: ClassVar[bool] = True  # its rails throw their shadow over the lanes (levels with shadow_m)
     # offset: gap between the carriageway edge and the rail (m); far_side: a second rail along the other edge;
     # median: a rail just left of the centre line; shadow_m: how far across the road (from the rail nearest
     # the ego) the sun throws the shadow of its top edge (0 = the case's sun is kept). Level 1 keeps the case's

@@ -68,6 +68,7 @@ class SunShadowIllusion(Illusion):
     """Fields and sun handling shared by the shadow illusions (not registered itself)."""
 
     CATEGORY: ClassVar[Category] = "shadow"
+    SETS_SUN: ClassVar[bool] = True
 
     sun_altitude: StrictFloat | None = Field(
         None, ge=2, le=89, description="sun altitude (degrees); empty = from the severity table"

@@ -4,6 +4,11 @@
 
 The one place mapping the registry's illusion types (``road_crack``, …) to the benchmark's folder names
 (``RoadDamage/RoadCrack``, …). Dataset generation, exports and the web API all build paths from here.
+
+A case holding illusions of several types is filed under ``Mixed/<CategoryType>+<CategoryType>/<case>``
+(``Mixed/ShadowFence+ReflectionSunLight/...``, types in registry order); its type name is the registry types
+joined by ``+`` (``fence_shadow+sunlight_reflection``) and its category ``mixed``, so the API, the study and the
+reports group it on its own rather than under its first illusion.
 """
 
 from __future__ import annotations
@@ -36,6 +41,9 @@ TYPE_FOLDERS: dict[str, str] = {
     "vehicle_reflection": "Vehicle",
 }
 CLEAN_FOLDER = "Clean"  # cases with no illusion and no illusion type to file them under
+MIXED_FOLDER = "Mixed"  # cases holding illusions of several types
+MIXED_CATEGORY = "mixed"
+TYPE_JOIN = "+"
 LABELS_FILE = "labels.json"
 
 
@@ -51,17 +59,44 @@ def illusion_folder(illusion_type: str) -> PurePosixPath:
     return PurePosixPath(CATEGORY_FOLDERS[REGISTRY[illusion_type].CATEGORY], TYPE_FOLDERS[illusion_type])
 
 
+def case_types(case: Case, fallback: str | None = None) -> tuple[str, ...]:
+    """The distinct illusion types a case holds, in registry order; ``(fallback,)`` for a case with none (an
+    original filed by its folders), ``()`` for a clean case."""
+    if not case.illusions:
+        return (fallback,) if fallback is not None else ()
+    held = {illusion.type for illusion in case.illusions}
+    return tuple(name for name in REGISTRY if name in held)
+
+
 def case_illusion_type(case: Case, fallback: str | None = None) -> str | None:
-    """The type a case is filed under: its first illusion's, else ``fallback`` (an original's type), else None."""
-    return case.illusions[0].type if case.illusions else fallback
+    """The type a case is filed under: its illusions' type (several joined by ``+``: a mixed case), else
+    ``fallback`` (an original's type), else None."""
+    types = case_types(case, fallback)
+    return TYPE_JOIN.join(types) if types else None
+
+
+def type_category(type_name: str) -> str:
+    """The category of a type name from ``case_illusion_type``: the registry's, or ``mixed``."""
+    return MIXED_CATEGORY if TYPE_JOIN in type_name else REGISTRY[type_name].CATEGORY
+
+
+def case_filing(case: Case, fallback: str | None = None) -> tuple[str, str] | None:
+    """(category folder, type folder) a case is filed under; None for a clean case."""
+    types = case_types(case, fallback)
+    if not types:
+        return None
+    if len(types) == 1:
+        return CATEGORY_FOLDERS[REGISTRY[types[0]].CATEGORY], TYPE_FOLDERS[types[0]]
+    return MIXED_FOLDER, TYPE_JOIN.join(str(illusion_folder(name)).replace("/", "") for name in types)
 
 
 def case_folder(case: Case, name: str | PurePosixPath, fallback_type: str | None = None) -> PurePosixPath:
-    """``Category/Type/name`` for a case; clean cases with no type go under ``Clean/name``."""
-    illusion_type = case_illusion_type(case, fallback_type)
-    if illusion_type is None:
+    """``Category/Type/name`` for a case (``Mixed/...`` for several types); clean cases with no type go under
+    ``Clean/name``."""
+    filing = case_filing(case, fallback_type)
+    if filing is None:
         return PurePosixPath(CLEAN_FOLDER, name)
-    return illusion_folder(illusion_type) / name
+    return PurePosixPath(*filing) / name
 
 
 def folder_type(relative: PurePosixPath) -> str | None:

@@ -192,12 +192,29 @@ LABEL_SUFFIX = "_label.json"
 DATASET_SPLIT = "test"  # the split a dataset folder (written by ``lanevil dataset``) stands for
 
 
-def split_folder(path: str | Path) -> Path:
-    """``path``, or its ``test`` split when ``path`` is a dataset folder (no label file of its own, a ``test/``)."""
+def resolve_split(path: str | Path) -> tuple[Path, str | None]:
+    """(split folder, note): ``path``, or its ``test`` split when ``path`` is a dataset folder (no label file of
+    its own, a ``test/``); a dataset folder with no ``test/`` but one other split (``lanevil dataset`` with only
+    ``--train-frames``) falls back to that split, and the note says so (None when nothing was substituted)."""
     path = Path(path)
-    if path.is_dir() and not any(path.glob(f"*{LABEL_SUFFIX}")) and (path / DATASET_SPLIT).is_dir():
-        return path / DATASET_SPLIT
-    return path
+    if not path.is_dir() or any(path.glob(f"*{LABEL_SUFFIX}")):
+        return path, None
+    if (path / DATASET_SPLIT).is_dir():
+        return path / DATASET_SPLIT, None
+    splits = sorted(child for child in path.iterdir() if child.is_dir() and any(child.glob(f"*{LABEL_SUFFIX}")))
+    if len(splits) == 1:
+        return splits[0], f"{path} has no {DATASET_SPLIT}/ split: using its {splits[0].name}/ split"
+    return path, None
+
+
+def split_folder(path: str | Path) -> Path:
+    """``path``, or the split a dataset folder stands for (``resolve_split``)."""
+    return resolve_split(path)[0]
+
+
+def split_note(path: str | Path) -> str | None:
+    """What ``resolve_split`` substituted for ``path``, if anything (printed by the commands before they run)."""
+    return resolve_split(path)[1]
 
 
 def split_labels(split_dir: str | Path) -> Path:

@@ -14,7 +14,7 @@ from ..illusions import CompileContext, EgoDrive, MeshFileError
 from ..world.environment import environment_for, in_proportion, is_night
 from ..world.paint import road_paint
 from ..world.road_layout import RoadNetwork, build_network
-from ..world.scene import CompiledScene, Mesh
+from ..world.scene import CompiledScene, Environment, Mesh
 from ..world.scenery import roadside_meshes
 from ..world.user_meshes import load_obstacle, mesh_path
 
@@ -74,6 +74,11 @@ def ego_drive(case: Case) -> EgoDrive:
                     road_length=case.road.length)
 
 
+def _sun_of(env: Environment) -> tuple[float, ...]:
+    """What an illusion may do to the sun: its direction, its strength, night."""
+    return (*(float(v) for v in env.sun_dir_world), float(env.sun_intensity), float(env.night))
+
+
 def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir: Path | None = None) -> CompiledScene:
     """Build the network, the roadside props and every illusion's scene elements.
 
@@ -90,7 +95,10 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):
         ctx.source = index
+        sun_before = _sun_of(ctx.env)
         illusion.compile(ctx)
+        if _sun_of(ctx.env) != sun_before:
+            ctx.env.sun_set_by = (*ctx.env.sun_set_by, index)
     if case.camera.sensor is not None:  # a photograph: sun and sky in daylight's proportion for the final sun
         in_proportion(ctx.env, air_mass=ctx.env.sun_intensity == case_sun)
     return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),

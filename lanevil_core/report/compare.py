@@ -33,6 +33,7 @@ from .robustness import (
     _pct,
     drop_figure_png,
     gap_cell,
+    gap_points,
     interval_numbers,
     with_interval,
     write_report,
@@ -381,7 +382,7 @@ def comparison_plot(detectors: list[Detector]) -> bytes:
     fig, ax = plt.subplots(figsize=(9.0 if many else 7.0, 4.2), dpi=120)
     for index, detector in enumerate(detectors):
         row = category_rows(detector.report)[-1]
-        points = [(level, -100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
+        points = gap_points(row)
         if points:
             ax.plot([p[0] for p in points], [p[1] for p in points], linewidth=1.8, label=detector.name,
                     **line_style(index))

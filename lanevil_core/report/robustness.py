@@ -277,8 +277,15 @@ def severity_csv(report: Report) -> str:
     return _csv(rows)
 
 
+def gap_points(row: Row) -> list[tuple[int, float]]:
+    """(level, accuracy gap in percentage points) of every level a row has: level - Original, negative for a drop,
+    the sign of the tables."""
+    return [(level, 100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
+
+
 def severity_plot(report: Report) -> bytes:
-    """PNG: accuracy drop (Original - level, percentage points) against severity, one line per category."""
+    """PNG: accuracy gap (level - Original, percentage points, negative = drop) against severity, one line per
+    category."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -288,7 +295,7 @@ def severity_plot(report: Report) -> bytes:
     for row in report.rows:
         if row.type != ALL:
             continue
-        points = [(level, -100 * gap) for level in LEVELS if (gap := row.gap("accuracy", level)) is not None]
+        points = gap_points(row)
         if not points:
             continue
         style = {"color": "black", "linestyle": "--", "linewidth": 2.2} if row.category == ALL else {"linewidth": 1.6}
@@ -297,12 +304,12 @@ def severity_plot(report: Report) -> bytes:
 
 
 def drop_figure_png(fig: Any, ax: Any, title: str, legend_beside: bool = False, legend_columns: int = 1) -> bytes:
-    """Finish an accuracy-drop-by-severity plot (zero line, level ticks, labels, grid, legend) and encode it;
+    """Finish an accuracy-gap-by-severity plot (zero line, level ticks, labels, grid, legend) and encode it;
     ``legend_beside`` puts the legend right of the axes, off the lines, for plots with many of them."""
     ax.axhline(0.0, color="grey", linewidth=0.8)
     ax.set_xticks(list(LEVELS))
     ax.set_xlabel("severity level")
-    ax.set_ylabel("accuracy drop vs original (percentage points)")
+    ax.set_ylabel("accuracy gap vs original (points, negative = drop)")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     if legend_beside:

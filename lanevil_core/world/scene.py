@@ -137,6 +137,7 @@ class Environment:
     night: bool
     headlights: float = 0.0  # intensity of the ego's two headlights (0 = off)
     detail: float = 0.0  # surface texture a photograph shows (0 = the ideal render's smooth surfaces)
+    sun_set_by: tuple[int, ...] = ()  # illusions (indices) that moved the sun or put out its light, in order
 
 
 def array_bytes(root: Any) -> int:

@@ -80,9 +80,11 @@ export class IllusionCard {
     this.display = display;
     this.ids = { original: null, perturbed: null };
     this.sunDefault = null;  // {azimuth, altitude} of the case, once read
-    // shadow and reflection illusions place the sun themselves unless a sun override is given
-    this.sunAuto = "sun_azimuth" in (info.parameters ?? {}) || "sun_altitude" in (info.severity?.[0] ?? {});
-    this.sunTouched = false;
+    // info.sun: "overrides" (the illusion places the sun; a sun slider overrides it), "table" (its severity table
+    // places the sun: no slider moves it, so the sliders are off) or "case" (the case's sun)
+    this.sunAuto = info.sun === "overrides" || info.sun === "table";
+    this.sunFixed = info.sun === "table";
+    this.sunTouched = new Set();  // the sun sliders the user moved: only those go into frame URLs
     this.activated = false;
     this.el = template.content.firstElementChild.cloneNode(true);
     this.build();
@@ -178,12 +180,14 @@ export class IllusionCard {
       const sun = document.sun;
       this.sunDefault = { azimuth: wrapDegrees(sun.azimuth), altitude: sun.altitude };
       const night = sun.intensity <= 0 || sun.altitude <= 0;
-      this.inputs.azimuth.disabled = night;
-      this.inputs.altitude.disabled = night;
+      this.inputs.azimuth.disabled = night || this.sunFixed;
+      this.inputs.altitude.disabled = night || this.sunFixed;
       const note = this.el.querySelector(".card__note");
       note.hidden = !night && !this.sunAuto;
       note.textContent = night ? "Night scene: lit by street lamps and headlights, so there is no sun to move."
-        : "Sun “auto”: the illusion places the sun itself until you move a sun slider.";
+        : this.sunFixed ? "Sun fixed: this illusion's severity table places the sun where its glare needs it, "
+          + "so the sun sliders are off."
+        : "Sun “auto”: the illusion places the sun itself; a sun slider you move overrides only that angle.";
       this.resetSun();
     } catch (error) {
       this.showCardError(`Could not read the case's sun (${error.message}); the sun sliders stay off.`);
@@ -226,7 +230,7 @@ export class IllusionCard {
   }
 
   onInput(name) {
-    if (name !== "severity") this.sunTouched = true;
+    if (name !== "severity") this.sunTouched.add(name);
     this.showValues();
     this.refresh();
   }
@@ -243,7 +247,7 @@ export class IllusionCard {
   }
 
   resetSun() {
-    this.sunTouched = false;
+    this.sunTouched.clear();
     if (this.sunDefault) {
       this.inputs.azimuth.value = String(this.sunDefault.azimuth);
       this.inputs.altitude.value = String(this.sunDefault.altitude);
@@ -251,19 +255,21 @@ export class IllusionCard {
     this.showValues();
   }
 
-  /** The control values that go into frame URLs; the sun only once the user moved it. */
+  /** The control values that go into frame URLs; of the sun only the angles the user moved (an untouched
+   * azimuth stays the illusion's own, so moving the altitude alone keeps a shadow across the lanes). */
   settings() {
-    const sun = this.sunTouched
-      ? { sunAzimuth: Number(this.inputs.azimuth.value), sunAltitude: Number(this.inputs.altitude.value) }
-      : {};
+    const sun = {};
+    if (this.sunTouched.has("azimuth")) sun.sunAzimuth = Number(this.inputs.azimuth.value);
+    if (this.sunTouched.has("altitude")) sun.sunAltitude = Number(this.inputs.altitude.value);
     return { severity: Number(this.inputs.severity.value), overlay: this.display.overlay,
       detector: this.display.detector, ...sun };
   }
 
-  /** " · sun 120° / 20°" once the user moved a sun slider, else "". */
+  /** " · sun azimuth 120°, altitude 20°" for the sun angles the user moved, else "". */
   sunCaption() {
-    if (!this.sunTouched) return "";
-    return ` · sun ${this.inputs.azimuth.value}° / ${this.inputs.altitude.value}°`;
+    const moved = ["azimuth", "altitude"].filter((name) => this.sunTouched.has(name));
+    if (moved.length === 0) return "";
+    return ` · sun ${moved.map((name) => `${name} ${this.inputs[name].value}°`).join(", ")}`;
   }
 
   showValues() {
@@ -271,13 +277,14 @@ export class IllusionCard {
     this.outputs.severity.textContent = `${severity.value} / ${LEVELS}`;
     severity.setAttribute("aria-valuetext", `level ${severity.value} of ${LEVELS}`);
     const known = this.sunDefault !== null;
-    const auto = this.sunAuto && !this.sunTouched;
-    this.outputs.azimuth.textContent = !known ? "–" : auto ? "auto" : `${azimuth.value}°`;
-    this.outputs.azimuth.title = auto ? "" : azimuthWords(Number(azimuth.value));
-    azimuth.setAttribute("aria-valuetext", auto ? "set by the illusion" : `${azimuth.value} degrees, `
+    const auto = (name) => this.sunAuto && !this.sunTouched.has(name);
+    this.outputs.azimuth.textContent = !known ? "–" : auto("azimuth") ? "auto" : `${azimuth.value}°`;
+    this.outputs.azimuth.title = auto("azimuth") ? "" : azimuthWords(Number(azimuth.value));
+    azimuth.setAttribute("aria-valuetext", auto("azimuth") ? "set by the illusion" : `${azimuth.value} degrees, `
       + azimuthWords(Number(azimuth.value)));
-    this.outputs.altitude.textContent = !known ? "–" : auto ? "auto" : `${altitude.value}°`;
-    altitude.setAttribute("aria-valuetext", auto ? "set by the illusion" : `${altitude.value} degrees above the horizon`);
+    this.outputs.altitude.textContent = !known ? "–" : auto("altitude") ? "auto" : `${altitude.value}°`;
+    altitude.setAttribute("aria-valuetext", auto("altitude") ? "set by the illusion"
+      : `${altitude.value} degrees above the horizon`);
     const row = this.info.severity?.[Number(severity.value) - 1];
     this.el.querySelector(".card__level").textContent = row ? `Level ${severity.value}: ${levelSummary(row)}` : "";
     const sun = this.sunCaption();
@@ -289,7 +296,8 @@ export class IllusionCard {
   /** Ask both frames for the pictures (and the detector's scores) of the current settings. */
   refresh({ immediate = false } = {}) {
     const { severity, overlay, detector, sunAzimuth, sunAltitude } = this.settings();
-    const sun = sunAzimuth === undefined ? "" : `, sun at ${sunAzimuth}° azimuth and ${sunAltitude}° altitude`;
+    const angles = [[sunAzimuth, "azimuth"], [sunAltitude, "altitude"]].filter(([value]) => value !== undefined);
+    const sun = angles.length ? `, sun at ${angles.map(([value, name]) => `${value}° ${name}`).join(" and ")}` : "";
     const lanes = (overlay ? ", ground-truth lanes drawn" : "") + (detector ? `, ${detector} lanes in magenta` : "");
     const views = {
       original: [{ sunAzimuth, sunAltitude }, `${this.title}: original frame without the illusion`],

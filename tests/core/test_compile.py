@@ -58,3 +58,13 @@ def test_renderer_labels_and_exporter_read_nothing_of_the_case(make_case) -> Non
     assert len(tusimple_record(scene, 5, frame, raw_file="000005.png")["lanes"]) >= 2
     assert isinstance(culane_lines(scene, frame), str)
     assert scene_glb(scene)[:4] == b"glTF"
+
+
+def test_the_scene_says_which_illusions_set_the_sun() -> None:
+    clean = parse_case({"road": {"type": "straight"}})
+    assert compile_scene(clean).env.sun_set_by == ()
+    both = parse_case({"road": {"type": "straight"}, "illusions": [
+        {"type": "fence_shadow", "severity": 3}, {"type": "road_crack", "severity": 2},
+        {"type": "sunlight_reflection", "severity": 3}]})
+    assert compile_scene(both).env.sun_set_by == (0, 2)  # the crack leaves the sun alone; the last one's is shown
+    assert [type(i).SETS_SUN for i in both.illusions] == [True, False, True]

@@ -267,12 +267,16 @@ def _free_port() -> int:
     (["--cases", "{cases}", "--scheduler", "tcp://127.0.0.1:{port}", "--scheduler-timeout", "1"],
      "cannot reach the Dask scheduler"),
     (["--cases", "{typed}", "--train-frames", "5"], "--train-frames needs clean cases"),
+    (["--cases", "{clean}", "--frames-per-case", "3"], "--frames-per-case 3: no test case under --cases"),
+    (["--cases", "{clean}", "--frames-per-case", "3", "--train-frames", "5"], "only seed the train split"),
+    (["--cases", "{clean}"], "no test cases (cases with an illusion type) found and --train-frames is 0"),
 ])
 def test_cli_errors_exit_2_with_one_line(argv: list[str], message: str, tmp_path: Path, cases_dir: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "empty").mkdir()
     typed = copy_cases(tmp_path / "typed", CASE_FILES[:1])
-    values = {"tmp": tmp_path, "cases": cases_dir, "typed": typed, "port": _free_port()}
+    clean = copy_cases(tmp_path / "clean", CASE_FILES[3:]) / "00_clean"
+    values = {"tmp": tmp_path, "cases": cases_dir, "typed": typed, "clean": clean, "port": _free_port()}
     argv = [part.format(**values) for part in argv]
     assert run_cli(*argv, "--out", str(tmp_path / "out"), "--quiet") == 2
     err = capsys.readouterr().err.strip()

@@ -6,7 +6,7 @@ from pathlib import Path, PurePosixPath
 
 import pytest
 
-from lanevil_core.case import Case
+from lanevil_core.case import Case, parse_case
 from lanevil_core.dataset import PlanError, Settings, build_plan, discover_cases, evenly_spaced
 from lanevil_core.dataset.manifest import _PACKAGE, source_files
 from lanevil_core.dataset.plan import SourceCase, render_tasks, train_variation
@@ -166,3 +166,15 @@ def test_the_local_pool_lets_go_of_each_task_s_frames_once_they_are_written():
     assert len(handed) == 6
     # At each call only the frames handed over now are alive (this call's argument), none of the earlier tasks'.
     assert alive_at_each_call == [0] * 6
+
+
+def test_a_case_of_two_illusion_types_is_planned_under_mixed(stock: list[SourceCase]) -> None:
+    source = next(source for source in stock if source.relative.name == "03_level3.json"
+                  and source.case.illusions[0].type == "fence_shadow")
+    data = source.case.model_dump()
+    data["illusions"].append({"type": "road_crack", "severity": 2, "s": 60.0})
+    mixed = SourceCase(source.relative, parse_case(data))
+    planned = build_plan([mixed], Settings(frames_per_case=2, sampling="even")).cases[0]
+    assert str(planned.folder) == "Mixed/RoadDamageRoadCrack+ShadowFence/00_uphill_rural_noon/03_level3"
+    assert (planned.category, planned.type_folder, planned.illusion_type) == (
+        "Mixed", "RoadDamageRoadCrack+ShadowFence", "road_crack+fence_shadow")

@@ -177,6 +177,11 @@ def test_summary_applies_the_paper_criterion(make_case):
     assert viewed.t_view == pytest.approx(1.9) and viewed.success
     departed = summarize(_trace(make_case, [0.0, 0.9, -6.0]))
     assert departed.lane_departure and departed.t_departure == pytest.approx(0.1) and departed.off_road
+    assert early.verdict.startswith("LANE LOST") and late.verdict.startswith("LANE KEPT at first")
+    assert viewed.verdict == "ATTACK SUCCEEDED"
+    kept = summarize(_trace(make_case, [0.1] * 40, span=(80.0, 120.0)))
+    assert kept.verdict == "LANE KEPT (attack failed)"
+    assert summarize(_trace(make_case, [0.0] * 5)).verdict == "LANE KEPT"
 
 
 def test_illusion_span_covers_the_illusion():
@@ -210,6 +215,9 @@ def test_drive_command_writes_trace_summary_plots_and_video(tmp_path, make_case,
                      "--out", str(out), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["steps"] == 10 and summary["max_abs_deviation"] < 0.01 and summary["success"] is False
+    assert cli.main(["drive", str(path), "--detector", "gt", "--seconds", "1", "--size", "320x180", "--no-video",
+                     "--out", str(tmp_path / "words")]) == 0
+    assert capsys.readouterr().out.startswith("LANE KEPT: max |deviation|")  # not "no success"
     assert summary["deviation_threshold_m"] == 0.285 and summary["success_window_s"] == 2.5
     names = {p.name for p in out.iterdir()}
     assert {"trace.csv", "summary.json", "trace.png", "path.png"} <= names

@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -21,7 +22,7 @@ from lanevil_core.metrics.tusimple import ImageScore, f1_ganet
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
 from lanevil_core.report.compare import line_style
-from lanevil_core.report.robustness import ALL, build_report, markdown, severity_csv
+from lanevil_core.report.robustness import ALL, build_report, gap_points, markdown, severity_csv
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 SIZE = (320, 180)
@@ -144,6 +145,28 @@ def test_a_dataset_folder_stands_for_its_test_split(tiny_split, tmp_path, capsys
     assert main(["report", "--gt", str(empty), "--pred", str(preds), "--out", str(tmp_path / "r2")]) == 2
     err = capsys.readouterr().err
     assert "found 0" in err and "DATASET/test" in err
+
+
+def test_a_dataset_folder_with_only_a_train_split_stands_for_it_and_says_so(tiny_split, tmp_path, capsys):
+    dataset = tmp_path / "dataset"  # what `lanevil dataset --train-frames N` alone writes: a train split only
+    shutil.copytree(tiny_split, dataset / "train")
+    (dataset / "train" / "test_label.json").rename(dataset / "train" / "train_label.json")
+    preds = tmp_path / "train.json"
+    assert main(["detect", str(dataset), "--method", "birdseye", "--out", str(preds), "--fixed-run-time", "1"]) == 0
+    assert "has no test/ split: using its train/ split" in capsys.readouterr().err
+    raw_files = [json.loads(line)["raw_file"] for line in preds.read_text().splitlines()]
+    assert raw_files and not any(name.startswith("train/") for name in raw_files)  # named as its labels name them
+    for gt in (dataset, dataset / "train"):
+        assert main(["eval", "--gt", str(gt), "--pred", str(preds), "--json"]) == 0
+    scores = [json.loads(line) for line in capsys.readouterr().out.strip().splitlines()[-2:]]
+    assert scores[0] == scores[1] and scores[0]["images"] == len(CASES)
+
+
+def test_the_plot_shows_gaps_with_the_tables_sign():
+    images = [scored("Shadow", "Fence", 0, 1.0), scored("Shadow", "Fence", 1, 0.8), scored("Shadow", "Fence", 5, 0.4)]
+    row = next(row for row in build_report(images).rows if row.type == ALL and row.category == "Shadow")
+    assert gap_points(row) == [(1, pytest.approx(-20.0)), (5, pytest.approx(-60.0))]
+    assert f"{100 * row.gap('accuracy', 5):.2f}" in markdown(build_report(images))  # the table's -60.00
 
 
 def test_paint_free_control_and_several_detectors(tmp_path):

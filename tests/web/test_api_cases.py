@@ -11,6 +11,7 @@ from fastapi.testclient import TestClient
 
 from app.api.limits import UPLOADS_PER_REQUEST
 from app.main import create_app
+from lanevil_core.case import default_markings
 from lanevil_core.illusions import REGISTRY
 
 FENCE = "fence_shadow-00_uphill_rural_noon"  # the fence shadow's representative original
@@ -229,6 +230,28 @@ def test_patch_merges_and_resets_with_null(client) -> None:
     assert reset["version"] == 3 and reset["case"]["title"] == ""
 
 
+def test_patching_the_lane_count_re_derives_markings_unless_given(client) -> None:
+    custom = [{"type": t} for t in ("none", "white_solid", "yellow_solid", "botts_dots", "white_solid")]
+    url = f"/api/cases/{SHADOW_ID}"
+    assert client.patch(url, json={"road": {"markings": custom}}).status_code == 200
+    same = client.patch(url, json={"road": {"lanes_per_direction": 2}}).json()["case"]["road"]
+    assert [m["type"] for m in same["markings"]] == [m["type"] for m in custom]  # an unchanged count keeps them
+    road = client.patch(url, json={"road": {"lanes_per_direction": 3}}).json()["case"]["road"]
+    assert [m["type"] for m in road["markings"]] == [m.type for m in default_markings(3)]
+    given = [{"type": "white_solid"}] * 3
+    road = client.patch(url, json={"road": {"lanes_per_direction": 1, "markings": given}}).json()["case"]["road"]
+    assert [m["type"] for m in road["markings"]] == ["white_solid"] * 3
+    wrong = client.patch(url, json={"road": {"lanes_per_direction": 2, "markings": given}})
+    assert wrong.status_code == 422 and "markings needs 5 entries" in wrong.json()["detail"]
+
+
+def test_put_with_the_defaults_of_another_lane_count_re_derives_them(client) -> None:
+    document = client.get(f"/api/cases/{SHADOW_ID}").json()["case"]
+    document["road"].update(lanes_per_direction=3, markings=[m.model_dump() for m in default_markings(2)])
+    road = client.put(f"/api/cases/{SHADOW_ID}", json=document).json()["case"]["road"]
+    assert len(road["markings"]) == 7
+
+
 def test_patch_stale_and_invalid(client) -> None:
     assert client.patch(f"/api/cases/{SHADOW_ID}", json={"title": "a"}).status_code == 200
     stale = client.patch(f"/api/cases/{SHADOW_ID}", json={"title": "b"}, headers={"If-Match": '"1"'})
@@ -297,6 +320,8 @@ def test_illusions_registry(client) -> None:
     assert fence["parameters"]["severity"]["maximum"] == 5 and "default" in fence["parameters"]["severity"]
     assert body["categories"]["shadow"] == [name for name, cls in REGISTRY.items() if cls.CATEGORY == "shadow"]
     assert "illusions" in body["case_schema"]["properties"]
+    suns = {info["name"]: info["sun"] for info in body["data"]}  # what the demo's sun sliders may do per type
+    assert (suns["fence_shadow"], suns["sunlight_reflection"], suns["road_crack"]) == ("overrides", "table", "case")
 
 
 def test_multipart_uploads_have_their_own_limit(settings, state) -> None:

@@ -145,3 +145,17 @@ def test_a_client_past_its_share_of_the_queue_gets_429_with_retry_after(client, 
     assert "the most it takes" in full.json()["detail"]
     for job_id in ids:
         client.delete(f"/api/exports/{job_id}")
+
+
+def test_a_case_of_two_illusion_types_is_filed_under_mixed(client) -> None:
+    """Exports and the listing name both types, not only the first illusion's (the study: test_study.py)."""
+    case = client.get(f"/api/cases/{SHADOW_ID}").json()["case"]
+    case["illusions"].append({"type": "road_crack", "severity": 2, "s": 60.0})
+    created = client.post("/api/cases", json={"id": "two-types", "case": case})
+    assert created.status_code == 201, created.text
+    row = next(row for row in client.get("/api/cases").json()["data"] if row["id"] == "two-types")
+    assert (row["category"], row["type"]) == ("mixed", "road_crack+fence_shadow")
+    for illusion_type in ("fence_shadow", "road_crack"):  # listed under each type it holds
+        assert "two-types" in {row["id"] for row in client.get(f"/api/cases?type={illusion_type}").json()["data"]}
+    archive = zipfile.ZipFile(io.BytesIO(client.get("/api/cases/two-types/export.zip?frames=0").content))
+    assert "Mixed/RoadDamageRoadCrack+ShadowFence/two-types/labels.json" in archive.namelist()

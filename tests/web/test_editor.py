@@ -42,53 +42,53 @@ def settle(tab: EditorTab) -> np.ndarray:
 
 
 def open_shadow(tab: EditorTab) -> np.ndarray:
-    tab.panel.case_id.value = SHADOW
+    tab.cases.case_id.value = SHADOW
     rgb = settle(tab)
-    tab.panel.selected.value = tab.panel.selected.options[1]
+    tab.illusions.selected.value = tab.illusions.selected.options[1]
     return rgb
 
 
 def test_launch_serves_on_the_real_port_and_shows_a_preview(editor_server: Editor, tab: EditorTab) -> None:
     assert editor_server.port > 0 and editor_server.port == editor_server.server.get_port()
-    assert tab.session is not None and tab.session.case_id == tab.panel.case_id.value
+    assert tab.session is not None and tab.session.case_id == tab.cases.case_id.value
     assert settle(tab).shape == (360, 640, 3)
     assert tab.view.surface is not None  # the 3D view has the road
 
 
 def test_a_case_opens_with_its_first_illusion_selected(tab: EditorTab) -> None:
-    tab.panel.case_id.value = SHADOW  # one illusion
-    assert tab.selected == 0 and tab.panel.selected.value == tab.panel.selected.options[1]
-    assert not tab.panel.severity.disabled and tab.panel.severity.value == 3
-    assert not tab.panel.delete.disabled
-    tab.panel.case_id.value = "clean-00_straight_urban"  # none: nothing to select
-    assert tab.selected is None and tab.panel.severity.disabled
+    tab.cases.case_id.value = SHADOW  # one illusion
+    assert tab.selected == 0 and tab.illusions.selected.value == tab.illusions.selected.options[1]
+    assert not tab.illusions.severity.disabled and tab.illusions.severity.value == 3
+    assert not tab.illusions.delete_button.disabled
+    tab.cases.case_id.value = "clean-00_straight_urban"  # none: nothing to select
+    assert tab.selected is None and tab.illusions.severity.disabled
     settle(tab)
 
 
 def test_severity_slider_changes_the_case_and_the_preview(tab: EditorTab) -> None:
     before = open_shadow(tab)
-    assert tab.selected == 0 and not tab.panel.severity.disabled
-    tab.panel.severity.value = 5
+    assert tab.selected == 0 and not tab.illusions.severity.disabled
+    tab.illusions.severity.value = 5
     after = settle(tab)
     assert tab.case.illusions[0].severity == 5
     assert tab.session.dirty
     # Levels share one sun, so only the fence and its shadow change: a real but local change of the image.
     assert np.abs(after.astype(int) - before.astype(int)).mean() > 0.2
-    assert "version 1" in tab.panel.status.content and "unsaved" in tab.panel.status.content
+    assert "version 1" in tab.status.content and "unsaved" in tab.status.content
 
 
 def test_click_on_the_road_places_the_chosen_type_and_save_stores_it(tab: EditorTab, state: AppState) -> None:
     settle(tab)
     line = tab.view.network.main.line
     p_target = line.to_world(45.0, -1.75)
-    tab.panel.place.value = "pedestrian"
-    index = tab.click(p_target + np.array([-20.0, 0.0, 15.0]), np.array([20.0, 0.0, -15.0]))
+    tab.illusions.place_type.value = "pedestrian"
+    index = tab.illusions.click(p_target + np.array([-20.0, 0.0, 15.0]), np.array([20.0, 0.0, -15.0]))
     settle(tab)
     assert index == len(tab.case.illusions) - 1 and tab.selected == index
     assert tab.case.illusions[index].type == "pedestrian"
     assert tab.case.illusions[index].s == pytest.approx(45.0, abs=0.05)
-    assert tab.panel.place.value.startswith("(")  # placing ends after one click
-    tab.panel.save.value = True  # a click on Save
+    assert tab.illusions.place_type.value.startswith("(")  # placing ends after one click
+    tab.cases.save_button.value = True  # a click on Save
     stored = state.store.get(tab.session.case_id)
     assert stored.version == 2 and stored.case.illusions[-1].type == "pedestrian"
     assert not tab.session.dirty
@@ -96,40 +96,40 @@ def test_click_on_the_road_places_the_chosen_type_and_save_stores_it(tab: Editor
 
 def test_click_off_the_road_while_placing_is_reported(tab: EditorTab) -> None:
     settle(tab)
-    tab.panel.place.value = "vehicle"
+    tab.illusions.place_type.value = "vehicle"
     count = len(tab.case.illusions)
     with pytest.raises(EditError, match="position: click on the road"):
-        tab.click(np.array([0.0, 0.0, 5.0]), np.array([1.0, 0.0, 0.5]))  # the sky
+        tab.illusions.click(np.array([0.0, 0.0, 5.0]), np.array([1.0, 0.0, 0.5]))  # the sky
     assert len(tab.case.illusions) == count
     browser_click = SimpleNamespace(ray_origin=(0.0, 0.0, 5.0), ray_direction=(1.0, 0.0, 0.5))
     tab.on_scene_click(browser_click)  # as a click in a browser arrives
-    assert "click on the road" in tab.panel.status.content and len(tab.case.illusions) == count
+    assert "click on the road" in tab.status.content and len(tab.case.illusions) == count
 
 
 def test_undo_and_redo_buttons(tab: EditorTab) -> None:
     open_shadow(tab)
-    tab.panel.severity.value = 1
-    tab.panel.severity.value = 4
-    tab.panel.undo.value = True
+    tab.illusions.severity.value = 1
+    tab.illusions.severity.value = 4
+    tab.cases.undo_button.value = True
     assert tab.case.illusions[0].severity == 1
-    tab.panel.undo.value = True
+    tab.cases.undo_button.value = True
     assert tab.case.illusions[0].severity == 3 and not tab.session.dirty
-    tab.panel.redo.value = True
+    tab.cases.redo_button.value = True
     assert tab.case.illusions[0].severity == 1
-    assert tab.panel.severity.value == 1  # the slider follows the case
+    assert tab.illusions.severity.value == 1  # the slider follows the case
 
 
 def test_conflicting_save_is_reported_and_the_edits_kept(tab: EditorTab, state: AppState) -> None:
     open_shadow(tab)
-    tab.panel.severity.value = 5
+    tab.illusions.severity.value = 5
     theirs = state.store.get(SHADOW).case.model_copy(update={"title": "changed over REST"})
     state.store.update(SHADOW, theirs, expected_version=1)
     assert tab.session.remote_version == 2
-    assert tab.save() is None
-    assert "Not saved" in tab.panel.status.content
+    assert tab.cases.save() is None
+    assert "Not saved" in tab.status.content
     assert tab.case.illusions[0].severity == 5  # nothing lost
     assert state.store.get(SHADOW).case.title == "changed over REST"
-    new_id = tab.save_as_new()
+    new_id = tab.cases.save_as_new()
     assert state.store.get(new_id).case.illusions[0].severity == 5
 
 
@@ -137,21 +137,21 @@ def test_a_save_is_never_reported_as_a_version_stored_elsewhere(tab: EditorTab, 
                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
     open_shadow(tab)
     errors: list[str] = []
-    report = tab._report
+    report = tab.report
 
     def recording_report(message: str, error: bool = False) -> None:
         if error:
             errors.append(message)
         report(message, error)
 
-    monkeypatch.setattr(tab, "_report", recording_report)
-    tab.panel.severity.value = 5
-    tab.panel.save.value = True  # a click on Save
+    monkeypatch.setattr(tab, "report", recording_report)
+    tab.illusions.severity.value = 5
+    tab.cases.save_button.value = True  # a click on Save
     assert state.store.get(SHADOW).version == 2 and tab.session.version == 2
     assert errors == [] and tab.session.remote_version is None
-    assert "saved version 2" in tab.panel.status.content
+    assert "saved version 2" in tab.status.content
     # a write made elsewhere while this session has unsaved edits is still reported
-    tab.panel.severity.value = 4
+    tab.illusions.severity.value = 4
     theirs = state.store.get(SHADOW).case.model_copy(update={"title": "changed over REST"})
     state.store.update(SHADOW, theirs, expected_version=2)
     assert tab.session.remote_version == 3
@@ -181,53 +181,53 @@ def test_a_rest_change_shows_up_in_the_open_editor(tab: EditorTab, state: AppSta
                           "illusions": [{"type": "fence_shadow", "severity": 1}]})
     state.store.update(SHADOW, changed, expected_version=record.version)
     settle(tab)
-    assert tab.case.title == "from the API" and tab.panel.title.value == "from the API"
+    assert tab.case.title == "from the API" and tab.cases.title.value == "from the API"
     assert tab.case.illusions[0].severity == 1 and tab.session.version == 2
-    assert "new-id" not in tab.panel.case_id.options
+    assert "new-id" not in tab.cases.case_id.options
     state.store.create(changed, case_id="new-id")
-    assert "new-id" in tab.panel.case_id.options
+    assert "new-id" in tab.cases.case_id.options
 
 
 def test_sun_sliders_and_weather_preset(tab: EditorTab) -> None:
     before = settle(tab)
-    tab.panel.sun_altitude.value = 8.0
-    tab.panel.sun_azimuth.value = -120.0
+    tab.sun.altitude.value = 8.0
+    tab.sun.azimuth.value = -120.0
     after = settle(tab)
     assert (tab.case.sun.altitude, tab.case.sun.azimuth) == (8.0, -120.0)
     assert np.abs(after.astype(int) - before.astype(int)).mean() > 1.0
-    tab.panel.weather.value = "HardRainNoon"
+    tab.sun.weather.value = "HardRainNoon"
     settle(tab)
     assert tab.case.weather.precipitation == 100 and tab.case.sun.azimuth == -120.0
-    tab.panel.sun_intensity.value = 0.5
+    tab.sun.intensity.value = 0.5
     assert tab.case.sun.intensity == 0.5
 
 
-def test_pavement_dropdown_paves_the_road_with_concrete_and_undo_takes_it_back(tab: EditorTab) -> None:
+def test_road_pavement_input_paves_the_road_with_concrete_and_undo_takes_it_back(tab: EditorTab) -> None:
     before = settle(tab)
-    assert tab.panel.pavement.value == tab.case.road.pavement == "asphalt"
-    tab.panel.pavement.value = "concrete"
+    assert tab.road.section.inputs.handles["pavement"].value == tab.case.road.pavement == "asphalt"
+    tab.road.section.inputs.handles["pavement"].value = "concrete"
     after = settle(tab)
     assert tab.case.road.pavement == "concrete"
     assert after.astype(float).mean() > before.astype(float).mean() + 5  # pale slabs fill the lower frame
-    tab.undo()
+    tab.cases.undo()
     settle(tab)
-    assert tab.case.road.pavement == "asphalt" and tab.panel.pavement.value == "asphalt"
+    assert tab.case.road.pavement == "asphalt" and tab.road.section.inputs.handles["pavement"].value == "asphalt"
 
 
 def test_sun_sliders_override_a_shadow_illusions_own_sun(tab: EditorTab) -> None:
     open_shadow(tab)
-    tab.panel.sun_altitude.value = 20.0
+    tab.sun.altitude.value = 20.0
     shadow: Any = tab.case.illusions[0]
     assert shadow.sun_altitude == 20.0
 
 
 def test_frame_slider_and_overlay_toggle(tab: EditorTab) -> None:
     first = settle(tab)
-    tab.panel.frame.value = 40
+    tab.display.frame.value = 40
     moved = settle(tab)
     assert tab.last_result.request.frame == 40
     assert np.abs(moved.astype(int) - first.astype(int)).mean() > 0.5
-    tab.panel.overlay.value = False
+    tab.display.overlay.value = False
     plain = settle(tab)
     assert not tab.last_result.request.overlay
     assert not np.array_equal(plain, moved)
@@ -235,17 +235,17 @@ def test_frame_slider_and_overlay_toggle(tab: EditorTab) -> None:
 
 def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(tab: EditorTab, state: AppState, monkeypatch,
                                                                  tmp_path) -> None:
-    assert list(tab.panel.detector.options) == ["none", *METHODS] and tab.panel.detector.value == "none"
+    assert list(tab.display.detector.options) == ["none", *METHODS] and tab.display.detector.value == "none"
     plain = settle(tab)
-    assert tab.panel.detection.content == "" and tab.last_result.request.detector is None
+    assert tab.display.detection.content == "" and tab.last_result.request.detector is None
     shown: dict[str, np.ndarray] = {}
     for name in ("hough", "ufld"):
-        tab.panel.detector.value = name
+        tab.display.detector.value = name
         shown[name] = settle(tab)
         request = tab.last_result.request
         assert request.detector == name and request.overlay
         found = state.frames.detection(request.case, request.frame, request.size, name)
-        text = tab.panel.detection.content
+        text = tab.display.detection.content
         assert f"**{name}**" in text and f"accuracy **{100 * found.accuracy:.1f}%**" in text
         assert f"FP {rate_text(found.fp)} · FN {rate_text(found.fn)}" in text
         assert ("fooled**" in text) == (found.fp > 0 or found.fn > 0)
@@ -253,14 +253,14 @@ def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(tab: EditorTab, 
     assert not np.array_equal(shown["hough"], shown["ufld"])
 
     monkeypatch.setattr(detector_catalog, "SHIPPED_MODELS", tmp_path)  # as without the ufld model
-    tab.panel.frame.value = 1
+    tab.display.frame.value = 1
     missing = settle(tab)
-    assert "not available" in tab.panel.detection.content and "⚠" not in tab.panel.status.content
+    assert "not available" in tab.display.detection.content and "⚠" not in tab.status.content
     overlaid = state.frames.frame(tab.case, 1, missing.shape[1::-1], overlay=True).rgb
     np.testing.assert_array_equal(missing, overlaid)  # the preview without the detector, not an error
-    tab.panel.detector.value = "none"
+    tab.display.detector.value = "none"
     settle(tab)
-    assert tab.panel.detection.content == "" and tab.last_result.request.detector is None
+    assert tab.display.detection.content == "" and tab.last_result.request.detector is None
 
 
 @pytest.fixture
@@ -272,53 +272,53 @@ def served_detector(monkeypatch, lane_server):
 
 def test_a_plugin_detector_is_a_choice_and_a_server_down_is_said(served_detector, tab: EditorTab, monkeypatch,
                                                                   down_url: str) -> None:
-    assert list(tab.panel.detector.options) == ["none", *METHODS, "mine"]
-    tab.panel.detector.value = "mine"
+    assert list(tab.display.detector.options) == ["none", *METHODS, "mine"]
+    tab.display.detector.value = "mine"
     settle(tab)
-    assert "**mine**" in tab.panel.detection.content and served_detector.sizes
+    assert "**mine**" in tab.display.detection.content and served_detector.sizes
     monkeypatch.setenv("LANEVIL_DETECTORS", f"mine={down_url}")
-    tab.panel.frame.value = 1
+    tab.display.frame.value = 1
     settle(tab)
-    assert "⚠ **mine**" in tab.panel.detection.content and "cannot connect" in tab.panel.detection.content
+    assert "⚠ **mine**" in tab.display.detection.content and "cannot connect" in tab.display.detection.content
 
 
 def test_gizmo_move_and_parameter_inputs(tab: EditorTab) -> None:
     open_shadow(tab)
     settle(tab)
     line = tab.view.network.main.line
-    tab.move_selected(line.to_world(70.0, 11.0, 0.3))  # where a drag of the handle ends
+    tab.illusions.move_selected(line.to_world(70.0, 11.0, 0.3))  # where a drag of the handle ends
     fence: Any = tab.case.illusions[0]
     assert fence.s == pytest.approx(70.0, abs=0.01) and fence.side == "left"
     assert fence.offset == pytest.approx(11.0 - roadside_t(tab.view.network.main, 0.0, 1.0), abs=0.01)
-    tab.panel.params.handles["offset"].value = 2.0
+    tab.illusions.params.handles["offset"].value = 2.0
     fence = tab.case.illusions[0]
     assert fence.offset == 2.0
-    tab.panel.params.handles["length"].value = "abc"  # not a number: reported with the field name
+    tab.illusions.params.handles["length"].value = "abc"  # not a number: reported with the field name
     fence = tab.case.illusions[0]
     assert "length" in tab.message and fence.length is None
-    tab.panel.delete.value = True
-    assert tab.case.illusions == [] and tab.selected is None and tab.panel.delete.disabled
+    tab.illusions.delete_button.value = True
+    assert tab.case.illusions == [] and tab.selected is None and tab.illusions.delete_button.disabled
 
 
 def test_new_case_from_a_road_template(tab: EditorTab, state: AppState) -> None:
-    tab.panel.template.value = "bend"
-    tab.panel.scene_kind.value = "highway"
-    tab.panel.create.value = True
+    tab.cases.template.value = "bend"
+    tab.cases.scene_kind.value = "highway"
+    tab.cases.create_button.value = True
     settle(tab)
     record = state.store.get(tab.session.case_id)
     assert record.case.road.type == "bend" and record.case.scene.kind == "highway"
-    assert tab.panel.case_id.value == record.id
+    assert tab.cases.case_id.value == record.id
 
 
 def test_exports(tab: EditorTab) -> None:
     open_shadow(tab)
-    name, data = tab.export_case()
+    name, data = tab.exports.export_case()
     assert name == f"{SHADOW}.json" and json.loads(data)["illusions"][0]["type"] == "fence_shadow"
-    tab.panel.frame.value = 3
-    (png_name, png), (labels_name, labels) = tab.export_frame()
+    tab.display.frame.value = 3
+    (png_name, png), (labels_name, labels) = tab.exports.export_frame()
     assert png_name == f"{SHADOW}_000003.png" and png.startswith(b"\x89PNG")
     assert json.loads(labels)["raw_file"] == png_name and labels_name.endswith(".json")
-    job = tab.export_sequence(frames=range(2))
+    job = tab.exports.export_sequence(frames=range(2))
     assert job.finished.wait(WAIT_S) and job.status == "done"
     names = set(zipfile.ZipFile(io.BytesIO(job.result.read_bytes())).namelist())
     folder = f"{illusion_folder('fence_shadow')}/{SHADOW}"
@@ -366,45 +366,45 @@ def test_partial_recompile_equals_a_full_compile(illusion: dict) -> None:
 
 def test_camera_controls_change_the_case_camera_and_the_preview(tab: EditorTab) -> None:
     before = settle(tab)
-    tab.panel.camera_preset.value = "dashcam"
+    tab.camera.preset.value = "dashcam"
     after = settle(tab)
     camera = tab.case.camera
     assert camera.fov == 58.0 and camera.bonnet is not None and camera.sensor is not None and camera.lens.k1 < 0
-    assert tab.panel.camera_bonnet.value and tab.panel.camera_sensor.value
+    assert tab.camera.bonnet.value and tab.camera.sensor.value
     assert np.abs(after.astype(int) - before.astype(int)).mean() > 5.0
-    tab.panel.camera_fov.value = 70.0
-    tab.panel.camera_roll.value = 1.5
-    tab.panel.camera_exposure.value = 1.0
+    tab.camera.fov.value = 70.0
+    tab.camera.roll.value = 1.5
+    tab.camera.exposure.value = 1.0
     assert (tab.case.camera.fov, tab.case.camera.roll, tab.case.camera.sensor.bias) == (70.0, 1.5, 1.0)
-    tab.panel.camera_bonnet.value = False
-    tab.panel.camera_sensor.value = False
+    tab.camera.bonnet.value = False
+    tab.camera.sensor.value = False
     settle(tab)
     assert tab.case.camera.bonnet is None and tab.case.camera.sensor is None
-    assert tab.panel.camera_exposure.disabled
+    assert tab.camera.exposure.disabled
 
 
 INJECTION = '<iframe srcdoc="<script>alert(1)</script>"> <script>alert(2)</script> [x](javascript:alert(3))'
 
 
 def markdown_texts(tab: EditorTab) -> list[str]:
-    return [tab.panel.status.content, tab.panel.preview_info.content, tab.panel.detection.content,
+    return [tab.status.content, tab.display.info.content, tab.display.detection.content,
             tab.drive.status.content]
 
 
 def test_case_text_and_errors_are_escaped_in_the_markdown(tab: EditorTab, state: AppState, monkeypatch) -> None:
     case = parse_case({"title": INJECTION, "description": INJECTION})
     record = state.store.create(case, case_id="injected")
-    tab.panel.case_id.value = record.id
+    tab.cases.case_id.value = record.id
     settle(tab)
-    assert tab.panel.title.value == INJECTION  # a text input shows the title as typed
+    assert tab.cases.title.value == INJECTION  # a text input shows the title as typed
 
     def fail(*args, **kwargs):
         raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
 
     monkeypatch.setattr(state.frames, "frame", fail)
-    tab.panel.frame.value = 3
+    tab.display.frame.value = 3
     assert tab.preview.wait_idle(WAIT_S)
-    status = tab.panel.status.content
+    status = tab.status.content
     assert "Preview failed" in status and "obstacle model not found" in status
     assert "&lt;iframe srcdoc\\=&quot;&lt;script&gt;" in status
     tab.drive.status.content = ""
@@ -418,32 +418,32 @@ def test_upload_mesh_stores_the_model_and_sets_the_vehicles_mesh_file(tab: Edito
 
 
     case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1, "kind": "van"}]})
-    tab.panel.case_id.value = state.store.create(case, case_id="vans").id
+    tab.cases.case_id.value = state.store.create(case, case_id="vans").id
     settle(tab)
-    tab.panel.selected.value = tab.panel.selected.options[1]
+    tab.illusions.selected.value = tab.illusions.selected.options[1]
     glb = trimesh.Scene(trimesh.creation.box((4.0, 2.0, 1.5))).export(file_type="glb")
-    assert tab.upload_mesh("../My Van.glb", glb) == "My_Van.glb"
+    assert tab.illusions.upload_mesh("../My Van.glb", glb) == "My_Van.glb"
     settle(tab)
     obstacle: Any = tab.case.illusions[0]
     assert obstacle.mesh_file == "My_Van.glb"
     assert (state.meshes_dir / "My_Van.glb").read_bytes() == glb
-    assert "⚠" not in tab.panel.status.content
+    assert "⚠" not in tab.status.content
     with pytest.raises(EditError, match="mesh not stored"):
-        tab.upload_mesh("notes.txt", b"hello")
+        tab.illusions.upload_mesh("notes.txt", b"hello")
     open_shadow(tab)
     with pytest.raises(EditError, match="takes no mesh"):
-        tab.upload_mesh("van.glb", glb)
+        tab.illusions.upload_mesh("van.glb", glb)
 
 
 def test_a_mesh_file_that_is_not_uploaded_is_not_saved(tab: EditorTab, state: AppState) -> None:
     case = parse_case({"title": "vans", "illusions": [{"type": "vehicle", "severity": 1}]})
-    tab.panel.case_id.value = state.store.create(case, case_id="vans").id
+    tab.cases.case_id.value = state.store.create(case, case_id="vans").id
     settle(tab)
-    tab.panel.selected.value = tab.panel.selected.options[1]
-    tab.set_field("mesh_file", "nowhere.glb")
+    tab.illusions.selected.value = tab.illusions.selected.options[1]
+    tab.illusions.set_field("mesh_file", "nowhere.glb")
     assert tab.preview.wait_idle(WAIT_S)
     with pytest.raises(EditError, match="nowhere.glb"):
-        tab.save()
+        tab.cases.save()
     with pytest.raises(EditError, match="Not saved"):
-        tab.save_as_new()
+        tab.cases.save_as_new()
     assert state.store.get("vans").version == 1

@@ -65,7 +65,7 @@ def test_place_an_illusion_scrub_severity_and_save(browser, editor: Editor, edit
     place = combos.nth(combos.evaluate_all("(inputs) => inputs.findIndex((i) => i.value.startsWith('(pick a type'))"))
     place.click()
     page.get_by_role("option", name="vehicle", exact=True).click()
-    wait_for(lambda: tab.panel.place.value == "vehicle", "the Place dropdown")
+    wait_for(lambda: tab.illusions.place_type.value == "vehicle", "the Place dropdown")
     page.mouse.click(*ROAD_CLICK)
     wait_for(lambda: any(ill.type == "vehicle" for ill in tab.case.illusions), "the placed vehicle")
     assert tab.preview.wait_idle(WAIT_S)
@@ -102,7 +102,7 @@ def test_detector_dropdown_draws_lanes_and_scores_the_preview(browser, editor: E
     seen = [before]
     for current, name in (("none", "hough"), ("hough", "ufld")):
         pick(page, current, name)
-        wait_for(lambda name=name: bool(tab.panel.detector.value == name), f"the Detector dropdown at {name}")
+        wait_for(lambda name=name: tab.display.detector.value == name, f"the Detector dropdown at {name}")
         assert tab.preview.wait_idle(WAIT_S)
         score = page.get_by_text(f"{name} (magenta):").first
         score.wait_for(timeout=WAIT_S * 1000)
@@ -159,14 +159,14 @@ def test_an_injected_case_and_error_show_as_text(browser, editor: Editor, editor
     page.wait_for_selector("canvas", timeout=WAIT_S * 1000)
     tab = editor.tab(timeout=WAIT_S)
     scripts_before = page.locator("script").count()
-    tab.panel.case_id.value = record.id
+    tab.cases.case_id.value = record.id
     assert tab.preview.wait_idle(WAIT_S)
 
     def fail(*args: object, **kwargs: object) -> None:
         raise FileNotFoundError(f"obstacle model not found: {INJECTION}")
 
     monkeypatch.setattr(state.frames, "frame", fail)
-    tab.panel.frame.value = 2
+    tab.display.frame.value = 2
     assert tab.preview.wait_idle(WAIT_S)
     page.get_by_text("obstacle model not found", exact=False).first.wait_for(timeout=WAIT_S * 1000)
     time.sleep(2)
@@ -192,7 +192,7 @@ def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Edi
                                                              screenshot_dir: Path) -> None:
     page, tab = open_page(browser, editor, editor_url)
     page.locator("img[src^='blob:']").first.wait_for(timeout=WAIT_S * 1000)
-    assert tab.preview.wait_idle(WAIT_S) and tab.panel.quality.value == "draft"
+    assert tab.preview.wait_idle(WAIT_S) and tab.display.quality.value == "draft"
     shown: list[bool] = []  # whether each pushed preview was a draft
     publish = tab.preview._publish
 
@@ -209,7 +209,7 @@ def test_quality_dropdown_drafts_while_the_sun_slider_moves(browser, editor: Edi
     assert tab.last_result.rgb.shape == (360, 640, 3)
 
     pick(page, "draft", "full")
-    wait_for(lambda: tab.panel.quality.value == "full", "the Quality dropdown at full")
+    wait_for(lambda: tab.display.quality.value == "full", "the Quality dropdown at full")
     assert tab.preview.wait_idle(WAIT_S)
     shown.clear()
     drag_thumb(page, altitude, 80)

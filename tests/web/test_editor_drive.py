@@ -19,11 +19,11 @@ def test_drive_button_runs_the_open_case_and_plays_it(tab: EditorTab) -> None:
     assert job.finished.wait(WAIT_S) and job.status == "done", job.error
     _wait_for_playback(tab)
     assert len(tab.drive.frames) == 10 and tab.drive.frames[0].shape == (360, 640, 3)
-    assert "no success" in tab.drive.status.content and not tab.drive.replay.disabled
+    assert "**LANE KEPT**" in tab.drive.status.content and not tab.drive.replay.disabled
 
 
 def test_drive_uses_the_preview_detector(tab: EditorTab) -> None:
-    tab.set_detector("hough")
+    tab.display.set_detector("hough")
     tab.drive.seconds.value = 1.0
     job = tab.drive.start()
     assert job is not None and job.meta["detector"] == "hough"
@@ -39,7 +39,7 @@ def _wait_for_playback(tab: EditorTab) -> None:
 
 
 def test_the_drive_plot_is_titled_after_the_edited_case(tab: EditorTab) -> None:
-    tab.panel.title.value = "Edited, not saved"
+    tab.cases.title.value = "Edited, not saved"
     assert tab.session.dirty and tab.state.store.get(tab.session.case_id).case.title != "Edited, not saved"
     tab.drive.seconds.value = 1.0
     job = tab.drive.start()

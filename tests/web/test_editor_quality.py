@@ -52,10 +52,10 @@ def test_the_worker_follows_a_draft_with_the_exact_frame_once_it_rests() -> None
 
 
 def test_draft_quality_shows_a_draft_then_the_exact_frame(tab: EditorTab, state: AppState) -> None:
-    assert tuple(tab.panel.quality.options) == QUALITIES and tab.panel.quality.value == "draft"
+    assert tuple(tab.display.quality.options) == QUALITIES and tab.display.quality.value == "draft"
     assert tab.preview.wait_idle(WAIT_S)
     published = watched(tab)
-    tab.panel.sun_altitude.value = 15.0
+    tab.sun.altitude.value = 15.0
     assert tab.preview.wait_idle(WAIT_S)
     draft, exact = published[-2:]
     assert draft.request.draft and draft.rgb.shape == (DRAFT_SIZE[1], DRAFT_SIZE[0], 3)
@@ -63,20 +63,20 @@ def test_draft_quality_shows_a_draft_then_the_exact_frame(tab: EditorTab, state:
     assert draft.request.seq == exact.request.seq == tab.preview.latest_seq
     expected = state.frames.frame(tab.case, tab.frame, PREVIEW_SIZE, overlay=True).rgb
     np.testing.assert_array_equal(tab.last_result.rgb, expected)  # it rests on the exact frame
-    assert "draft" not in tab.panel.preview_info.content
+    assert "draft" not in tab.display.info.content
 
 
 def test_full_quality_shows_exact_frames_only(tab: EditorTab) -> None:
-    tab.panel.quality.value = "full"
+    tab.display.quality.value = "full"
     assert tab.preview.wait_idle(WAIT_S)
     published = watched(tab)
     for altitude in (20.0, 25.0):
-        tab.panel.sun_altitude.value = altitude
+        tab.sun.altitude.value = altitude
         assert tab.preview.wait_idle(WAIT_S)
     assert published and not any(result.request.draft for result in published)
     assert {result.rgb.shape for result in published} == {(PREVIEW_SIZE[1], PREVIEW_SIZE[0], 3)}
     with pytest.raises(EditError, match="quality"):
-        tab.set_quality("fast")
+        tab.display.set_quality("fast")
 
 
 def mean_difference(a: np.ndarray, b: np.ndarray) -> float:

@@ -38,7 +38,10 @@ def wait_for(condition: Callable[[], bool], what: str, timeout: float = WAIT_S) 
 
 
 def dropdowns(page) -> list[str]:
-    return page.locator("input[role=combobox]").evaluate_all("(inputs) => inputs.map((i) => i.value)")
+    """The values the page's dropdowns show, but the 3D view's (the test fixture switches it as the tab opens)."""
+    return page.locator("input[role=combobox]").evaluate_all(
+        "(inputs) => inputs.filter((i) => !i.closest('.mantine-Flex-root')?.querySelector('label')?.textContent"
+        "  ?.startsWith('3D view')).map((i) => i.value)")
 
 
 def open_tab(browser, editor: Editor, url: str):
@@ -56,7 +59,7 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, editor_ur
     assert tab0 is not tab1 and tab0.session.case_id == tab1.session.case_id
     case_id = tab0.session.case_id
 
-    tab0.panel.title.value = "Edited in a tab"  # an unsaved edit of the first tab only
+    tab0.cases.title.value = "Edited in a tab"  # an unsaved edit of the first tab only
     assert tab1.case.title != "Edited in a tab"
     page0.get_by_role("button", name="Save", exact=True).click()
     wait_for(lambda: state.store.get(case_id).version == 2, "the save")
@@ -68,7 +71,7 @@ def test_save_in_one_of_two_tabs_warns_no_tab(browser, editor: Editor, editor_ur
     assert state.store.get(case_id).case.title == tab1.case.title == "Edited in a tab"
     page1.screenshot(path=str(screenshot_dir / "editor_two_tabs_saved.png"))
 
-    tab1.panel.title.value = "Edited again, not saved"  # the second tab's own unsaved edit
+    tab1.cases.title.value = "Edited again, not saved"  # the second tab's own unsaved edit
     theirs = state.store.get(case_id).case.model_copy(update={"title": "changed over REST"})
     state.store.update(case_id, theirs, expected_version=2)
     page1.locator(TOAST, has_text=FOREIGN).wait_for()  # a foreign write over unsaved edits is reported
@@ -87,9 +90,9 @@ def test_view_settings_stay_in_their_tab(browser, editor: Editor, editor_url: st
     assert "draft" in defaults and "none" in defaults
     pick(page0, "draft", "full")
     pick(page0, "none", "hough")
-    wait_for(lambda: (tab0.panel.quality.value, tab0.panel.detector.value) == ("full", "hough"), "the first tab")
+    wait_for(lambda: (tab0.display.quality.value, tab0.display.detector.value) == ("full", "hough"), "the first tab")
     page1, tab1 = open_tab(browser, editor, editor_url)
-    assert tab1 is not tab0 and (tab1.panel.quality.value, tab1.panel.detector.value) == ("draft", "none")
+    assert tab1 is not tab0 and (tab1.display.quality.value, tab1.display.detector.value) == ("draft", "none")
     assert dropdowns(page1) == defaults
     assert "full" in dropdowns(page0) and "hough" in dropdowns(page0)
     page1.screenshot(path=str(screenshot_dir / "editor_tabs_own_settings.png"), timeout=SLOW_MS)

@@ -4,6 +4,7 @@ a tab opened later starts from the stored case and the panel's defaults, and the
 from __future__ import annotations
 
 import json
+import operator
 
 import numpy as np
 
@@ -21,49 +22,49 @@ def settle(tab: EditorTab) -> np.ndarray:
 
 
 def opened(tab: EditorTab, case_id: str) -> EditorTab:
-    tab.panel.case_id.value = case_id
+    tab.cases.case_id.value = case_id
     settle(tab)
     return tab
 
 
-VIEW = ("severity", "sun_azimuth", "sun_altitude", "sun_intensity", "detector", "quality", "overlay", "frame",
-        "camera_fov", "title")
+VIEW = ("illusions.severity", "sun.azimuth", "sun.altitude", "sun.intensity", "display.detector", "display.quality",
+        "display.overlay", "display.frame", "camera.fov", "cases.title")
 
 
 def shown(tab: EditorTab) -> dict[str, object]:
     """What the tab's panel shows for the settings a user scrubs."""
-    return {name: getattr(tab.panel, name).value for name in VIEW}
+    return {name: operator.attrgetter(name)(tab).value for name in VIEW}
 
 
 def test_a_new_tab_inherits_nothing_from_an_open_tab(editor_server: Editor, state: AppState) -> None:
     with HeadlessTab(editor_server, timeout=WAIT_S) as first:
         opened(first, SHADOW)
         fresh = shown(first)
-        first.panel.severity.value = 5
-        first.panel.sun_altitude.value = 12.0
-        first.panel.sun_azimuth.value = -100.0
-        first.panel.detector.value = "hough"
-        first.panel.quality.value = "full"
-        first.panel.overlay.value = False
-        first.panel.frame.value = 7
-        first.panel.camera_fov.value = 70.0
+        first.illusions.severity.value = 5
+        first.sun.altitude.value = 12.0
+        first.sun.azimuth.value = -100.0
+        first.display.detector.value = "hough"
+        first.display.quality.value = "full"
+        first.display.overlay.value = False
+        first.display.frame.value = 7
+        first.camera.fov.value = 70.0
         settle(first)
         edited = shown(first)
-        assert [name for name in VIEW if edited[name] == fresh[name]] == ["sun_intensity", "title"]
+        assert [name for name in VIEW if edited[name] == fresh[name]] == ["sun.intensity", "cases.title"]
         with HeadlessTab(editor_server, timeout=WAIT_S) as second:
             assert second is not first and second.client_id != first.client_id
-            assert second.panel is not first.panel and second.preview is not first.preview
+            assert second.display is not first.display and second.preview is not first.preview
             opened(second, SHADOW)
             assert shown(second) == fresh  # the stored case and the panel's defaults, not the first tab's state
             assert second.case == state.store.get(SHADOW).case and not second.session.dirty
             request = second.last_result.request
             assert (request.detector, request.overlay, request.frame, request.draft) == (None, True, 0, False)
 
-            second.panel.sun_altitude.value = 70.0  # and back: the second tab's edits stay in the second tab
-            second.panel.detector.value = "birdseye"
+            second.sun.altitude.value = 70.0  # and back: the second tab's edits stay in the second tab
+            second.display.detector.value = "birdseye"
             settle(second)
             assert shown(first) == edited and first.case.sun.altitude == 12.0
-            assert first.panel.detector.value == "hough" and first.case.illusions[0].severity == 5
+            assert first.display.detector.value == "hough" and first.case.illusions[0].severity == 5
         assert first.session.dirty and first.case.sun.altitude == 12.0
 
 
@@ -72,19 +73,19 @@ def test_a_save_in_one_tab_reaches_a_clean_tab_and_warns_an_edited_one(editor_se
     with HeadlessTab(editor_server, timeout=WAIT_S) as first, HeadlessTab(editor_server, timeout=WAIT_S) as second:
         opened(first, SHADOW)
         opened(second, SHADOW)
-        first.panel.severity.value = 1
+        first.illusions.severity.value = 1
         assert second.case.illusions[0].severity == 3  # unsaved edits are the first tab's own
-        first.panel.save.value = True
+        first.cases.save_button.value = True
         assert state.store.get(SHADOW).version == 2
         assert second.case.illusions[0].severity == 1 and second.session.version == 2  # clean: takes it at once
-        assert "arrived from the store" in second.panel.status.content
-        assert "stored elsewhere" not in first.panel.status.content
+        assert "arrived from the store" in second.status.content
+        assert "stored elsewhere" not in first.status.content
 
-        second.panel.sun_altitude.value = 30.0
-        first.panel.title.value = "Saved from the first tab"
-        first.panel.save.value = True
+        second.sun.altitude.value = 30.0
+        first.cases.title.value = "Saved from the first tab"
+        first.cases.save_button.value = True
         assert second.case.sun.altitude == 30.0 and second.case.title != "Saved from the first tab"
-        assert "Version 3 was stored elsewhere" in second.panel.status.content
+        assert "Version 3 was stored elsewhere" in second.status.content
         settle(first)
         settle(second)
 
@@ -108,7 +109,7 @@ def test_each_tab_drives_its_own_edited_case(editor_server: Editor, state: AppSt
     with HeadlessTab(editor_server, timeout=WAIT_S) as first, HeadlessTab(editor_server, timeout=WAIT_S) as second:
         opened(first, SHADOW)
         opened(second, SHADOW)
-        first.panel.title.value = "Edited in the first tab"
+        first.cases.title.value = "Edited in the first tab"
         jobs = []
         for tab in (first, second):
             tab.drive.seconds.value = 1.0

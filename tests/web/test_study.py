@@ -125,6 +125,17 @@ def test_json_spec_without_uploads(client) -> None:
     assert [item["case_id"] for item in response.json()["items"]] == ["clean-00_straight_urban"]
 
 
+def test_a_case_of_two_illusion_types_is_its_own_study_group(client) -> None:
+    case = client.get("/api/cases/fence_shadow-00_uphill_rural_noon-03_level3").json()["case"]
+    case["illusions"].append({"type": "road_crack", "severity": 2, "s": 60.0})
+    assert client.post("/api/cases", json={"id": "two-types", "case": case}).status_code == 201
+    spec = {"title": "Mixed", **SIZE, "generated": {"cases": ["two-types"]}}
+    response = client.post("/api/study/studies", headers=ADMIN, json=spec)
+    assert response.status_code == 201, response.text
+    item = response.json()["items"][0]
+    assert item["illusion_type"] == "road_crack+fence_shadow" and item["category"] == "mixed"
+
+
 def test_admin_routes_need_the_token(client, state) -> None:
     spec = {"title": "x", "generated": {"cases": ["clean-00_straight_urban"]}}
     assert create(client, spec, headers={}).status_code == 401
