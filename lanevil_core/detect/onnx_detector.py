@@ -39,6 +39,7 @@ import numpy as np
 
 from ..metrics.formats import LaneFileError
 from ..typed import BoolArray, FloatArray, UInt8Array
+from .model_spec import CONFIG_FILE, ONNX_FILE
 from .standard_heads import (
     HEADS,
     decode_mask_head,
@@ -239,9 +240,12 @@ def _load(name: str, path: str, version: str) -> OnnxLaneDetector:
 
 
 def onnx_version(onnx_path: Path) -> str:
-    """Size and time of the model and its sidecar: a new model or sidecar is a new detector version."""
+    """Size and time of the model and its sidecar (of a model folder: its ONNX file and config): a new model or
+    sidecar is a new detector version."""
     parts = []
-    for path in (onnx_path, sidecar_path(onnx_path)):
+    files = (onnx_path / ONNX_FILE, onnx_path / CONFIG_FILE) if onnx_path.is_dir() else (onnx_path,
+                                                                                          sidecar_path(onnx_path))
+    for path in files:
         try:
             stat = path.stat()
         except OSError:

@@ -14,7 +14,8 @@ Built-ins are ``detect.split.METHODS`` (six learned families, two classical base
 - the installed Python plug-ins of the entry-point group ``lanevil.detectors`` (``detect.plugin``).
 
 A SOURCE is ``http://HOST:PORT/PATH`` (or https: ``detect.http_detector``) or ``onnx:PATH`` (an ONNX model with a
-sidecar: ``detect.onnx_detector``). The command line also takes a SOURCE itself as a method
+sidecar: ``detect.onnx_detector``; or a model folder of ``lanevil train`` / ``lanevil adapt``, run as its family).
+The command line also takes a SOURCE itself as a method
 (``lanevil detect --method http://127.0.0.1:8500/detect``); the web app takes names only, so a request cannot make
 the server call an address or open a file of the request's choosing. Names are 1-40 letters, digits, ``_``, ``.``
 or ``-``; a built-in method's name, ``gt`` and ``none`` are taken.
@@ -193,7 +194,7 @@ def plugin_spec(name: str, sources: bool = False) -> PluginSpec | None:
 def plugin_real_trained(spec: PluginSpec) -> bool:
     """Whether a plug-in is marked trained on real roads: in its configuration, or by the plug-in itself (an ONNX
     sidecar's ``real_trained``, a Python plug-in's attribute); loads it."""
-    return spec.real_trained or bool(getattr(loaded_plugin(spec).plugin, "real_trained", False))
+    return spec.real_trained or bool(getattr(getattr(loaded_plugin(spec), "plugin", None), "real_trained", False))
 
 
 _HTTP_CLIENTS: dict[PluginSpec, Any] = {}
@@ -222,7 +223,16 @@ def loaded_plugin(spec: PluginSpec) -> Any:
     if spec.kind == "onnx":
         from .onnx_detector import onnx_detector
 
-        return PolylineDetector(spec.name, onnx_detector(spec.name, Path(spec.source.removeprefix(ONNX_PREFIX))))
+        path = Path(spec.source.removeprefix(ONNX_PREFIX))
+        if path.is_dir():  # a model folder of `lanevil train` or `lanevil adapt`: run as its family is
+            from .learned import load_detector
+            from .model_spec import ModelSpecError
+
+            try:
+                return load_detector(str(path.resolve()))
+            except ModelSpecError as error:
+                raise LaneFileError(f"detector: {spec.name}: {error}") from None
+        return PolylineDetector(spec.name, onnx_detector(spec.name, path))
     return plugin_detector(spec.name)
 
 

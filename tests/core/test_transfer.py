@@ -180,6 +180,20 @@ def test_adapt_writes_a_model_usable_as_weights(tiny_dataset, tmp_path, capsys):
                  "--out", str(tmp_path / "pred.json")]) == 0
 
 
+def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, monkeypatch, capsys):  # noqa: F811
+    from lanevil_core.detect.catalog import detector_info
+
+    assert _train(tiny_dataset, tmp_path / "model", "seg") == 0
+    monkeypatch.setenv("LANEVIL_DETECTORS", f"mine=onnx:{tmp_path / 'model'};gone=onnx:{tmp_path / 'nowhere'}")
+    info = detector_info("mine")
+    assert info.kind == "onnx" and info.available, info.reason
+    assert main(["detect", str(tiny_dataset / "train"), "--method", "mine", "--out", str(tmp_path / "p.json")]) == 0
+    assert len((tmp_path / "p.json").read_text().splitlines()) == 10
+    assert not detector_info("gone").available
+    assert main(["detect", str(tiny_dataset / "train"), "--method", "gone", "--out", str(tmp_path / "q.json")]) == 2
+    assert "gone" in capsys.readouterr().err
+
+
 def test_adapt_errors_exit_2(tmp_path, capsys):
     (tmp_path / "empty").mkdir()
     assert main(["adapt", "--weights", "ufld", "--frames", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 2
