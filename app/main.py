@@ -9,7 +9,7 @@ from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
 from .api.allow import AllowMiddleware
-from .api.errors import error_response, handle_exception
+from .api.errors import error_response, handle_exception, handle_server_error
 from .docs import mount_docs
 from .headers import SecurityHeadersMiddleware
 from .jobs import JobNotFound
@@ -35,6 +35,7 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     app.add_middleware(SecurityHeadersMiddleware)  # added last = outermost: 413s carry the headers too
     for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route
         app.add_exception_handler(error, handle_exception)
+    app.add_exception_handler(Exception, handle_server_error)  # any other exception: a 500 with the headers
     app.include_router(api_router, prefix="/api")
     app.include_router(study_router)
     mount_docs(app)  # /docs and /redoc with their scripts served here, not from a CDN
