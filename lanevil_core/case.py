@@ -16,6 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, Stri
 
 from .files import write_atomic
 from .illusions import IllusionSpec
+from .illusions.base import MAX_ROAD_LENGTH_M
 from .presets import camera_preset_values, preset_values
 from .typed import LineType, Pavement, RoadType, SceneKind, Turn
 
@@ -67,7 +68,7 @@ class Road(_Model):
     """
 
     type: RoadType = "straight"
-    length: StrictFloat = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
+    length: StrictFloat = Field(400.0, ge=100.0, le=MAX_ROAD_LENGTH_M, description="length of the main road (m)")
     lanes_per_direction: StrictInt = Field(2, ge=1, le=4)
     lane_width: StrictFloat = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
     radius: StrictFloat = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")

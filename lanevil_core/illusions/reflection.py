@@ -49,11 +49,14 @@ def puddle_mask(rng: np.random.Generator, shape: tuple[int, int], coverage: floa
 
 def _wet_road(ctx: CompileContext, rng: np.random.Generator, s0: float, length: float, wetness: float,
               puddles: float, blob_m: float, name: str) -> None:
-    """Wet the whole road and lay puddles over the carriageway from ``s0`` for ``length`` metres."""
+    """Wet the whole road and lay puddles over the carriageway from ``s0`` for ``length`` metres (none where that
+    stretch is empty: an illusion placed beyond the end of the drive)."""
     ctx.env.wetness = max(ctx.env.wetness, wetness)
     piece = ctx.network.main
     t0 = -piece.half_width - 0.5
     rows = int(length / PUDDLE_TEXEL_M)
+    if rows < 1:
+        return
     cols = int((2 * piece.half_width + 1.0) / PUDDLE_TEXEL_M)
     wet = puddle_mask(rng, (rows, cols), puddles, blob_m)
     rgba = np.empty((rows, cols, 4), np.float32)

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from lanevil_core.case import parse_case
+from lanevil_core.case import Case, parse_case
+from lanevil_core.illusions import REGISTRY
 from lanevil_core.pipeline.compile import compile_scene, roadside_key
+from lanevil_core.render import render_frame
 
 
 def _assert_same(a, b) -> None:
@@ -58,3 +61,11 @@ def test_renderer_labels_and_exporter_read_nothing_of_the_case(make_case) -> Non
     assert len(tusimple_record(scene, 5, frame, raw_file="000005.png")["lanes"]) >= 2
     assert isinstance(culane_lines(scene, frame), str)
     assert scene_glb(scene)[:4] == b"glTF"
+
+
+@pytest.mark.parametrize("illusion_type", sorted(REGISTRY))
+def test_an_illusion_beyond_the_end_of_the_drive_compiles_and_renders(illusion_type: str) -> None:
+    """``s`` may lie anywhere on the road (0..3000 m), past the drive's end or the road's: nothing to see there."""
+    case = Case.model_validate({"illusions": [{"type": illusion_type, "s": 2999.0, "severity": 4}]})
+    frame = render_frame(compile_scene(case), 0, (64, 64))
+    assert frame.rgb.shape == (64, 64, 3)
