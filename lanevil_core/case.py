@@ -10,13 +10,13 @@ import math
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
 
 from .files import write_atomic
 from .illusions import IllusionSpec
-from .illusions.base import MAX_ROAD_LENGTH_M
+from .illusions.base import MAX_ROAD_LENGTH_M, RGB
 from .presets import camera_preset_values, preset_values
 from .typed import LineType, Pavement, RoadType, SceneKind, Turn
 
@@ -131,7 +131,6 @@ class Sun(_Model):
     intensity: StrictFloat = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
 
 
-Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 
 
 def _take_preset(data: Any, lookup: Callable[[str], dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]] | None:
@@ -170,7 +169,7 @@ class Bonnet(_Model):
     drop: StrictFloat = Field(0.45, ge=0.05, le=2.0, description="how far below the camera the front edge is (m)")
     width: StrictFloat = Field(1.75, ge=0.8, le=3.0, description="width of the bonnet (m)")
     crown: StrictFloat = Field(0.08, ge=0.0, le=0.5, description="how much lower its corners are than its middle (m)")
-    color: tuple[Unit, Unit, Unit] = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
+    color: RGB = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
     gloss: StrictFloat = Field(0.35, ge=0.0, le=1.0, description="share of the sky mirrored in the paint")
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
@@ -27,6 +27,8 @@ DEFAULT_AHEAD_M = 22.0
 # frames still see it ahead.
 BEYOND_DRIVE_M = 30.0
 MAX_ROAD_LENGTH_M = 3000.0  # the longest main road a case may have (``Road.length``)
+Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
+RGB = tuple[Unit, Unit, Unit]  # a linear RGB colour of a case file
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from ..world.primitives import pose_on_road, transformed
 from ..world.props import car, van
 from ..world.scene import PointLight, SurfaceLayer
 from ..world.structures import streetlight, streetlight_lamp_offset
-from .base import Category, CompileContext, Illusion, Level, register
+from .base import RGB, Category, CompileContext, Illusion, Level, register
 
 PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
@@ -221,9 +221,7 @@ class VehicleReflection(Illusion):
     type: Literal["vehicle_reflection"] = "vehicle_reflection"
     count: StrictInt | None = Field(None, ge=1, le=20, description="vehicles ahead; empty = from the severity")
     gap: StrictFloat = Field(14.0, ge=6, le=60, description="distance between vehicles along the road (m)")
-    color: tuple[StrictFloat, StrictFloat, StrictFloat] | None = Field(
-        None, description="linear RGB paint; empty = varied"
-    )
+    color: RGB | None = Field(None, description="linear RGB paint, each channel 0..1; empty = varied")
     length: StrictFloat = Field(150.0, gt=5, le=1000, description="extent of the wet stretch (m)")
 
     def level(self) -> VehicleReflectionLevel:

@@ -19,7 +19,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, cast
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, cast
 
 import numpy as np
 import trimesh
@@ -28,7 +28,7 @@ from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 from ..world import props
 from ..world.primitives import pose_on_road, rotation_z, to_mesh, transformed
 from ..world.scene import Mesh
-from .base import BEYOND_DRIVE_M, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
+from .base import BEYOND_DRIVE_M, RGB, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
 
 if TYPE_CHECKING:
     from ..typed import FloatArray
@@ -47,8 +47,6 @@ MESH_NAME_RULE = (f"must be a file name in the uploads folder (letters, digits, 
                   f"{', '.join('.' + suffix for suffix in MESH_SUFFIXES)}), not a path")
 MAX_OBSTACLE_FACES = 60_000
 
-Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
-RGB = tuple[Unit, Unit, Unit]
 # Footprint and height (length, width, height) of each procedural vehicle (m).
 VEHICLE_SIZE: dict[str, tuple[float, float, float]] = {"car": (4.5, 1.8, 1.45), "van": (5.2, 2.0, 2.3),
                                                        "truck": (8.0, 2.5, 3.4)}
