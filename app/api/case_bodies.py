@@ -24,19 +24,22 @@ PATCH_SUFFIX = "Patch"
 NULL = {"type": "null"}
 
 
-def envelope(case: dict[str, Any]) -> dict[str, Any]:
-    """The envelope form of a body whose ``case`` is described by ``case`` (read-only fields are ignored)."""
-    return {"type": "object", "required": ["case"], "additionalProperties": False, "properties": {
+def envelope(case: dict[str, Any], with_id: bool) -> dict[str, Any]:
+    """The envelope form of a body whose ``case`` is described by ``case`` (read-only fields are ignored). A write
+    to ``/api/cases/{case_id}`` takes its id from the URL (the server takes an ``id`` only when equal to it)."""
+    properties: dict[str, Any] = {
         "case": case,
-        "id": {"type": "string", "pattern": ID_PATTERN.pattern, "description": "the case id"},
         "version": {"type": "integer", "minimum": 1, "description": "the version the change is based on"},
         "created_at": {"type": "number", "description": "read-only, ignored"},
         "updated_at": {"type": "number", "description": "read-only, ignored"},
-        "origin": {"anyOf": [{"type": "string"}, NULL], "description": "read-only, ignored"}}}
+        "origin": {"anyOf": [{"type": "string"}, NULL], "description": "read-only, ignored"}}
+    if with_id:
+        properties["id"] = {"type": "string", "pattern": ID_PATTERN.pattern, "description": "the case id"}
+    return {"type": "object", "required": ["case"], "additionalProperties": False, "properties": properties}
 
 
-def document_or_envelope(case: dict[str, Any], description: str) -> dict[str, Any]:
-    return {"anyOf": [case, envelope(case)], "description": description}
+def document_or_envelope(case: dict[str, Any], description: str, with_id: bool = True) -> dict[str, Any]:
+    return {"anyOf": [case, envelope(case, with_id)], "description": description}
 
 
 def merge_patch_schemas(model: type[Case] = Case) -> dict[str, dict[str, Any]]:
@@ -69,10 +72,13 @@ CASE_BODY_SCHEMAS = merge_patch_schemas()
 CASE_REF = {"$ref": f"{COMPONENTS}{Case.__name__}"}
 PATCH_REF = {"$ref": f"{COMPONENTS}{Case.__name__}{PATCH_SUFFIX}"}
 CASE_BODY = document_or_envelope(CASE_REF, "a case document, or an envelope {id?, version?, case}")
-PATCH_BODY = document_or_envelope(PATCH_REF, "a JSON merge patch of the case, or an envelope {id?, version?, case: "
-                                             "patch}")
+REPLACE_BODY = document_or_envelope(CASE_REF, "a case document, or an envelope {version?, case}", with_id=False)
+PATCH_BODY = document_or_envelope(PATCH_REF, "a JSON merge patch of the case, or an envelope {version?, case: patch}",
+                                  with_id=False)
 
 CaseBody = Annotated[dict[str, Any], WithJsonSchema(CASE_BODY),
                      Body(openapi_examples={"case": {"value": {"title": "my case"}}})]
+ReplaceBody = Annotated[dict[str, Any], WithJsonSchema(REPLACE_BODY),
+                        Body(openapi_examples={"case": {"value": {"title": "my case"}}})]
 PatchBody = Annotated[dict[str, Any], WithJsonSchema(PATCH_BODY),
                       Body(openapi_examples={"patch": {"value": {"sun": {"altitude": 20.0}}}})]

@@ -25,7 +25,7 @@ from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..state import AppState
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id
-from .case_bodies import PATCH_BODY, CaseBody, PatchBody
+from .case_bodies import PATCH_BODY, CaseBody, PatchBody, ReplaceBody
 from .deps import CaseIdPath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
 from .params import VERSION_PATTERN, etag_matches, parse_version
@@ -189,7 +189,7 @@ def get_case(record: RecordDep, if_none_match: Annotated[str | None, Header(alia
 
 @router.put("/{case_id}", summary="Replace a case",
             responses={200: envelope_response("the case at its new version"), **NOT_FOUND, **CONFLICT})
-def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
+def put_case(case_id: CaseIdPath, body: ReplaceBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
     """Replace the case; ``If-Match`` or the body's ``version`` guards against overwriting someone else's change."""
     document, body_id, body_version = split_body(body, allow_version=True)
     if body_id is not None and body_id != case_id:

@@ -101,7 +101,7 @@ def get_detections(
     """Run `detector` on frame `frame` (same size and override parameters as the frame image) and score its lanes
     against the frame's TuSimple labels: `accuracy`, `fp`, `fn` are the official per-image values, computed on the
     1280x720 grid whatever the frame's size; the metric's 200 ms run-time rule is not applied."""
-    check_frame(record.case, frame, status_code=404)
+    check_frame(record.case, frame)
     checked_detector(detector)
     size = image_size(query.width, query.height, record.case, state.settings)
     case = query.apply(record.case)

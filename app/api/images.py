@@ -57,7 +57,7 @@ def get_frame(record: RecordDep, frame: FramePath, fmt: ImageFormat, state: Stat
     """Frame ``frame`` as PNG or JPEG at the case camera's size or ``width``x``height``, optionally with the lane
     overlay (ground truth, one colour per lane), a detector's lanes (``detector=``, magenta) and severity/sun
     overrides (not saved)."""
-    check_frame(record.case, frame, status_code=404)
+    check_frame(record.case, frame)
     return image_response(state, record.case, frame, query, fmt, if_none_match, FRAME_CACHE_CONTROL)
 
 

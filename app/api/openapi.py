@@ -13,6 +13,7 @@ It also says what the server takes, no more: a query, path or header parameter i
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -58,7 +59,7 @@ def document_errors(schema: dict[str, Any], schemas: Mapping[str, dict[str, Any]
     components = schema.setdefault("components", {}).setdefault("schemas", {})
     components.setdefault(ErrorBody.__name__, ErrorBody.model_json_schema())
     for name, model_schema in (schemas or {}).items():
-        components.setdefault(name, model_schema)
+        components.setdefault(name, copy.deepcopy(model_schema))  # each app fills in its own server limits
     text = repr(schema.get("paths", {}))
     for name in FASTAPI_VALIDATION_SCHEMAS:
         if f"#/components/schemas/{name}'" not in text:

@@ -69,9 +69,10 @@ def _within(value: int, largest: int) -> int:
     return max(MIN_SIZE, min(value, largest))
 
 
-def check_frame(case: Case, frame: int, status_code: int = 422) -> int:
+def check_frame(case: Case, frame: int) -> int:
+    """``frame`` when the case has it; else a 404 naming ``frame`` (the frame asked for does not exist)."""
     if not 0 <= frame < case.ego.frames:
-        raise ApiError(status_code, f"{frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} "
+        raise ApiError(404, f"{frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} "
                                     "frames)", "frame")
     return frame
 

@@ -112,8 +112,13 @@ def test_render_unsaved_case(client) -> None:
                        headers={"If-None-Match": posted.headers["etag"]}).status_code == 304
 
 
+@pytest.mark.parametrize("frame", [500, -1])
+def test_render_of_a_frame_the_case_lacks_is_404_as_for_a_stored_case(client, frame: int) -> None:
+    response = client.post(f"/api/render?{SMALL}&frame={frame}", json={})
+    assert (response.status_code, response.json()["field"]) == (404, "frame")
+
+
 @pytest.mark.parametrize(("query", "body", "field"), [
-    (f"{SMALL}&frame=500", {}, "frame"),
     (SMALL, {"camera": {"fov": 400}}, "camera.fov"),
     (SMALL, {"case": {"ego": {"speed": -1}}}, "case.ego.speed"),
     (f"{SMALL}&format=bmp", {}, "format"),
