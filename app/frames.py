@@ -33,6 +33,8 @@ from lanevil_core.pipeline.compile import compile_scene, roadside_key
 from lanevil_core.render import all_cores, render_frame
 from lanevil_core.world.scene import CompiledScene
 
+from .memory import release_free_memory
+
 ImageFormat = Literal["png", "jpg"]
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
 JPEG_QUALITY = 90
@@ -144,6 +146,7 @@ class RenderSlots:
         finally:
             self._held.depth = 0
             self._semaphore.release()
+            release_free_memory()  # what the compile and render freed goes back to the system (memory.py)
 
 
 def case_hash(case: Case) -> str:
