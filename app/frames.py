@@ -33,6 +33,7 @@ from lanevil_core.pipeline.compile import compile_scene, roadside_key
 from lanevil_core.render import all_cores, render_frame
 from lanevil_core.world.scene import CompiledScene
 
+from .memory import release_free_memory
 from .settings import FRAME_CACHE_BYTES, MAX_RENDER_QUEUE, MAX_RENDERS, SCENE_CACHE_BYTES
 
 MEDIA_TYPES: dict[str, str] = {"png": "image/png", "jpg": "image/jpeg"}
@@ -142,6 +143,7 @@ class RenderSlots:
         finally:
             self._held.depth = 0
             self._semaphore.release()
+            release_free_memory()  # what the compile and render freed goes back to the system (memory.py)
 
 
 def case_hash(case: Case) -> str:

@@ -12,6 +12,7 @@ no client and are never refused, though they count towards the total.
 
 from __future__ import annotations
 
+import logging
 import math
 import re
 import shutil
@@ -57,6 +58,9 @@ class JobLimit(Exception):
 
 class JobCancelled(Exception):
     """Raised inside a job's ``progress`` callback once the job was cancelled, to stop its work."""
+
+
+LOG = logging.getLogger(__name__)
 
 
 @dataclass
@@ -192,8 +196,12 @@ class JobManager:
                 self._seconds_per_step = (time.time() - job.started_at) / job.total
         except JobCancelled:
             job.status = "cancelled"
-        except Exception as error:  # noqa: BLE001 - a failed job reports its error instead of killing the worker
+        except ValueError as error:  # input the job cannot use (a mesh removed since): its message names the field
             job.error = f"{type(error).__name__}: {error}"
+            job.status = "failed"
+        except Exception as error:  # noqa: BLE001 - a failed job reports its error instead of killing the worker
+            LOG.exception("job %s failed", job.id)  # the details (paths, tracebacks) go to the server's log only
+            job.error = f"{type(error).__name__}: the job stopped on a server error"
             job.status = "failed"
         job.finished_at = time.time()
         job.finished.set()

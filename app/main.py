@@ -11,7 +11,8 @@ from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
 from .api import router as api_router
 from .api.allow import AllowMiddleware
-from .api.errors import error_response, handle_exception
+from .api.case_bodies import CASE_BODY_SCHEMAS
+from .api.errors import error_response, handle_exception, handle_server_error
 from .docs import mount_docs
 from .headers import SecurityHeadersMiddleware
 from .jobs import JobNotFound
@@ -37,10 +38,11 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     app.add_middleware(SecurityHeadersMiddleware)  # added last = outermost: 413s carry the headers too
     for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route
         app.add_exception_handler(error, handle_exception)
+    app.add_exception_handler(Exception, handle_server_error)  # any other exception: a 500 with the headers
     app.include_router(api_router, prefix="/api")
     app.include_router(study_router)
     mount_docs(app)  # /docs and /redoc with their scripts served here, not from a CDN
-    api_openapi.install(app, STUDY_SCHEMAS)
+    api_openapi.install(app, settings, {**STUDY_SCHEMAS, **CASE_BODY_SCHEMAS})
     mount_static(app)
     app.state.editor_port = None  # set by the server once the viser editor listens
     app.state.open_in_editor = None  # the editor's open_case(case_id) for the next tab, set with editor_port

@@ -6,14 +6,19 @@ other bytes (409), so frames cached for a case that names it stay right.
 
 from __future__ import annotations
 
-import json
 import os
 import re
+import struct
 import tempfile
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 from lanevil_core.illusions.traffic import MESH_NAME_RULE, MESH_SUFFIXES, is_mesh_name, load_obstacle
+
+GLTF_SUFFIXES = ("gltf", "glb")
+MAX_GLTF_DEPTH = 64  # exporters write glTF JSON a handful of levels deep (its ``extras`` a few more)
+GLB_HEADER = struct.Struct("<4sIIII")  # magic, version, total length; the first chunk's length and type
+GLB_JSON_CHUNK = 0x4E4F534A  # "JSON" as a little-endian uint32
 
 
 class MeshUploadError(ValueError):
@@ -64,8 +69,8 @@ def store_mesh(uploads: Path, filename: str, data: bytes, max_bytes: int) -> str
         raise MeshUploadError(422, f"{filename!r} {MESH_NAME_RULE}")
     if len(data) > max_bytes:
         raise MeshUploadError(413, f"{name} is over {max_bytes} bytes")
-    if suffix == "gltf":
-        _check_embedded(data, name)
+    if suffix in GLTF_SUFFIXES:
+        _check_embedded(gltf_document(data, suffix, name), name)
     target = uploads / name
     if target.exists():
         if target.read_bytes() == data:
@@ -76,16 +81,36 @@ def store_mesh(uploads: Path, filename: str, data: bytes, max_bytes: int) -> str
     return name
 
 
-def _check_embedded(data: bytes, name: str) -> None:
-    """A ``.gltf`` must carry its buffers and images inline (``data:`` URIs): it is read alone, never with files it
-    names on the server."""
+def gltf_document(data: bytes, suffix: str, name: str) -> Any:
+    """The JSON document of a ``.gltf`` file or of a ``.glb``'s first chunk, read strictly (UTF-8, at most
+    ``MAX_GLTF_DEPTH`` levels deep, no NaN): a 422 ``MeshUploadError`` for anything else, before the model loader
+    sees it (Python's ``json`` recurses once per level, so a deeply nested document would exhaust the stack)."""
+    from .api.json_body import BodyError, parse_json  # the api package imports this module
+
+    text = data
+    if suffix == "glb":
+        magic, _, _, length, kind = struct.unpack_from("<4sIIII", data.ljust(GLB_HEADER.size, b"\0"))
+        if magic != b"glTF" or kind != GLB_JSON_CHUNK or length > len(data) - GLB_HEADER.size:
+            raise MeshUploadError(422, f"{name} is not a binary glTF (GLB) file: no glTF header and JSON chunk")
+        text = data[GLB_HEADER.size:GLB_HEADER.size + length]
     try:
-        document = json.loads(data)
-    except (UnicodeDecodeError, ValueError):
-        raise MeshUploadError(422, f"{name} is not glTF JSON") from None
-    parts = [*document.get("buffers", []), *document.get("images", [])] if isinstance(document, dict) else []
-    if any(isinstance(part, dict) and not str(part.get("uri", "data:")).startswith("data:") for part in parts):
+        return parse_json(text, name, max_depth=MAX_GLTF_DEPTH)
+    except BodyError as error:
+        raise MeshUploadError(422, f"{name} is not usable glTF JSON: {error}") from None
+
+
+def _check_embedded(document: Any, name: str) -> None:
+    """A glTF must carry its buffers and images inline (``data:`` URIs, or a ``.glb``'s own binary chunk): it is
+    read alone, never with files it names on the server."""
+    if not isinstance(document, dict):
+        raise MeshUploadError(422, f"{name}: its glTF JSON is not an object")
+    parts = [part for key in ("buffers", "images") for part in _as_list(document.get(key))]
+    if any(not isinstance(part, dict) or not str(part.get("uri", "data:")).startswith("data:") for part in parts):
         raise MeshUploadError(422, f"{name} refers to other files: embed its buffers and images (or upload a .glb)")
+
+
+def _as_list(value: Any) -> list[Any]:
+    return value if isinstance(value, list) else [] if value is None else [value]
 
 
 def _write_checked(uploads: Path, target: Path, data: bytes) -> None:
@@ -96,9 +121,9 @@ def _write_checked(uploads: Path, target: Path, data: bytes) -> None:
         with os.fdopen(handle, "wb") as file:
             file.write(data)
         try:
-            load_obstacle(temp)
-        except Exception as error:  # trimesh raises many kinds for a file that is not a model  # noqa: BLE001
-            message = str(error).replace(str(temp), target.name)
+            load_obstacle(temp, name=target.stem)
+        except ValueError as error:  # its message names the file by its base name alone, never the folder
+            message = str(error).replace(temp.name, target.name)
             raise MeshUploadError(422, f"{target.name} is not a usable model: {message}") from None
         os.replace(temp, target)
     finally:

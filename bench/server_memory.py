@@ -5,7 +5,10 @@ Starts ``python -m app.cli serve --no-editor`` on a free port with a temporary d
 the server's resident memory (the process and its children) every 0.2 s, and prints the peak RSS and the p50/p95
 latency of a frame GET (and how many were answered 503: the render queue was full).
 
-    python bench/server_memory.py [--clients 8] [--seconds 60] [--frame-cache-bytes 0] [--json]
+    python bench/server_memory.py [--clients 8] [--seconds 60] [--frame-cache-bytes 0] [--cases road_crack] [--json]
+
+``--cases`` keeps the cases whose id contains that text (``road_crack``: the stock scenes that need the most
+memory, 0.2-0.6 GB each once compiled; the worst case for a server).
 
 Extra ``--env NAME=VALUE`` pairs go to the server (e.g. ``--env LANEVIL_MAX_RENDERS=2``).
 """
@@ -78,6 +81,7 @@ def main() -> int:
     parser.add_argument("--clients", type=int, default=8)
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--frame-cache-bytes", type=int, default=0)
+    parser.add_argument("--cases", default="", help="only cases whose id contains this text")
     parser.add_argument("--env", action="append", default=[], help="NAME=VALUE for the server")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
@@ -93,7 +97,7 @@ def main() -> int:
         try:
             wait_ready(base, server)
             idle_rss = rss_bytes(server.pid)
-            cases = [row["id"] for row in json.loads(get(f"{base}/api/cases")[1])["data"]]
+            cases = [row["id"] for row in json.loads(get(f"{base}/api/cases")[1])["data"] if args.cases in row["id"]]
             latencies: list[float] = []
             statuses: dict[int, int] = {}
             peak = [idle_rss]
@@ -130,7 +134,8 @@ def main() -> int:
             server.wait(timeout=30)
     ok = np.asarray(latencies)
     result = {"clients": args.clients, "seconds": args.seconds, "frame_cache_bytes": args.frame_cache_bytes,
-              "env": args.env, "idle_rss_mb": round(idle_rss / 1e6), "peak_rss_mb": round(peak[0] / 1e6),
+              "env": args.env, "cases": args.cases or "all",
+              "idle_rss_mb": round(idle_rss / 1e6), "peak_rss_mb": round(peak[0] / 1e6),
               "requests": len(latencies), "statuses": statuses,
               "p50_s": round(float(np.percentile(ok, 50)), 2) if len(ok) else None,
               "p95_s": round(float(np.percentile(ok, 95)), 2) if len(ok) else None}

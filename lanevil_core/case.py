@@ -10,13 +10,14 @@ import math
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
 
 from .files import write_atomic
 from .illusions import IllusionSpec
+from .illusions.base import MAX_ROAD_LENGTH_M, RGB
 from .presets import camera_preset_values, preset_values
 from .typed import LineType, Pavement, RoadType, SceneKind, Turn
 
@@ -88,7 +89,7 @@ class Road(_Model):
     """
 
     type: RoadType = "straight"
-    length: StrictFloat = Field(400.0, ge=100.0, le=3000.0, description="length of the main road (m)")
+    length: StrictFloat = Field(400.0, ge=100.0, le=MAX_ROAD_LENGTH_M, description="length of the main road (m)")
     lanes_per_direction: StrictInt = Field(2, ge=1, le=4)
     lane_width: StrictFloat = Field(3.5, ge=2.5, le=5.0, description="lane width (m)")
     radius: StrictFloat = Field(150.0, ge=30.0, le=5000.0, description="bend radius (bend, s_curve) (m)")
@@ -153,7 +154,6 @@ class Sun(_Model):
     intensity: StrictFloat = Field(1.0, ge=0, le=3, description="luminance of direct sun (1 = clear noon)")
 
 
-Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
 
 
 def _take_preset(data: Any, lookup: Callable[[str], dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]] | None:
@@ -209,7 +209,7 @@ class Bonnet(_Model):
     drop: StrictFloat = Field(0.45, ge=0.05, le=2.0, description="how far below the camera the front edge is (m)")
     width: StrictFloat = Field(1.75, ge=0.8, le=3.0, description="width of the bonnet (m)")
     crown: StrictFloat = Field(0.08, ge=0.0, le=0.5, description="how much lower its corners are than its middle (m)")
-    color: tuple[Unit, Unit, Unit] = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
+    color: RGB = Field((0.04, 0.045, 0.05), description="paint colour (linear RGB)")
     gloss: StrictFloat = Field(0.35, ge=0.0, le=1.0, description="share of the sky mirrored in the paint")
 
 

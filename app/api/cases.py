@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Header, Query, Request, Response
+from fastapi import APIRouter, Header, Query, Request, Response
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field, ValidationError
 
@@ -26,6 +26,7 @@ from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..state import AppState
 from ..store import CaseRecord, InvalidId, VersionConflict, check_id
+from .case_bodies import PATCH_BODY, CaseBody, PatchBody, ReplaceBody
 from .deps import CaseIdPath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
 from .params import VERSION_PATTERN, etag_matches, parse_version
@@ -77,8 +78,6 @@ def envelope_response(description: str) -> dict[str, Any]:
             "headers": {"ETag": {"description": 'the version, e.g. "3"', "schema": {"type": "string"}}}}
 
 
-CaseBody = Annotated[dict[str, Any], Body(description="a case document, or an envelope {id?, version?, case}",
-                                          openapi_examples={"case": {"value": {"title": "my case"}}})]
 IfMatch = Annotated[str | None, Header(alias="If-Match", description='the version the change is based on: "3"',
                                        json_schema_extra={"pattern": VERSION_PATTERN})]
 
@@ -147,8 +146,10 @@ def merge_patch(target: Any, patch: Any) -> Any:
 @router.get("", summary="List cases")
 def list_cases(
     state: StateDep,
-    category: Annotated[str | None, Query(description=f"one of {', '.join(LISTING_CATEGORIES)}")] = None,
-    type: Annotated[str | None, Query(description="an illusion type, e.g. fence_shadow")] = None,  # noqa: A002
+    category: Annotated[str | None, Query(description=f"one of {', '.join(LISTING_CATEGORIES)}",
+                                          json_schema_extra={"enum": list(LISTING_CATEGORIES)})] = None,
+    type: Annotated[str | None, Query(description="an illusion type, e.g. fence_shadow",  # noqa: A002
+                                      json_schema_extra={"enum": list(REGISTRY)})] = None,
 ) -> CaseList:
     """Summaries of the stored cases (sorted by id), optionally of one category and/or illusion type (an empty
     value is no filter)."""
@@ -189,7 +190,7 @@ def get_case(record: RecordDep, if_none_match: Annotated[str | None, Header(alia
 
 @router.put("/{case_id}", summary="Replace a case",
             responses={200: envelope_response("the case at its new version"), **NOT_FOUND, **CONFLICT})
-def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
+def put_case(case_id: CaseIdPath, body: ReplaceBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
     """Replace the case; ``If-Match`` or the body's ``version`` guards against overwriting someone else's change."""
     document, body_id, body_version = split_body(body, allow_version=True)
     if body_id is not None and body_id != case_id:
@@ -202,9 +203,8 @@ def put_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfM
 
 @router.patch("/{case_id}", summary="Merge-patch a case (RFC 7396)",
               responses={200: envelope_response("the case at its new version"), **NOT_FOUND, **CONFLICT},
-              openapi_extra={"requestBody": {"content": {"application/merge-patch+json": {
-                  "schema": {"type": "object"}}}}})
-def patch_case(case_id: CaseIdPath, body: CaseBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
+              openapi_extra={"requestBody": {"content": {"application/merge-patch+json": {"schema": PATCH_BODY}}}})
+def patch_case(case_id: CaseIdPath, body: PatchBody, state: StateDep, if_match: IfMatch = None) -> JSONResponse:
     """Merge a JSON merge patch into the case (``null`` resets a field to its default, lists are replaced)."""
     patch, body_id, body_version = split_body(body, allow_version=True)
     if body_id is not None and body_id != case_id:

@@ -21,9 +21,9 @@ from lanevil_core.detect.registry import ready_detector
 from lanevil_core.detect.split import METHODS
 from lanevil_core.metrics.formats import LaneFileError
 
-from .deps import RecordDep, StateDep
+from .deps import FramePath, RecordDep, StateDep
 from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiError, ApiRoute, ErrorBody
-from .params import ScrubQueryDep, check_frame, image_size
+from .params import ScrubQueryDep, check_frame, detector_enum, image_size
 
 router = APIRouter(tags=["detectors"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
@@ -104,15 +104,15 @@ def get_detectors() -> dict[str, Any]:
             responses={404: {"model": ErrorBody, "description": "no such case or frame"}, **RENDER_BUSY})
 def get_detections(
     record: RecordDep,
-    frame: int,
+    frame: FramePath,
     state: StateDep,
     query: ScrubQueryDep,
-    detector: Annotated[str, Query(max_length=40, description=DETECTOR_HELP)],
+    detector: Annotated[str, Query(max_length=40, description=DETECTOR_HELP, json_schema_extra=detector_enum())],
 ) -> dict[str, Any]:
     """Run `detector` on frame `frame` (same size and override parameters as the frame image) and score its lanes
     against the frame's TuSimple labels: `accuracy`, `fp`, `fn` are the official per-image values, computed on the
     1280x720 grid whatever the frame's size; the metric's 200 ms run-time rule is not applied."""
-    check_frame(record.case, frame, status_code=404)
+    check_frame(record.case, frame)
     checked_detector(detector)
     size = image_size(query.width, query.height, record.case, state.settings)
     case = query.apply(record.case)

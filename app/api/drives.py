@@ -15,6 +15,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import FileResponse, JSONResponse
 from pydantic import BaseModel, Field
 
+from lanevil_core.case import Case
 from lanevil_core.drive.detectors import DRIVE_DETECTORS, GROUND_TRUTH
 from lanevil_core.drive.loop import DriveSettings
 from lanevil_core.drive.outputs import PATH_PLOT_FILE, SUMMARY_FILE, TRACE_FILE, TRACE_PLOT_FILE
@@ -22,14 +23,17 @@ from lanevil_core.pipeline.compile import check_mesh_files
 
 from ..frames import case_hash
 from ..jobs import Job, drive_job
+from ..settings import Settings
+from ..store import ID_PATTERN
 from .deps import StateDep
 from .detectors import checked_detector
 from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
 from .exports import JobBody
-from .params import image_size
+from .params import HEIGHT_HELP, WIDTH_HELP, detector_enum, image_size, size_schema
 
 router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
+DRIVE_SIZE = (640, 360)  # the drive camera's default width and height
 MEDIA_TYPES = {TRACE_FILE: "text/csv", SUMMARY_FILE: "application/json", TRACE_PLOT_FILE: "image/png",
                PATH_PLOT_FILE: "image/png", "drive.mp4": "video/mp4", "drive.gif": "image/gif"}
 JOB_NOT_FOUND: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "description": "no such drive job"}}
@@ -50,14 +54,22 @@ DRIVE_JOB: dict[int | str, dict[str, Any]] = {200: {"model": DriveJob}, **JOB_NO
 class DriveRequest(BaseModel):
     """Body of ``POST /api/drives``."""
 
-    case_id: str = Field(description="id of a stored case", max_length=200)
-    detector: str = Field(GROUND_TRUTH, max_length=40,
-                          description=f"gt (the projected ground truth, the reference), a built-in detector "
-                                      f"({', '.join(DRIVE_DETECTORS[1:])}) or a plug-in of `GET /api/detectors`")
+    case_id: str = Field(description="id of a stored case", json_schema_extra={"pattern": ID_PATTERN.pattern})
+    detector: str = Field(GROUND_TRUTH, description=f"one of {', '.join(DRIVE_DETECTORS)} (gt = the projected "
+                                                    "ground truth, the reference) that can run here",
+                          json_schema_extra=detector_enum(GROUND_TRUTH))
     controller: Literal["pure_pursuit", "stanley"] = Field("pure_pursuit", description="lateral controller")
     seconds: float | None = Field(None, gt=0, le=60, description="how long to drive; default the case's drive")
-    width: int = Field(640, description="camera width, pixels (64 to the server's largest)")
-    height: int = Field(360, description="camera height, pixels (64 to the server's largest)")
+    width: int | None = Field(None, description=f"{WIDTH_HELP}; default {DRIVE_SIZE[0]}x{DRIVE_SIZE[1]} (at most "
+                                                "the server's largest)", json_schema_extra=size_schema("max_width"))
+    height: int | None = Field(None, description=HEIGHT_HELP, json_schema_extra=size_schema("max_height"))
+
+    def size(self, case: Case, settings: Settings) -> tuple[int, int]:
+        """The camera size: ``width``/``height`` as a frame's (``image_size``), or ``DRIVE_SIZE`` within the
+        server's largest."""
+        if self.width is None and self.height is None:
+            return min(DRIVE_SIZE[0], settings.max_width), min(DRIVE_SIZE[1], settings.max_height)
+        return image_size(self.width, self.height, case, settings)
 
 
 def _files(job: Job) -> list[str]:
@@ -92,13 +104,13 @@ def create_drive(body: DriveRequest, state: StateDep, request: Request) -> JSONR
     record = state.store.get(body.case_id)
     if body.detector != GROUND_TRUTH:
         checked_detector(body.detector, ready=True)  # a plug-in server that is down: 422 now, not a failed job
-    size = image_size(body.width, body.height, record.case, state.settings)
+    size = body.size(record.case, state.settings)
     check_mesh_files(record.case, state.meshes_dir)
     settings = DriveSettings(detector=body.detector, controller=body.controller, seconds=body.seconds, size=size)
     meta = {"case_id": record.id, "case_version": record.version, "detector": body.detector,
             "controller": body.controller}
     key = (f"drive:{case_hash(record.case)}:{body.detector}:{body.controller}:{body.seconds}:"
-           f"{body.width}x{body.height}")
+           f"{size[0]}x{size[1]}")
     client = request.client.host if request.client else "unknown"
     job = drive_job(state.jobs, record.case, settings, meta, key=key, client=client, meshes_dir=state.meshes_dir)
     payload = drive_body(job, request)

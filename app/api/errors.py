@@ -22,6 +22,7 @@ from lanevil_core.case import CaseError
 from lanevil_core.illusions import MeshFileError
 
 from ..frames import RenderBusy
+from ..headers import SECURITY_HEADERS
 from ..jobs import JobLimit, JobNotFound
 from ..store import CaseExists, CaseNotFound, InvalidId, StoreError, VersionConflict
 from .json_body import BodyError, check_json_type, parse_json
@@ -113,6 +114,13 @@ async def handle_exception(request: Request, error: Exception) -> Response:
     if response is None:
         raise error
     return response
+
+
+async def handle_server_error(request: Request, error: Exception) -> Response:
+    """The 500 of an uncaught exception: the API's error body (no traceback, no message that might quote the
+    server's files) with the security headers. Starlette answers it from its outermost middleware, outside every
+    middleware the app adds, so the headers are set here; the exception is then logged by the server."""
+    return error_response(500, "internal server error: the request could not be completed", None, SECURITY_HEADERS)
 
 
 class StrictJsonRequest(Request):

@@ -25,10 +25,10 @@ from lanevil_core.pipeline.compile import check_mesh_files
 from ..frames import case_hash
 from ..jobs import Job, JobStatus, export_zip
 from ..state import AppState
-from ..store import CaseRecord
+from ..store import ID_PATTERN, CaseRecord
 from .deps import RecordDep, StateDep
 from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
-from .params import frame_range
+from .params import FRAMES_PATTERN, frame_range
 
 router = APIRouter(tags=["exports"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
@@ -78,8 +78,9 @@ NO_CASE: dict[int | str, dict[str, Any]] = {404: {"model": ErrorBody, "descripti
 class ExportRequest(BaseModel):
     """Body of ``POST /api/exports``."""
 
-    case_id: str = Field(description="id of a stored case", max_length=200)
-    frames: str | None = Field(None, description="START:STOP (half-open) or N; default: every frame")
+    case_id: str = Field(description="id of a stored case", json_schema_extra={"pattern": ID_PATTERN.pattern})
+    frames: str | None = Field(None, description="START:STOP (half-open) or N; default: every frame",
+                               json_schema_extra={"pattern": FRAMES_PATTERN})
 
 
 def zip_name(record: CaseRecord) -> str:
@@ -117,7 +118,8 @@ def export_case_zip(
     record: RecordDep,
     state: StateDep,
     request: Request,
-    frames: Annotated[str | None, Query(description="START:STOP (half-open) or N; default: every frame")] = None,
+    frames: Annotated[str | None, Query(description="START:STOP (half-open) or N; default: every frame",
+                                        json_schema_extra={"pattern": FRAMES_PATTERN})] = None,
 ) -> Response:
     """The zip itself for up to ``SYNC_EXPORT_FRAMES`` frames; otherwise 202 with a job to poll."""
     chosen = frame_range(frames, record.case.ego.frames, range(record.case.ego.frames))

@@ -9,13 +9,14 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Header, Query, Response
+from fastapi import APIRouter, Header, Query, Response
 
-from lanevil_core.case import Case
+from lanevil_core.case import Case, Ego
 
 from ..state import AppState
+from .case_bodies import CaseBody
 from .cases import split_body, validate_case
-from .deps import RecordDep, StateDep
+from .deps import FramePath, RecordDep, StateDep
 from .detectors import checked_detector, detector_errors
 from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
 from .params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
@@ -30,6 +31,7 @@ IMAGE_RESPONSES: dict[int | str, dict[str, Any]] = {
     404: {"model": ErrorBody, "description": "no such case or frame"},
     **RENDER_BUSY,
 }
+MAX_FRAMES = Ego.model_json_schema()["properties"]["frames"]["maximum"]  # frames of the longest case
 IfNoneMatch = Annotated[str | None, Header(alias="If-None-Match")]
 
 
@@ -50,22 +52,23 @@ def image_response(state: AppState, case: Case, frame: int, query: RenderQuery, 
 
 @router.get("/cases/{case_id}/frames/{frame}.{fmt}", summary="Render a frame of a stored case",
             response_class=Response, responses=IMAGE_RESPONSES)
-def get_frame(record: RecordDep, frame: int, fmt: ImageFormat, state: StateDep, query: RenderQueryDep,
+def get_frame(record: RecordDep, frame: FramePath, fmt: ImageFormat, state: StateDep, query: RenderQueryDep,
               if_none_match: IfNoneMatch = None) -> Response:
     """Frame ``frame`` as PNG or JPEG at the case camera's size or ``width``x``height``, optionally with the lane
     overlay (ground truth, one colour per lane), a detector's lanes (``detector=``, magenta) and severity/sun
     overrides (not saved)."""
-    check_frame(record.case, frame, status_code=404)
+    check_frame(record.case, frame)
     return image_response(state, record.case, frame, query, fmt, if_none_match, FRAME_CACHE_CONTROL)
 
 
 @router.post("/render", summary="Render a frame of a case given in the body", response_class=Response,
              responses=IMAGE_RESPONSES)
 def render_case(
-    body: Annotated[dict[str, Any], Body(description="a case document (or an envelope {case: ...})")],
+    body: CaseBody,
     state: StateDep,
     query: RenderQueryDep,
-    frame: Annotated[int, Query(description="frame index")] = 0,
+    frame: Annotated[int, Query(description="frame index, below the case's `ego.frames`",
+                                json_schema_extra={"minimum": 0, "maximum": MAX_FRAMES - 1})] = 0,
     fmt: Annotated[ImageFormat, Query(alias="format", description="png or jpg")] = "png",
     if_none_match: IfNoneMatch = None,
 ) -> Response:

@@ -14,6 +14,7 @@ import re
 from typing import Any
 
 MAX_DEPTH = 64  # a case document is about 6 levels deep
+MAX_EXACT_INTEGER = 2**53  # whole numbers a float holds exactly
 # A JSON string (skipped whole, so brackets and words inside strings do not count), or a bracket, or a constant.
 _TOKENS = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}]|-?Infinity|NaN')
 
@@ -72,6 +73,13 @@ def _scan(text: str, field: str, max_depth: int) -> None:
                                         "NaN or Infinity; send a finite number)")
 
 
+def _number(text: str) -> float | int:
+    """A JSON number written with a fraction or exponent: an ``int`` when it is a whole number (JSON Schema's
+    ``integer`` is any number without a fractional part, so ``3.0`` is one; float fields take ints), else a float."""
+    value = float(text)
+    return int(value) if value.is_integer() and abs(value) <= MAX_EXACT_INTEGER else value
+
+
 def parse_json(data: bytes | str, field: str = "body", max_depth: int = MAX_DEPTH) -> Any:
     """The JSON value of ``data``; ``BodyError`` (422, ``field``) for anything that is not strict JSON."""
     if isinstance(data, bytes):
@@ -82,7 +90,7 @@ def parse_json(data: bytes | str, field: str = "body", max_depth: int = MAX_DEPT
     else:
         text = data
     try:
-        value = json.loads(text)
+        value = json.loads(text, parse_float=_number)
     except json.JSONDecodeError as error:
         raise BodyError(422, field, f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}") from None
     except RecursionError:

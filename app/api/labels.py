@@ -17,7 +17,7 @@ from lanevil_core.labels.lanes import CULANE_SIZE, TUSIMPLE_SIZE
 
 from .deps import RecordDep, StateDep
 from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
-from .params import frame_range
+from .params import FRAMES_PATTERN, frame_range
 
 router = APIRouter(tags=["labels"], route_class=ApiRoute, responses={**ERROR_RESPONSES, **RENDER_BUSY})
 
@@ -37,7 +37,8 @@ def get_labels(
     state: StateDep,
     format: Annotated[Literal["tusimple", "culane"], Query(description="label format")] = "tusimple",  # noqa: A002
     frames: Annotated[str | None, Query(description=f"START:STOP (half-open) or N; default 0:1; at most "
-                                                    f"{MAX_LABEL_FRAMES} frames")] = None,
+                                                    f"{MAX_LABEL_FRAMES} frames",
+                                        json_schema_extra={"pattern": FRAMES_PATTERN})] = None,
 ) -> Response:
     """TuSimple: JSON lines (``application/x-ndjson``), one record per frame. CULane: a JSON object
     ``{"format": "culane", "size": [1640, 590], "lines": {"0": "x1 y1 x2 y2 ...\\n...", ...}}`` keyed by frame."""

@@ -9,7 +9,9 @@ from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel
 from starlette.datastructures import UploadFile
 
-from ..meshes import MeshUploadError, list_meshes, store_mesh
+from lanevil_core.illusions.traffic import MAX_OBSTACLE_FACES
+
+from ..meshes import MAX_GLTF_DEPTH, MeshUploadError, list_meshes, store_mesh
 from .deps import StateDep
 from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
 from .forms import read_form
@@ -31,9 +33,17 @@ class MeshStored(BaseModel):
 
 router = APIRouter(prefix="/meshes", tags=["meshes"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
-UPLOAD_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {"multipart/form-data": {"schema": {
-    "type": "object", "required": ["file"],
-    "properties": {"file": {"type": "string", "format": "binary", "description": ".glb, .gltf or .obj model"}}}}}}}
+# The file's name says its format (``.glb``, ``.gltf``, ``.obj``; any other is a 415), its part's media type is
+# not read; the example file name is what clients generated from the description send.
+MODEL_MEDIA_TYPES = "model/gltf-binary, model/gltf+json, model/obj, application/octet-stream"
+UPLOAD_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {"multipart/form-data": {
+    "schema": {"type": "object", "required": ["file"], "additionalProperties": False, "properties": {"file": {
+        "type": "string", "format": "binary", "contentMediaType": "model/gltf-binary",
+        "description": f"a model that loads, at most {MAX_OBSTACLE_FACES} triangles, whose file name ends .glb, "
+                       ".gltf (buffers and images embedded) or .obj; a .gltf/.glb's JSON at most "
+                       f"{MAX_GLTF_DEPTH} levels deep"}}},
+    "encoding": {"file": {"contentType": MODEL_MEDIA_TYPES, "headers": {"Content-Disposition": {
+        "schema": {"type": "string"}, "example": 'form-data; name="file"; filename="model.glb"'}}}}}}}}
 
 
 @router.get("", summary="List uploaded meshes")

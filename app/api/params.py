@@ -2,21 +2,27 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Annotated
+from typing import Annotated, Any
 
 from fastapi import Depends, Query
 from pydantic import ValidationError
 
-from lanevil_core.case import Case
+from lanevil_core.case import Case, Sun
+from lanevil_core.detect.catalog import detector_infos
 from lanevil_core.images import ImageFormat as ImageFormat  # the format parameter of the image routes
 from lanevil_core.pipeline.frames import parse_frame_range
 
 from ..frames import apply_overrides
 from ..settings import Settings
 from .errors import ApiError, first_error
+from .openapi import SERVER_LIMIT
 
 MIN_SIZE = 64  # smallest rendered width or height (the case camera's lower bound)
+# What ``frame_range`` reads, for the OpenAPI description: ``START:STOP`` (either end optional) or ``N``; whether the
+# range lies in the case (and is not empty) depends on the case, so only the server can say.
+FRAMES_PATTERN = r"^([0-9]{1,3}|[0-9]{0,3}:[0-9]{0,3})$"
 # pydantic locations of the override fields in a case -> the query parameter that set them
 OVERRIDE_FIELDS: dict[tuple[str, ...], str] = {("sun", "azimuth"): "sun_azimuth", ("sun", "altitude"): "sun_altitude",
                                                ("sun", "intensity"): "sun_intensity"}
@@ -43,22 +49,30 @@ def _parse_range(text: str, frames: int) -> range:
 
 
 def image_size(width: int | None, height: int | None, case: Case, settings: Settings) -> tuple[int, int]:
-    """The requested (width, height) — both or neither (then the case camera's) — within 64..the server's max."""
-    if (width is None) != (height is None):
-        missing = "height" if height is None else "width"
-        raise ApiError(422, "give width and height together (or neither, for the case camera's size)", missing)
-    if width is None or height is None:
-        width, height = case.camera.width, case.camera.height
-        return min(width, settings.max_width), min(height, settings.max_height)
-    for name, value, largest in (("width", width, settings.max_width), ("height", height, settings.max_height)):
-        if not MIN_SIZE <= value <= largest:
-            raise ApiError(422, f"{value} is outside {MIN_SIZE}..{largest}", name)
+    """The requested (width, height), each within 64..the server's max. Neither: the case camera's (capped); one
+    alone: the other follows the camera's aspect ratio (within the same bounds)."""
+    largest = {"width": settings.max_width, "height": settings.max_height}
+    for name, value in (("width", width), ("height", height)):
+        if value is not None and not MIN_SIZE <= value <= largest[name]:
+            raise ApiError(422, f"{value} is outside {MIN_SIZE}..{largest[name]}", name)
+    camera = case.camera
+    if width is None:
+        if height is None:
+            return min(camera.width, settings.max_width), min(camera.height, settings.max_height)
+        return _within(round(height * camera.width / camera.height), settings.max_width), height
+    if height is None:
+        return width, _within(round(width * camera.height / camera.width), settings.max_height)
     return width, height
 
 
-def check_frame(case: Case, frame: int, status_code: int = 422) -> int:
+def _within(value: int, largest: int) -> int:
+    return max(MIN_SIZE, min(value, largest))
+
+
+def check_frame(case: Case, frame: int) -> int:
+    """``frame`` when the case has it; else a 404 naming ``frame`` (the frame asked for does not exist)."""
     if not 0 <= frame < case.ego.frames:
-        raise ApiError(status_code, f"{frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} "
+        raise ApiError(404, f"{frame} is outside 0..{case.ego.frames - 1} (the case has {case.ego.frames} "
                                     "frames)", "frame")
     return frame
 
@@ -117,13 +131,47 @@ class RenderQuery:
             raise ApiError(422, message, name) from None
 
 
+def sun_bounds(name: str) -> dict[str, Any]:
+    """The ``minimum``/``maximum`` of the case schema's ``sun.<name>``, for the override's OpenAPI description."""
+    schema = Sun.model_json_schema()["properties"][name]
+    return {key: schema[key] for key in ("minimum", "maximum") if key in schema}
+
+
+def size_schema(limit: str) -> dict[str, Any]:
+    """OpenAPI bounds of an image width or height: ``MIN_SIZE`` up to the setting ``limit`` (``max_width`` …),
+    filled in from the server's settings when the description is built (``openapi.SERVER_LIMIT``)."""
+    return {"minimum": MIN_SIZE, SERVER_LIMIT: limit}
+
+
+def available_detectors() -> list[str]:
+    """The detector names that can run on this server (``GET /api/detectors`` with ``available``)."""
+    return [info.name for info in detector_infos() if info.available]
+
+
+def detector_enum(*also: str) -> Callable[[dict[str, Any]], None]:
+    """``json_schema_extra`` listing ``also`` and the available detectors, when the OpenAPI document is built."""
+
+    def extra(schema: dict[str, Any]) -> None:
+        schema["enum"] = [*also, *available_detectors()]
+
+    return extra
+
+
+WIDTH_HELP = "image width, 64 up to the server's largest (alone: the height follows the case camera's aspect ratio)"
+HEIGHT_HELP = "image height, 64 up to the server's largest (alone: the width follows the case camera's aspect ratio)"
+
+
 def scrub_query(
-    width: Annotated[int | None, Query(description="image width (with height; default: the case camera's)")] = None,
-    height: Annotated[int | None, Query(description="image height (with width)")] = None,
+    width: Annotated[int | None, Query(description=f"{WIDTH_HELP}; default: the case camera's",
+                                       json_schema_extra=size_schema("max_width"))] = None,
+    height: Annotated[int | None, Query(description=HEIGHT_HELP, json_schema_extra=size_schema("max_height"))] = None,
     severity: Annotated[int | None, Query(ge=1, le=5, description="render every illusion at this level")] = None,
-    sun_azimuth: Annotated[float | None, Query(description="sun azimuth override (degrees)")] = None,
-    sun_altitude: Annotated[float | None, Query(description="sun altitude override (degrees)")] = None,
-    sun_intensity: Annotated[float | None, Query(description="sun intensity override")] = None,
+    sun_azimuth: Annotated[float | None, Query(description="sun azimuth override (degrees)",
+                                               json_schema_extra=sun_bounds("azimuth"))] = None,
+    sun_altitude: Annotated[float | None, Query(description="sun altitude override (degrees)",
+                                                json_schema_extra=sun_bounds("altitude"))] = None,
+    sun_intensity: Annotated[float | None, Query(description="sun intensity override",
+                                                 json_schema_extra=sun_bounds("intensity"))] = None,
 ) -> RenderQuery:
     """Size and overrides: what picks the rendered frame."""
     return RenderQuery(False, width, height, severity, sun_azimuth, sun_altitude, sun_intensity)
@@ -136,7 +184,8 @@ def render_query(
     scrub: ScrubQueryDep,
     overlay: Annotated[bool, Query(description="draw the TuSimple lane labels on the image")] = False,
     detector: Annotated[str | None, Query(max_length=40, description="draw this detector's lanes (magenta): a "
-                                          "name of `GET /api/detectors`; empty = none")] = None,
+                                          "name of `GET /api/detectors`; empty = none",
+                                          json_schema_extra=detector_enum(""))] = None,
 ) -> RenderQuery:
     return replace(scrub, overlay=overlay, detector=detector or None)
 

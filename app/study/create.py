@@ -158,7 +158,10 @@ def insert_study(db: sqlite3.Connection, study_id: str, spec: StudySpec, items: 
 
 def create_study(db: sqlite3.Connection, settings: Settings, store: CaseStore, frames: FrameService,
                  jobs: JobManager, spec: StudySpec, uploads: Mapping[str, CheckedUpload]) -> tuple[Study, Job | None]:
-    """Check, render (now or as a job) and store a new study; return it and its render job, if any."""
+    """Check, render (now or as a job) and store a new study; return it and its render job, if any. A size the
+    spec does not give is the default within the server's largest."""
+    spec = spec.model_copy(update={name: min(getattr(spec, name), getattr(settings, f"max_{name}"))
+                                   for name in ("width", "height") if name not in spec.model_fields_set})
     items = prepare_items(spec, uploads, store, settings)
     study_id = secrets.token_hex(6)
     folder = items_folder(settings.data_dir, study_id)

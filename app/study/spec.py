@@ -19,6 +19,9 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, model_validator
 
+from ..api.openapi import SERVER_LIMIT
+from ..store import ID_PATTERN
+
 Role = Literal["test", "training", "gold", "trap"]
 Source = Literal["synthetic", "real"]
 ACR_LABELS: dict[int, str] = {5: "Excellent", 4: "Good", 3: "Fair", 2: "Poor", 1: "Bad"}
@@ -44,7 +47,8 @@ class _Strict(BaseModel):
 class ItemSpec(_Strict):
     """One stimulus: a generated frame or an uploaded image, with its role and quality-control answer."""
 
-    case_id: str | None = Field(None, description="stored case to render (synthetic item)")
+    case_id: str | None = Field(None, description="stored case to render (synthetic item)",
+                                json_schema_extra={"pattern": ID_PATTERN.pattern})
     frame: StrictInt = Field(0, ge=0, description="frame index of the case")
     upload: str | None = Field(None, description="file name of an uploaded real image (real item)")
     role: Role = "test"
@@ -78,8 +82,9 @@ class ItemSpec(_Strict):
 class GeneratedSet(_Strict):
     """Shorthand for many scored synthetic items: every listed case at every listed frame."""
 
-    cases: list[str] = Field(min_length=1)
-    frames: list[StrictInt] = Field([0], min_length=1)
+    cases: list[str] = Field(min_length=1,
+                             json_schema_extra={"items": {"type": "string", "pattern": ID_PATTERN.pattern}})
+    frames: list[StrictInt] = Field([0], min_length=1, json_schema_extra={"items": {"type": "integer", "minimum": 0}})
 
     @model_validator(mode="after")
     def _frames_non_negative(self) -> GeneratedSet:
@@ -96,8 +101,10 @@ class StudySpec(_Strict):
     consent_text: str = Field(DEFAULT_CONSENT, min_length=1, max_length=10_000)
     instructions: str = Field(DEFAULT_INSTRUCTIONS, min_length=1, max_length=10_000)
     viewing_seconds: StrictFloat = Field(3.0, ge=0.1, le=30.0, description="how long each image is shown")
-    width: StrictInt = Field(1280, ge=16, description="render width of generated items")
-    height: StrictInt = Field(720, ge=16, description="render height of generated items")
+    width: StrictInt = Field(1280, ge=16, description="render width of generated items (at most the server's largest)",
+                             json_schema_extra={SERVER_LIMIT: "max_width"})
+    height: StrictInt = Field(720, ge=16, description="render height of generated items (at most the server's "
+                              "largest)", json_schema_extra={SERVER_LIMIT: "max_height"})
     items: list[ItemSpec] = Field(default_factory=list)
     generated: GeneratedSet | None = None
     uploads_as_items: StrictBool = Field(True, description="uploads no item names become scored real items")
@@ -117,7 +124,8 @@ class StudySpec(_Strict):
 class ConsentIn(_Strict):
     """A participant's agreement; nothing is stored unless ``consent`` is true."""
 
-    consent: StrictBool
+    consent: StrictBool = Field(description="must be true: nothing is stored without it",
+                                json_schema_extra={"const": True})
 
 
 class RatingIn(_Strict):

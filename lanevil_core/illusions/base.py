@@ -8,7 +8,7 @@ into real scene elements (meshes, road-surface layers, lights, sun and wetness c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt
@@ -25,6 +25,9 @@ DEFAULT_AHEAD_M = 22.0
 # Where an illusion that runs along the road ends by default: this far past the ego's last position, so the last
 # frames still see it ahead.
 BEYOND_DRIVE_M = 30.0
+MAX_ROAD_LENGTH_M = 3000.0  # the longest main road a case may have (``Road.length``)
+Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
+RGB = tuple[Unit, Unit, Unit]  # a linear RGB colour of a case file
 
 
 @dataclass(frozen=True)
@@ -84,10 +87,15 @@ class Level:
     """Base of the severity rows: each illusion type's row is a frozen dataclass of what one level sets."""
 
 
+def _type_required(schema: dict[str, Any]) -> None:
+    """``type`` is the tag of the case's ``illusions`` union: a document names it even though it has a default."""
+    schema["required"] = ["type", *(name for name in schema.get("required", []) if name != "type")]
+
+
 class Illusion(BaseModel):
     """Base of every illusion type. Subclasses set ``type`` (a Literal), ``CATEGORY`` and ``SEVERITY``."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, json_schema_extra=_type_required)
 
     CATEGORY: ClassVar[Category]
     # Whether the type places the sun itself (a shadow across the lanes, glare on water, night): of several such
@@ -100,7 +108,8 @@ class Illusion(BaseModel):
     severity: StrictInt = Field(3, ge=1, le=5, description="1 = subtle ... 5 = most deceptive")
     seed: StrictInt = Field(0, ge=0, le=2**32 - 1)
     s: StrictFloat | None = Field(
-        None, ge=0, description="distance along the road where it starts (m); empty = just ahead of the ego start"
+        None, ge=0, le=MAX_ROAD_LENGTH_M,
+        description="distance along the road where it starts (m); empty = just ahead of the ego start",
     )
 
     def level(self) -> Level:

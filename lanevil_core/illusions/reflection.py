@@ -17,7 +17,7 @@ from ..world.primitives import pose_on_road, transformed
 from ..world.props import car, van
 from ..world.scene import PointLight, SurfaceLayer
 from ..world.structures import streetlight, streetlight_lamp_offset
-from .base import Category, CompileContext, Illusion, Level, register
+from .base import RGB, Category, CompileContext, Illusion, Level, register
 
 PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
@@ -49,11 +49,14 @@ def puddle_mask(rng: np.random.Generator, shape: tuple[int, int], coverage: floa
 
 def _wet_road(ctx: CompileContext, rng: np.random.Generator, s0: float, length: float, wetness: float,
               puddles: float, blob_m: float, name: str) -> None:
-    """Wet the whole road and lay puddles over the carriageway from ``s0`` for ``length`` metres."""
+    """Wet the whole road and lay puddles over the carriageway from ``s0`` for ``length`` metres (none where that
+    stretch is empty: an illusion placed beyond the end of the drive)."""
     ctx.env.wetness = max(ctx.env.wetness, wetness)
     piece = ctx.network.main
     t0 = -piece.half_width - 0.5
     rows = int(length / PUDDLE_TEXEL_M)
+    if rows < 1:
+        return
     cols = int((2 * piece.half_width + 1.0) / PUDDLE_TEXEL_M)
     wet = puddle_mask(rng, (rows, cols), puddles, blob_m)
     rgba = np.empty((rows, cols, 4), np.float32)
@@ -221,9 +224,7 @@ class VehicleReflection(Illusion):
     type: Literal["vehicle_reflection"] = "vehicle_reflection"
     count: StrictInt | None = Field(None, ge=1, le=20, description="vehicles ahead; empty = from the severity")
     gap: StrictFloat = Field(14.0, ge=6, le=60, description="distance between vehicles along the road (m)")
-    color: tuple[StrictFloat, StrictFloat, StrictFloat] | None = Field(
-        None, description="linear RGB paint; empty = varied"
-    )
+    color: RGB | None = Field(None, description="linear RGB paint, each channel 0..1; empty = varied")
     length: StrictFloat = Field(150.0, gt=5, le=1000, description="extent of the wet stretch (m)")
 
     def level(self) -> VehicleReflectionLevel:

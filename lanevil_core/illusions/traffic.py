@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Annotated, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
@@ -35,7 +35,7 @@ from ..world.user_meshes import (  # noqa: F401  # the user-mesh names as this m
     mesh_path,
     srgb_to_linear,
 )
-from .base import BEYOND_DRIVE_M, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
+from .base import BEYOND_DRIVE_M, RGB, Category, CompileContext, EgoDrive, Illusion, Level, MeshFileError, register
 
 EGO_CLEAR_M = 1.3  # half width of the ego's free path about its lane centre
 EGO_CLEAR_AHEAD_M = 12.0  # the free path runs this far past the ego's last position
@@ -44,8 +44,6 @@ NUDGES = (0.0, 1.0, -1.0, 2.0, -2.0)  # along-road moves, in footprint lengths, 
 GROUP_DEPTH_M = 5.0  # members of a group stand up to this far beyond its station
 
 
-Unit = Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
-RGB = tuple[Unit, Unit, Unit]
 # Footprint and height (length, width, height) of each procedural vehicle (m).
 VEHICLE_SIZE: dict[str, tuple[float, float, float]] = {"car": (4.5, 1.8, 1.45), "van": (5.2, 2.0, 2.3),
                                                        "truck": (8.0, 2.5, 3.4)}

@@ -8,7 +8,8 @@ pixel, the nearest face id, its depth and perspective-correct barycentric weight
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -238,15 +239,29 @@ def _fill_band(
               bands)
 
 
-_per_thread = threading.local()
+Scratch = dict[int, tuple[np.ndarray, np.ndarray]]  # view -> (slots, 6, 3) triangles, (slots, 2) row ranges
+_spare: list[Scratch] = []
+_spare_lock = threading.Lock()
 
 
-def _scratch(slots: int, view: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """(slots, 6, 3) float64 triangles and (slots, 2) int64 row ranges of a draw's ``view``, reused by the calling
-    thread's draws (fresh large arrays cost page faults every frame: 2.6 of a 160x90 frame's 7 ms were the
-    shadow cascades' setup writing into new pages)."""
-    buffers: dict[int, tuple[np.ndarray, np.ndarray]] = getattr(_per_thread, "buffers", None) or {}
-    _per_thread.buffers = buffers
+@contextmanager
+def _scratch_set() -> Iterator[Scratch]:
+    """Draw buffers for one draw, handed on to the next draw when it ends: fresh large arrays cost page faults
+    every frame (2.6 of a 160x90 frame's 7 ms were the shadow cascades' setup writing into new pages), and buffers
+    kept per thread made a server hold one set (41 MB after a 1280x720 frame of the largest stock scene measured)
+    for every request thread that ever rendered. Sets are as many as draws ever ran at once."""
+    with _spare_lock:
+        buffers = _spare.pop() if _spare else {}
+    try:
+        yield buffers
+    finally:
+        with _spare_lock:
+            _spare.append(buffers)
+
+
+def _scratch(buffers: Scratch, slots: int, view: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(slots, 6, 3) float64 triangles and (slots, 2) int64 row ranges of a draw's ``view`` from ``buffers``, grown
+    when they are too small."""
     tris, rows = buffers.get(view, (None, None))
     if tris is None or rows is None or tris.shape[0] < slots:
         tris, rows = np.empty((slots, 6, 3)), np.empty((slots, 2), np.int64)
@@ -258,11 +273,12 @@ def _draw(setup: Callable[[np.ndarray, np.ndarray, int, int], None], slots: int,
           buffers: tuple[IntArray, Float32Array, Float32Array], perspective: bool, attributes: bool,
           threads: int) -> None:
     """Set up every face's screen triangles (bands take runs of faces), then fill (bands take rows)."""
-    tris, rows = _scratch(slots)
-    run_bands(lambda band, bands: setup(tris, rows, band, bands), threads)
     face_buf, depth_buf, bary_buf = buffers
-    run_bands(lambda band, bands: _fill_band(tris, rows, per_slot, face_ids, face_buf, depth_buf, bary_buf,
-                                             perspective, attributes, band, bands), threads)
+    with _scratch_set() as scratch:
+        tris, rows = _scratch(scratch, slots)
+        run_bands(lambda band, bands: setup(tris, rows, band, bands), threads)
+        run_bands(lambda band, bands: _fill_band(tris, rows, per_slot, face_ids, face_buf, depth_buf, bary_buf,
+                                                 perspective, attributes, band, bands), threads)
 
 
 def rasterize_perspective(
@@ -296,18 +312,19 @@ def depth_orthographic_views(
     v_view = np.ascontiguousarray(v_view, np.float64)
     ids = face_ids.astype(np.int32)
     no_faces, no_bary = np.empty((1, 1), np.int32), np.empty((1, 1, 2), np.float32)
-    stored = [_scratch(ids.size, 1 + view) for view in range(len(views))]  # view 0 is the camera's draw
+    with _scratch_set() as scratch:
+        stored = [_scratch(scratch, ids.size, 1 + view) for view in range(len(views))]  # view 0: the camera's draw
 
-    def set_up(band: int, bands: int) -> None:
-        for (scale, u0, v0), (tris, rows) in zip(views, stored):
-            _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height, tris, rows, band, bands)
+        def set_up(band: int, bands: int) -> None:
+            for (scale, u0, v0), (tris, rows) in zip(views, stored):
+                _setup_orthographic(v_view, faces, ids, scale, u0, v0, width, height, tris, rows, band, bands)
 
-    def fill(band: int, bands: int) -> None:
-        for depth_buf, (tris, rows) in zip(outs, stored):
-            _fill_band(tris, rows, 1, ids, no_faces, depth_buf, no_bary, False, False, band, bands)
+        def fill(band: int, bands: int) -> None:
+            for depth_buf, (tris, rows) in zip(outs, stored):
+                _fill_band(tris, rows, 1, ids, no_faces, depth_buf, no_bary, False, False, band, bands)
 
-    run_bands(set_up, threads)
-    run_bands(fill, threads)
+        run_bands(set_up, threads)
+        run_bands(fill, threads)
 
 
 def depth_orthographic(

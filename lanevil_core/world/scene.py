@@ -151,9 +151,12 @@ def array_bytes(root: Any) -> int:
             continue
         seen.add(id(item))
         if isinstance(item, np.ndarray):
-            total += item.nbytes if item.base is None else 0  # a view costs nothing beyond its base
-            if item.base is not None:
+            # A view of another array costs nothing beyond that array. Any other base owns the data: an array a
+            # numba kernel returned has numba's MemInfo as its base (the crack and paint layers: 100s of MB).
+            if isinstance(item.base, np.ndarray):
                 stack.append(item.base)
+            else:
+                total += item.nbytes
         elif isinstance(item, dict):
             stack.extend(item.values())
         elif isinstance(item, (list, tuple, set, frozenset)):

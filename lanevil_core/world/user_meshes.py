@@ -87,14 +87,13 @@ def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: i
     """
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"obstacle model not found: {path}")
-    scene = cast(trimesh.Scene, trimesh.load(str(path), force="scene"))
-    parts = [g for g in scene.dump(concatenate=False) if isinstance(g, trimesh.Trimesh) and len(g.faces)]
+        raise FileNotFoundError(f"obstacle model not found: {path.name}")
+    parts = _model_parts(path)
     if not parts:
-        raise ValueError(f"{path}: no triangles in the model")
+        raise ValueError(f"{path.name}: no triangles in the model")
     faces = sum(len(g.faces) for g in parts)
     if faces > max_faces:
-        raise ValueError(f"{path}: {faces} triangles, more than the {max_faces} the renderer takes per obstacle")
+        raise ValueError(f"{path.name}: {faces} triangles, more than the {max_faces} the renderer takes per obstacle")
     vertices, tris, colors, offset = [], [], [], 0
     for g in parts:
         vertices.append(np.asarray(g.vertices, np.float64))
@@ -109,3 +108,13 @@ def load_obstacle(path: str | Path, *, up: Literal["y", "z"] = "y", max_faces: i
     mesh = to_mesh(trimesh.Trimesh(p, np.concatenate(tris), process=False), np.concatenate(colors),
                    name=name or path.stem, kind="obstacle", gloss=0.3)
     return mesh
+
+
+def _model_parts(path: Path) -> list[trimesh.Trimesh]:
+    """The triangle meshes of a model file; ``ValueError`` naming the file (by its base name, never its folder)
+    for anything trimesh cannot read. trimesh's own messages are not passed on: they quote folders and its API."""
+    try:
+        scene = cast(trimesh.Scene, trimesh.load(str(path), force="scene"))
+        return [g for g in scene.dump(concatenate=False) if isinstance(g, trimesh.Trimesh) and len(g.faces)]
+    except Exception as error:  # trimesh raises many kinds (KeyError, IndexError, RecursionError ...)  # noqa: BLE001
+        raise ValueError(f"{path.name}: not a readable {path.suffix.lstrip('.')} model") from error

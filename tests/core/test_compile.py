@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
+import pytest
 
-from lanevil_core.case import parse_case
+from lanevil_core.case import Case, parse_case
+from lanevil_core.illusions import REGISTRY
 from lanevil_core.pipeline.compile import compile_scene, roadside_key
+from lanevil_core.render import render_frame
+from lanevil_core.world.scene import array_bytes
 
 
 def _assert_same(a, b) -> None:
@@ -68,3 +73,19 @@ def test_the_scene_says_which_illusions_set_the_sun() -> None:
         {"type": "sunlight_reflection", "severity": 3}]})
     assert compile_scene(both).env.sun_set_by == (0, 2)  # the crack leaves the sun alone; the last one's is shown
     assert [type(i).SETS_SUN for i in both.illusions] == [True, False, True]
+
+
+@pytest.mark.parametrize("illusion_type", sorted(REGISTRY))
+def test_an_illusion_beyond_the_end_of_the_drive_compiles_and_renders(illusion_type: str) -> None:
+    """``s`` may lie anywhere on the road (0..3000 m), past the drive's end or the road's: nothing to see there."""
+    case = Case.model_validate({"illusions": [{"type": illusion_type, "s": 2999.0, "severity": 4}]})
+    frame = render_frame(compile_scene(case), 0, (64, 64))
+    assert frame.rgb.shape == (64, 64, 3)
+
+
+def test_scene_bytes_count_arrays_a_numba_kernel_allocated() -> None:
+    """Such an array's base is numba's MemInfo, not an array: it owns its data (the crack layers' 100s of MB)."""
+    ones = numba.njit(lambda n: np.ones((n, 4), np.float32))(1000)
+    assert not isinstance(ones.base, np.ndarray)
+    assert array_bytes([ones[:10], ones[10:20]]) == ones.nbytes == 16_000
+    assert array_bytes([np.zeros(8)[2:]]) == 64

@@ -342,7 +342,7 @@ def test_multipart_uploads_have_their_own_limit(settings, state) -> None:
     ({"illusions": [{"type": "fence_shadow", "severity": "3"}]}, "illusions.0.fence_shadow.severity"),
     ({"illusions": [{"type": "fence_shadow", "severity": True}]}, "illusions.0.fence_shadow.severity"),
     ({"seed": "3"}, "seed"),
-    ({"seed": 3.0}, "seed"),
+    ({"seed": 3.5}, "seed"),
     ({"ego": {"frames": True}}, "ego.frames"),
     ({"sun": {"azimuth": "120"}}, "sun.azimuth"),
     ({"sun": {"azimuth": False}}, "sun.azimuth"),
@@ -351,3 +351,12 @@ def test_numbers_are_strict(client, document: dict, field: str) -> None:
     response = client.post("/api/cases", json={"title": "strict", **document})
     assert response.status_code == 422, response.text
     assert response.json()["field"] == field
+
+
+def test_a_whole_number_written_with_a_fraction_is_an_integer(client) -> None:
+    """JSON Schema's ``integer`` is any number without a fractional part: ``3.0`` is one, as the schema says."""
+    response = client.post("/api/cases", content=b'{"title": "whole", "seed": 3.0, "ego": {"frames": 5e1}}',
+                           headers={"content-type": "application/json"})
+    assert response.status_code == 201, response.text
+    assert response.json()["case"]["seed"] == 3 and response.json()["case"]["ego"]["frames"] == 50
+    assert response.json()["case"]["sun"]["azimuth"] == 30.0

@@ -86,7 +86,7 @@ def test_detections_follow_the_scrubbing_parameters(client) -> None:
     (f"{FRAME}/100/detections?detector=ufld", 404, "frame"),
     (f"{FRAME}/0/detections", 422, "detector"),
     (f"{FRAME}/0/detections?detector=yolo", 422, "detector"),
-    (f"{FRAME}/0/detections?detector=ufld&width=320", 422, "height"),
+    (f"{FRAME}/0/detections?detector=ufld&width=32", 422, "width"),
     (f"{FRAME}/0/detections?detector=ufld&severity=9", 422, "severity"),
     (f"{FRAME}/0/detections?detector=ufld&sun_altitude=200", 422, "sun_altitude"),
     (f"{FRAME}/0.png?detector=yolo", 422, "detector"),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import struct
 from pathlib import Path
 
 import pytest
@@ -20,6 +21,16 @@ VEHICLE = {"type": "vehicle", "severity": 2, "kind": "van"}
 
 def box_glb(size: tuple[float, float, float] = (4.0, 2.0, 1.5)) -> bytes:
     return trimesh.Scene(trimesh.creation.box(size)).export(file_type="glb")
+
+
+def glb_of(document: bytes) -> bytes:
+    """A binary glTF whose only chunk is ``document`` (the JSON chunk, padded to 4 bytes as the format asks)."""
+    document += b" " * (-len(document) % 4)
+    return b"glTF" + struct.pack("<III", 2, 20 + len(document), len(document)) + b"JSON" + document
+
+
+def nested(depth: int) -> bytes:
+    return b'{"asset":' * depth + b"1" + b"}" * depth
 
 
 def upload(client, name: str, data: bytes):
@@ -131,3 +142,33 @@ def test_a_study_of_a_case_whose_mesh_is_missing_is_a_422(client, state) -> None
     response = client.post("/api/study/studies", json=spec, headers={"Authorization": "Bearer test-admin"})
     assert response.status_code == 422, response.text
     assert response.json()["field"].endswith("mesh_file")
+
+
+@pytest.mark.parametrize("depth", [100, 1_000, 100_000])
+@pytest.mark.parametrize("suffix", ["gltf", "glb"])
+def test_deeply_nested_gltf_is_a_422_naming_file(client, state, depth: int, suffix: str) -> None:
+    data = nested(depth) if suffix == "gltf" else glb_of(nested(depth))
+    response = client.post("/api/meshes", files={"file": (f"deep.{suffix}", io.BytesIO(data), "model/gltf+json")})
+    assert response.status_code == 422, response.text
+    assert response.json()["field"] == "file"
+    assert "nested deeper than 64 levels" in response.json()["detail"]
+    assert response.headers["X-Frame-Options"] == "DENY" and "Content-Security-Policy" in response.headers
+    assert list(state.meshes_dir.iterdir()) == []
+
+
+@pytest.mark.parametrize("uri", ["../../../../../../etc/hostname", "../admin_token", "/etc/passwd",
+                                 "file:///etc/passwd", "buffer.bin"])
+@pytest.mark.parametrize("part", ["buffers", "images"])
+def test_a_glb_naming_another_file_is_refused_without_reading_it(client, state, uri: str, part: str) -> None:
+    document = {"asset": {"version": "2.0"}, part: [{"uri": uri, "byteLength": 8}]}
+    response = upload(client, "escape.glb", glb_of(json.dumps(document).encode()))
+    assert (response.status_code, response.json()["field"]) == (422, "file")
+    assert "refers to other files" in response.json()["detail"]
+    assert str(state.settings.data_dir) not in response.text and "resolver" not in response.text
+
+
+@pytest.mark.parametrize("data", [b"", b"glTF", b"glTF\x02\0\0\0\xff\xff\0\0\xff\xff\0\0BIN\0", b"\x89PNG\r\n"])
+def test_a_glb_without_its_header_and_json_chunk_is_refused(client, data: bytes) -> None:
+    response = upload(client, "broken.glb", data)
+    assert (response.status_code, response.json()["field"]) == (422, "file")
+    assert "GLB" in response.json()["detail"]

@@ -68,7 +68,7 @@ def test_overrides_render_a_variant_without_saving(client, state) -> None:
 
 
 @pytest.mark.parametrize(("query", "field"), [
-    ("width=160", "height"), ("height=90", "width"), ("width=32&height=90", "width"),
+    ("width=32", "width"), ("height=5000", "height"), ("width=32&height=90", "width"),
     ("width=160&height=5000", "height"), ("width=abc&height=90", "width"),
     (f"{SMALL}&severity=6", "severity"), (f"{SMALL}&sun_altitude=120", "sun_altitude"),
     (f"{SMALL}&sun_intensity=-1", "sun_intensity"), (f"{SMALL}&sun_azimuth=nan", "sun_azimuth"),
@@ -83,6 +83,14 @@ def test_bad_render_queries_are_422_naming_the_parameter(client, query: str, fie
 @pytest.mark.parametrize(("path", "status"), [("100.png", 404), ("-1.png", 404), ("x.png", 422), ("0.gif", 422)])
 def test_bad_frames(client, path: str, status: int) -> None:
     assert client.get(f"{FRAME}/{path}?{SMALL}").status_code == status
+
+
+@pytest.mark.parametrize(("query", "shape"), [("width=160", (90, 160, 3)), ("height=90", (90, 160, 3)),
+                                              ("width=64", (64, 64, 3))])
+def test_one_side_alone_keeps_the_case_cameras_aspect_ratio(client, query: str, shape: tuple) -> None:
+    response = client.get(f"{FRAME}/0.jpg?{query}")
+    assert response.status_code == 200, response.text
+    assert decode(response).shape == shape
 
 
 def test_default_size_is_the_case_camera_capped_by_settings(app, client) -> None:
@@ -104,8 +112,13 @@ def test_render_unsaved_case(client) -> None:
                        headers={"If-None-Match": posted.headers["etag"]}).status_code == 304
 
 
+@pytest.mark.parametrize("frame", [500, -1])
+def test_render_of_a_frame_the_case_lacks_is_404_as_for_a_stored_case(client, frame: int) -> None:
+    response = client.post(f"/api/render?{SMALL}&frame={frame}", json={})
+    assert (response.status_code, response.json()["field"]) == (404, "frame")
+
+
 @pytest.mark.parametrize(("query", "body", "field"), [
-    (f"{SMALL}&frame=500", {}, "frame"),
     (SMALL, {"camera": {"fov": 400}}, "camera.fov"),
     (SMALL, {"case": {"ego": {"speed": -1}}}, "case.ego.speed"),
     (f"{SMALL}&format=bmp", {}, "format"),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 import pytest
+from fastapi.testclient import TestClient
 
 from app.headers import SECURITY_HEADERS
 
@@ -39,3 +40,32 @@ def test_docs_pages_allow_exactly_their_inline_scripts(client, path: str) -> Non
     assert "unsafe-inline" not in script_src
     assert script_src.count("'sha256-") == len(inline)
     assert response.headers["X-Frame-Options"] == "DENY"
+
+
+def assert_security_headers(headers) -> None:
+    for name, value in SECURITY_HEADERS.items():
+        assert headers[name] == value, name
+
+
+def test_an_unexpected_500_carries_them_and_the_error_body(app) -> None:
+    def broken() -> None:
+        raise RuntimeError("/srv/data/cases went away")
+
+    app.add_api_route("/api/broken", broken, methods=["GET"])
+    with TestClient(app, raise_server_exceptions=False) as client:
+        response = client.get("/api/broken")
+    assert response.status_code == 500
+    assert_security_headers(response.headers)
+    assert response.json() == {"detail": "internal server error: the request could not be completed", "field": None}
+
+
+def test_a_route_that_fails_inside_the_store_answers_500_with_them(app, state, monkeypatch) -> None:
+    def fail(*args, **kwargs):
+        raise OSError(f"disk gone under {state.settings.data_dir}")
+
+    monkeypatch.setattr(state.store, "list", fail)
+    with TestClient(app, raise_server_exceptions=False) as client:
+        response = client.get("/api/cases")
+    assert response.status_code == 500
+    assert_security_headers(response.headers)
+    assert str(state.settings.data_dir) not in response.text
