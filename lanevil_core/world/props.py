@@ -493,6 +493,39 @@ def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, 
     return merge(parts, name=name, kind="building", gloss=0.05)
 
 
+# Street furniture on the sidewalk: litter bins, bollards and sign posts (a traffic sign facing the oncoming
+# driver: the red ring of a prohibition or speed limit, the blue disc of a mandatory sign, a yellow warning plate).
+STREET_GREEN = (0.03, 0.07, 0.04)
+BOLLARD_GREY = (0.1, 0.1, 0.1)
+SIGN_FACES = ((0.55, 0.03, 0.02), (0.02, 0.1, 0.45), (0.7, 0.5, 0.02))
+SIGN_BACK = (0.35, 0.35, 0.35)
+
+
+def litter_bin(name: str = "bin") -> Mesh:
+    """A round street litter bin (0.9 m tall): a dark green body under a lid."""
+    return merge([cylinder(0.28, 0.85, (0.0, 0.0, 0.425), STREET_GREEN, sections=10),
+                  cylinder(0.31, 0.08, (0.0, 0.0, 0.89), np.asarray(STREET_GREEN) * 0.7, sections=10)],
+                 name=name, kind="pole", gloss=0.2)
+
+
+def bollard(name: str = "bollard") -> Mesh:
+    """A steel bollard (1 m tall) with a white reflective band near its top."""
+    return merge([cylinder(0.09, 0.82, (0.0, 0.0, 0.41), BOLLARD_GREY, sections=8),
+                  cylinder(0.095, 0.1, (0.0, 0.0, 0.87), (0.7, 0.7, 0.68), sections=8),
+                  cylinder(0.09, 0.08, (0.0, 0.0, 0.96), BOLLARD_GREY, sections=8)], name=name, kind="pole",
+                 gloss=0.3)
+
+
+def sign_post(rng: np.random.Generator, name: str = "sign") -> Mesh:
+    """A traffic sign on a 2.6 m galvanised post, its face towards -X (the driver coming along +X)."""
+    face = _pick(rng, SIGN_FACES)
+    plate = [box((0.03, 0.62, 0.62), (0.02, 0.0, 2.55), SIGN_BACK),
+             box((0.01, 0.56, 0.56), (-0.005, 0.0, 2.55), (0.75, 0.75, 0.72)),
+             box((0.012, 0.44, 0.44), (-0.012, 0.0, 2.55), face)]
+    return merge([cylinder(0.035, 2.9, (0.03, 0.0, 1.45), (0.45, 0.46, 0.47), sections=6), *plate], name=name,
+                 kind="pole", gloss=0.3)
+
+
 # New Jersey barrier cross-section (y, z), metres: 0.61 m base, 0.15 m top, 0.81 m tall.
 JERSEY_PROFILE = ((-0.305, 0.0), (0.305, 0.0), (0.305, 0.075), (0.2, 0.33), (0.075, 0.81), (-0.075, 0.81),
                   (-0.2, 0.33), (-0.305, 0.075))

@@ -290,6 +290,37 @@ def street_lamps(case: Case, network: RoadNetwork) -> list[PointLight]:
                                                                   STREETLIGHT_SPACING_M)]
 
 
+FURNITURE_SPACING_M = 22.0  # mean distance between pieces of street furniture along each sidewalk
+
+
+def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """Litter bins, bollards and sign posts (facing the traffic on their side) on the sidewalks (the first raised
+    strip), about every FURNITURE_SPACING_M, at the sidewalk's kerb side like the lamps; none where a junction arm
+    passes or within 2 m of a lamp."""
+    templates = (props.litter_bin(), props.bollard())
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+        if not raised:
+            continue
+        t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.5)
+        h = piece.strips[raised[0]].height
+        lamp_first = piece.s_start + 5.0 + (STREETLIGHT_SPACING_M / 2 if side > 0 else 0.0)
+        placed = []
+        for s in stations(piece.s_start + 12.0, piece.line.length - 5.0, FURNITURE_SPACING_M, rng):
+            choice = int(rng.integers(3))
+            mesh = props.sign_post(own_rng(rng)) if choice == 2 else templates[choice]
+            from_lamp = (s - lamp_first) % STREETLIGHT_SPACING_M
+            if min(from_lamp, STREETLIGHT_SPACING_M - from_lamp) < 2.0:
+                continue  # a lamp stands there
+            T_world_local = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
+            if not clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
+                placed.append((float(s), transformed(mesh, T_world_local)))
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"street furniture {label} piece {index}", "pole")
+    return out
+
+
 def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
@@ -333,6 +364,7 @@ def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
         meshes += rows_of(network, clear, rng, block, (0.5, 2.5), (1.0 / density, 10.0 / density), "building")
+        meshes += street_furniture(network, clear, own_rng(rng))
     return meshes
 
 
@@ -348,6 +380,7 @@ def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear:
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
     meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
+    meshes += street_furniture(network, clear, own_rng(rng))
     return meshes
 
 
