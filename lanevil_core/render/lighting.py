@@ -34,7 +34,7 @@ SUN_AUREOLE = 1.2
 # The cloud deck (``cloud_cover``): a plane CLOUD_HEIGHT_M up textured by the coarse noise (CLOUD_TEXEL_M texels,
 # plus a CLOUD_DETAIL share of an octave four times finer), covering about the case's cloudiness of the sky
 # (threshold and sharpness of the noise), thinning into the haze below about 1 / CLOUD_HAZE of elevation; lit
-# from above by the sun (CLOUD_SUNLIT of its intensity where thin) and by the sky (CLOUD_BASE of the horizon's
+# by the sun (CLOUD_SUNLIT of its intensity where thin) and by the sky (CLOUD_BASE of the horizon's
 # luminance); CLOUD_PIXEL_RAD is the angle a pixel spans (the footprint the noise is filtered over).
 CLOUD_HEIGHT_M = 1500.0
 CLOUD_TEXEL_M = 90.0
@@ -43,7 +43,7 @@ CLOUD_THRESHOLD = 0.35
 CLOUD_SHARPNESS = 3.0
 CLOUD_HAZE = 6.0
 CLOUD_LOWEST = 0.01
-CLOUD_SUNLIT = 0.9
+CLOUD_SUNLIT = 0.6  # a cloud scatters the sun's light from any altitude (bright undersides at sunset)
 CLOUD_BASE = 1.05
 CLOUD_PIXEL_RAD = 0.0016
 # The light table (PackedScene.lights; the frame adds the headlights): one row per lamp.
@@ -130,8 +130,7 @@ def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color
     cover = cloud_cover(dx, dy, dz, coarse, cloudiness)
     if cover > 0.0:
         grey = SKY_SCALE * (0.2126 * horizon[0] + 0.7152 * horizon[1] + 0.0722 * horizon[2])
-        lit = sun_intensity * max(sun_dir[2], 0.0) * CLOUD_SUNLIT * (1.0 - cover) \
-            + CLOUD_BASE * grey * (1.0 - 0.4 * cover)
+        lit = sun_intensity * CLOUD_SUNLIT * (1.0 - cover) + CLOUD_BASE * grey * (1.0 - 0.4 * cover)
         r = r * (1.0 - cover) + (lit * sun_r + 0.1 * grey) * cover
         g = g * (1.0 - cover) + (lit * sun_g + 0.1 * grey) * cover
         b = b * (1.0 - cover) + (lit * sun_b + 0.12 * grey) * cover

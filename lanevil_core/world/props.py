@@ -293,7 +293,7 @@ def tree(rng: np.random.Generator, *, conifer: bool | None = None, height: float
     height = float(rng.uniform(5.0, 11.0)) if height is None else height
     if conifer:
         return merge(_spruce(rng, height), name=name, kind="tree")
-    species = BROADLEAVES[int(rng.integers(len(BROADLEAVES)))]
+    species = BROADLEAVES[int(rng.choice(len(BROADLEAVES), p=BROADLEAF_SHARES))]
     return merge(_broadleaf(rng, height, species), name=name, kind="tree")
 
 
@@ -310,6 +310,7 @@ class Broadleaf:
     trunk: float = 1.0
 
 
+BROADLEAF_SHARES = (0.7, 0.15, 0.15)  # most roadside broadleaves have round crowns; birches and poplars are fewer
 BROADLEAVES = (
     Broadleaf(crown=0.32, crown_height=0.62, bark=BARK, branches=(4, 7), leaves=LEAVES),  # oak, maple, lime
     Broadleaf(crown=0.22, crown_height=0.6, bark=(0.42, 0.4, 0.36), branches=(3, 5),
