@@ -98,7 +98,7 @@ def beam_weight(lights: np.ndarray, i: int, qx: float, qy: float, qz: float) -> 
     return weight
 
 
-@kernel(inline="always")
+@kernel  # called, not inlined: the sky is inlined at four places of the shading kernel
 def cloud_cover(dx: float, dy: float, dz: float, coarse: np.ndarray, cloudiness: float) -> float:
     """Opacity in [0, 1] of the cloud deck seen along unit world direction (dx, dy, dz): two octaves of the coarse
     noise on a plane CLOUD_HEIGHT_M up, thresholded so that about ``cloudiness`` of the sky is covered, filtered
