@@ -37,10 +37,11 @@ SUN_AUREOLE = 1.2
 # by the sun (CLOUD_SUNLIT of its intensity where thin) and by the sky (CLOUD_BASE of the horizon's
 # luminance); CLOUD_PIXEL_RAD is the angle a pixel spans (the footprint the noise is filtered over).
 CLOUD_HEIGHT_M = 1500.0
-CLOUD_TEXEL_M = 90.0
+CLOUD_TEXEL_M = 30.0
 CLOUD_DETAIL = 0.45
-CLOUD_THRESHOLD = 0.35
-CLOUD_SHARPNESS = 3.0
+CLOUD_MEDIAN = -0.16  # median of the two octaves' sum (the noise is normalised by its largest value)
+CLOUD_THRESHOLD = 0.45
+CLOUD_SHARPNESS = 4.0
 CLOUD_HAZE = 6.0
 CLOUD_LOWEST = 0.01
 CLOUD_SUNLIT = 0.6  # a cloud scatters the sun's light from any altitude (bright undersides at sunset)
@@ -109,7 +110,8 @@ def cloud_cover(dx: float, dy: float, dz: float, coarse: np.ndarray, cloudiness:
     x, y, foot = dx * reach, dy * reach, reach * CLOUD_PIXEL_RAD
     shape = sample_noise(coarse, CLOUD_TEXEL_M, x, y, foot) \
         + CLOUD_DETAIL * sample_noise(coarse, CLOUD_TEXEL_M * 0.25, y + 911.0, x, foot)
-    cover = min(max((shape - CLOUD_THRESHOLD * (1.0 - 2.0 * cloudiness)) * CLOUD_SHARPNESS, 0.0), 1.0)
+    edge = CLOUD_MEDIAN + CLOUD_THRESHOLD * (1.0 - 2.0 * cloudiness)  # about the (1 - cloudiness) quantile
+    cover = min(max((shape - edge) * CLOUD_SHARPNESS + 0.5, 0.0), 1.0)
     return cover * (1.0 - np.exp(-dz * CLOUD_HAZE))
 
 
