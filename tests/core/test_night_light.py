@@ -50,7 +50,7 @@ def test_glare_spreads_only_what_is_far_brighter_than_white() -> None:
 def test_the_cloud_deck_covers_more_of_the_sky_with_more_cloudiness() -> None:
     _, coarse = noise_textures()
     rng = np.random.default_rng(0)
-    directions = [_unit(*rng.normal(size=2), abs(rng.normal()) + 0.2) for _ in range(400)]
+    directions = [_unit(float(rng.normal()), float(rng.normal()), abs(float(rng.normal())) + 0.2) for _ in range(400)]
 
     def cover(cloudiness: float) -> float:
         return float(np.mean([cloud_cover(*d, coarse, cloudiness) for d in directions]))
