@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
-from ..world.environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, sun_direction
+from ..world.environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, NIGHT_HORIZON, NIGHT_ZENITH, sun_direction
 from ..world.primitives import pose_on_road, transformed
 from ..world.props import car, van
 from ..world.scene import PointLight, SurfaceLayer
@@ -22,8 +22,6 @@ from .base import RGB, Category, CompileContext, Illusion, Level, register
 PUDDLE_TEXEL_M = 0.1
 WATER_RGBA = (0.012, 0.013, 0.015, 0.35)  # standing water darkens the asphalt under its mirror
 LAMP_COLORS: dict[str, tuple[float, float, float]] = {"white": (1.0, 0.95, 0.88), "yellow": (1.0, 0.62, 0.22)}
-NIGHT_ZENITH = np.array([0.001, 0.0015, 0.004], np.float32)
-NIGHT_HORIZON = np.array([0.006, 0.006, 0.009], np.float32)
 LAMP_INTENSITY = 45.0  # radiance scale at 1 m: lights a road 8 m below to about the level of an overcast day
 VEHICLE_AHEAD_M = 13.0  # the first glossy vehicle stands this far ahead of the ego start
 
@@ -192,7 +190,8 @@ class StreetlightReflection(Illusion):
                 ctx.add_mesh(transformed(pole, T_world_local).renamed(f"streetlight {side:+d} {k}"))
                 p_world = T_world_local[:3, :3] @ offset + T_world_local[:3, 3]
                 ctx.add_light(PointLight(p_world, np.array(color, np.float32),
-                                         LAMP_INTENSITY * level.lamp_scale, name=f"lamp {side:+d} {k}"))
+                                         LAMP_INTENSITY * level.lamp_scale, name=f"lamp {side:+d} {k}",
+                                         beam="street"))
         _wet_road(ctx, ctx.rng(self.seed), s0, s1 - s0, level.wetness, level.puddles, 1.4, "night puddles")
 
 

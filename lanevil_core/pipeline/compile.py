@@ -15,7 +15,7 @@ from ..world.environment import environment_for, in_proportion, is_night
 from ..world.paint import road_paint
 from ..world.road_layout import RoadNetwork, build_network
 from ..world.scene import CompiledScene, Environment, Mesh
-from ..world.scenery import roadside_meshes
+from ..world.scenery import roadside_meshes, street_lamps
 from ..world.user_meshes import load_obstacle, mesh_path
 
 
@@ -92,6 +92,7 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
                          user_meshes=load_user_meshes(case, meshes_dir))
     ctx.meshes.extend(roadside)
+    ctx.lights.extend(street_lamps(case, network))  # lit at night only
     case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):
         ctx.source = index

@@ -3,12 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
+
+from ..typed import FloatArray
 
 # The irradiance unit, set in world/environment.py beside the daylight models: SUN_SCALE is a clear noon sun's
 # irradiance relative to the sky's ambient unit, SKY_AMBIENT_GAIN the sky's ambient light per unit of its colour.
 from ..world.environment import SKY_AMBIENT_GAIN as SKY_AMBIENT_GAIN
 from ..world.environment import SUN_SCALE as SUN_SCALE
+from ..world.scene import BEAMS
 from ._jit import kernel
+from .surface import sample_noise
 
 SKY_SCALE = 1.6
 NORMAL_OFFSET_M = 0.03
@@ -23,12 +28,104 @@ FOOTPRINT_TAPS = 4  # most shadow lookups along each side of a pixel's footprint
 FOOTPRINT_TAP_TEXELS = 3.0
 # Per coarse cell: nearest and farthest caster depth over it and its 8 neighbours.
 NEAR_AROUND, FAR_AROUND = range(2)
+# The sun's disk: its true angular radius (0.267 deg) and its radiance per unit of the sun's intensity (a clipped
+# highlight at any exposure: the camera's glare, render.post.glare, spreads it, not a painted halo), then the
+# circumsolar aureole (a narrow Gaussian of SUN_AUREOLE_COS's width, about 1.3 deg) and the wide Mie glow.
+SUN_COS_RADIUS = 0.99998914
+SUN_DISK_RADIANCE = 1500.0
+SUN_AUREOLE_POWER = 2000.0
+SUN_AUREOLE = 1.2
+# The cloud deck (``cloud_cover``): a plane CLOUD_HEIGHT_M up textured by the coarse noise (CLOUD_TEXEL_M texels,
+# plus a CLOUD_DETAIL share of an octave four times finer), covering about the case's cloudiness of the sky
+# (threshold and sharpness of the noise), thinning into the haze below about 1 / CLOUD_HAZE of elevation; lit
+# by the sun (CLOUD_SUNLIT of its intensity where thin) and by the sky (CLOUD_BASE of the horizon's
+# luminance); CLOUD_PIXEL_RAD is the angle a pixel spans (the footprint the noise is filtered over).
+CLOUD_HEIGHT_M = 1500.0
+CLOUD_TEXEL_M = 30.0
+CLOUD_DETAIL = 0.45
+CLOUD_MEDIAN = -0.16  # median of the two octaves' sum (the noise is normalised by its largest value)
+CLOUD_THRESHOLD = 0.45
+CLOUD_SHARPNESS = 4.0
+CLOUD_HAZE = 6.0
+CLOUD_LOWEST = 0.01
+CLOUD_SUNLIT = 0.6  # a cloud scatters the sun's light from any altitude (bright undersides at sunset)
+CLOUD_BASE = 1.05
+CLOUD_PIXEL_RAD = 0.0016
+# The light table (PackedScene.lights; the frame adds the headlights): one row per lamp.
+LIGHT_X, LIGHT_R, LIGHT_POWER, LIGHT_AXIS, LIGHT_BEAM = 0, 3, 6, 7, 10
+LIGHT_COLUMNS = 11
+BEAM_OMNI, BEAM_STREET, BEAM_LOW = (BEAMS.index(name) for name in ("omni", "street", "low"))
+DOWN = (0.0, 0.0, -1.0)
+# A full cut-off street lamp: all of its light within STREET_FULL of the nadir (cosine), none beyond STREET_CUT.
+STREET_FULL, STREET_CUT = 0.45, 0.17
+# A low beam (UN ECE R112's pattern, simplified): a sharp cut-off LOW_CUTOFF below the horizontal (the 1 %
+# downward aim) with a stray LOW_ABOVE above it, falling off downwards over LOW_DROP and sideways over LOW_SPREAD
+# (tangents of the angles off the beam's axis).
+LOW_CUTOFF, LOW_EDGE, LOW_ABOVE, LOW_DROP, LOW_SPREAD = -0.01, 0.012, 0.02, 0.15, 0.45
+# Road markings and asphalt send a headlight's light back towards the driver (glass beads; EN 1436's coefficient of
+# retroreflected luminance R_L, about 150 mcd/m2/lx for white paint against 15 for asphalt, i.e. about half their
+# albedo in the renderer's units): seen from behind its own headlights the road returns RETROREFLECTION times its
+# albedo times the beam's irradiance square to it, far more than a diffuse surface lit at a grazing angle. A water
+# film drowns the beads (WET_RETRO_LOSS of it is lost on a wet road).
+RETROREFLECTION = 0.5
+WET_RETRO_LOSS = 0.8
+
+
+def light_row(p_world: npt.ArrayLike, color: npt.ArrayLike, intensity: float, axis: npt.ArrayLike,
+              beam: str) -> FloatArray:
+    """(LIGHT_COLUMNS,) float64 row of the light table: position, linear rgb, intensity (radiance scale at 1 m),
+    beam axis, beam."""
+    return np.concatenate([np.ravel(p_world), np.ravel(color), [intensity], np.ravel(axis),
+                           [BEAMS.index(beam)]]).astype(np.float64)
+
+
+@kernel(inline="always")
+def beam_weight(lights: np.ndarray, i: int, qx: float, qy: float, qz: float) -> float:
+    """Share of lamp ``i``'s intensity sent along unit direction q (from the lamp towards the lit point)."""
+    beam = lights[i, LIGHT_BEAM]
+    ax, ay = lights[i, LIGHT_AXIS], lights[i, LIGHT_AXIS + 1]
+    weight = 1.0
+    if beam == BEAM_STREET:
+        weight = min(max((-qz - STREET_CUT) / (STREET_FULL - STREET_CUT), 0.0), 1.0)
+    elif beam == BEAM_LOW:
+        ahead = qx * ax + qy * ay
+        if ahead <= 0.05:
+            weight = 0.0
+        else:
+            side = (ay * qx - ax * qy) / ahead
+            up = qz / ahead
+            if up > LOW_CUTOFF:
+                vertical = max(1.0 - (up - LOW_CUTOFF) / LOW_EDGE, LOW_ABOVE)
+            else:
+                drop = (up - LOW_CUTOFF) / LOW_DROP
+                vertical = np.exp(-drop * drop)
+            weight = vertical * np.exp(-(side / LOW_SPREAD) * (side / LOW_SPREAD))
+    return weight
+
+
+@kernel  # called, not inlined: the sky is inlined at four places of the shading kernel
+def cloud_cover(dx: float, dy: float, dz: float, coarse: np.ndarray, cloudiness: float) -> float:
+    """Opacity in [0, 1] of the cloud deck seen along unit world direction (dx, dy, dz): two octaves of the coarse
+    noise on a plane CLOUD_HEIGHT_M up, thresholded so that about ``cloudiness`` of the sky is covered, filtered
+    over the pixel's footprint (the far deck near the horizon blurs) and thinning into the haze low down."""
+    if cloudiness <= 0.0 or dz <= CLOUD_LOWEST:
+        return 0.0
+    reach = CLOUD_HEIGHT_M / dz
+    x, y, foot = dx * reach, dy * reach, reach * CLOUD_PIXEL_RAD
+    shape = sample_noise(coarse, CLOUD_TEXEL_M, x, y, foot) \
+        + CLOUD_DETAIL * sample_noise(coarse, CLOUD_TEXEL_M * 0.25, y + 911.0, x, foot)
+    edge = CLOUD_MEDIAN + CLOUD_THRESHOLD * (1.0 - 2.0 * cloudiness)  # about the (1 - cloudiness) quantile
+    cover = min(max((shape - edge) * CLOUD_SHARPNESS + 0.5, 0.0), 1.0)
+    return cover * (1.0 - np.exp(-dz * CLOUD_HAZE))
 
 
 @kernel(inline="always")
 def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color: np.ndarray, sun_intensity: float,
-                 zenith: np.ndarray, horizon: np.ndarray, cloudiness: float) -> tuple[float, float, float]:
-    """Radiance (r, g, b) of the sky seen along unit world direction (dx, dy, dz): gradient, sun disk, glow."""
+                 zenith: np.ndarray, horizon: np.ndarray, cloudiness: float,
+                 coarse: np.ndarray) -> tuple[float, float, float]:
+    """Radiance (r, g, b) of the sky seen along unit world direction (dx, dy, dz): gradient, clouds
+    (``cloud_cover``: grey-white, lit by the sun from behind the viewer, darker in their thick cores), the sun's
+    disk at its true size (hidden by a cloud in front of it), its aureole and glow."""
     sun_r, sun_g, sun_b = sun_color[0], sun_color[1], sun_color[2]  # read before any branch (see ``_jit``)
     k = np.sqrt(max(dz, 0.0))
     below = 0.85 if dz < 0.0 else 1.0  # below the horizon (seen past the terrain's edge): darker haze
@@ -36,19 +133,26 @@ def sky_radiance(dx: float, dy: float, dz: float, sun_dir: np.ndarray, sun_color
     g = SKY_SCALE * below * (horizon[1] * (1.0 - k) + zenith[1] * k)
     b = SKY_SCALE * below * (horizon[2] * (1.0 - k) + zenith[2] * k)
     cos_sun = dx * sun_dir[0] + dy * sun_dir[1] + dz * sun_dir[2]
+    cover = cloud_cover(dx, dy, dz, coarse, cloudiness)
+    if cover > 0.0:
+        grey = SKY_SCALE * (0.2126 * horizon[0] + 0.7152 * horizon[1] + 0.0722 * horizon[2])
+        lit = sun_intensity * CLOUD_SUNLIT * (1.0 - cover) + CLOUD_BASE * grey * (1.0 - 0.4 * cover)
+        r = r * (1.0 - cover) + (lit * sun_r + 0.1 * grey) * cover
+        g = g * (1.0 - cover) + (lit * sun_g + 0.1 * grey) * cover
+        b = b * (1.0 - cover) + (lit * sun_b + 0.12 * grey) * cover
     if cos_sun > 0.0 and sun_intensity > 0.0:
         clear = 1.0 - cloudiness
-        disk = 60.0 * clear if cos_sun > 0.99996 else 0.0
+        disk = SUN_DISK_RADIANCE * clear * (1.0 - cover) if cos_sun > SUN_COS_RADIUS else 0.0
         c2 = cos_sun * cos_sun
         c4 = c2 * c2
         c8 = c4 * c4
         c16 = c8 * c8
-        halo = np.exp(400.0 * np.log(cos_sun)) if cos_sun > 0.97 else 0.0
-        glow = sun_intensity * (disk + halo * 3.0 * clear + c16 * 0.35 * (0.3 + 0.7 * clear))
+        halo = np.exp(SUN_AUREOLE_POWER * np.log(cos_sun)) if cos_sun > 0.99 else 0.0
+        glow = sun_intensity * (disk + halo * SUN_AUREOLE * clear + c16 * 0.35 * (0.3 + 0.7 * clear))
         r += sun_r * glow
         g += sun_g * glow
         b += sun_b * glow
-    return r, g, b
+    return (r, g, b) if coarse.size > 0 else (r, g, b)
 
 
 @kernel(inline="always")

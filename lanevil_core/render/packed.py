@@ -16,6 +16,7 @@ from ..world.paint import MATERIAL_ALBEDO, stripe_index
 from ..world.road_layout import RoadNetwork
 from ..world.road_mesh import RoadSurface, road_surface
 from ..world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene, Mesh
+from .lighting import DOWN, LIGHT_COLUMNS, light_row
 from .raster import depth_orthographic
 
 
@@ -56,7 +57,7 @@ class PackedScene:
     stripes: FloatArray  # (k, paint.STRIPE_COLUMNS)
     stripe_index: np.ndarray  # (pieces, boundaries + 1, 2) see stripe_index()
     layers: LayerAtlas
-    lights: FloatArray  # (l, 7): x, y, z, r, g, b, intensity
+    lights: FloatArray  # (l, LIGHT_COLUMNS): x, y, z, r, g, b, intensity, beam axis x, y, z, beam (BEAMS index)
     overhead: Float32Array  # (H, W) share of the sky each ground cell sees (1 = open)
     overhead_params: FloatArray  # (3,) x0, y0, cells per metre
 
@@ -292,8 +293,8 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
     casters = roadside.casters.copy()
     casters.update(np.ascontiguousarray(all_v[all_f[shadow_faces[shadow_faces >= len(roadside.normals)]]]).tobytes())
     stripes = scene.paint.stripes(scene.network)
-    lights = np.array([[*light.p_world, *light.color, light.intensity] for light in scene.lights],
-                      np.float64).reshape(-1, 7)
+    lights = np.array([light_row(light.p_world, light.color, light.intensity, DOWN, light.beam)
+                       for light in scene.lights], np.float64).reshape(-1, LIGHT_COLUMNS)
     packed = PackedScene(
         vertices=all_v, faces=all_f, vertex_st=joined["st"].astype(np.float32),
         vertex_piece=joined["piece"], face_material=joined["mat"],

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from ..images import linear_to_srgb
@@ -11,6 +12,30 @@ from .bands import band_rows, run_bands
 LUT_SIZE = 4096
 WHITE_POINT = 4.0
 CLAMP = 8.0  # bright highlights are clamped before edge blending so a sun glint does not bleed
+# A lens's glare (the skirt of its point-spread function: scatter in the glass and off the barrel): light above
+# GLARE_THRESHOLD times the exposure's white spreads in three Gaussian lobes, (sigma as a share of the image width,
+# share of the light), so the sun's small disk and the lamps at night bloom as a camera shows them. Spread at
+# 1 / GLARE_SCALE of the image size.
+GLARE_THRESHOLD = 4.0
+GLARE_LOBES = ((0.004, 0.05), (0.015, 0.02), (0.06, 0.01))
+GLARE_SCALE = 4
+
+
+def glare(hdr: np.ndarray, exposure: float) -> None:
+    """Add, in place, the lens glare of the light in (H, W, 3) float32 linear ``hdr`` brighter than
+    ``GLARE_THRESHOLD`` at ``exposure`` (no change when nothing is that bright)."""
+    limit = GLARE_THRESHOLD / max(exposure, 1e-9)
+    if float(hdr.max(initial=0.0)) <= limit:
+        return
+    height, width = hdr.shape[:2]
+    small_size = (max(width // GLARE_SCALE, 1), max(height // GLARE_SCALE, 1))
+    excess = cv2.resize(np.maximum(hdr - np.float32(limit), np.float32(0.0)), small_size,
+                        interpolation=cv2.INTER_AREA)
+    spread = np.zeros(excess.shape, np.float32)
+    for sigma, share in GLARE_LOBES:
+        spread += np.float32(share) * np.asarray(cv2.GaussianBlur(excess, (0, 0), max(sigma * small_size[0], 0.5)),
+                                                 np.float32)
+    hdr += np.asarray(cv2.resize(spread, (width, height), interpolation=cv2.INTER_LINEAR), np.float32)
 
 
 def _srgb_lut() -> np.ndarray:

@@ -19,9 +19,9 @@ from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
 from .develop import NO_STREAKS, Streaks, develop, motion_blur
-from .lighting import face_sun_terms
+from .lighting import LIGHT_COLUMNS, face_sun_terms, light_row
 from .packed import PackedScene, pack_scene
-from .post import SRGB_LUT, blur_columns, finish
+from .post import SRGB_LUT, blur_columns, finish, glare
 from .raster import per_pixel, rasterize_perspective
 from .shading import (
     Geometry,
@@ -39,6 +39,8 @@ from .textures import noise_textures
 
 SURFACE_TABLE = surface_table(MATERIAL_ALBEDO)
 MIRROR_BLUR_PX_AT_1280 = 10
+MIRROR_LAMP_SPILL = 0.02  # irradiance of the street lamps on the objects a wet road mirrors at night
+HEADLIGHT_COLOR = (1.0, 0.95, 0.85)  # halogen-white low beams
 LAMP_RANGE_M = 75.0
 LAMP_BEHIND_M = 12.0
 
@@ -86,13 +88,14 @@ def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamer
     frags = rasterize_perspective(camera.world_to_camera(v_world), packed.faces, packed.mirror_faces,
                                   (k.width, k.height), k.fx, k.fy, k.cx, k.cy, camera.near, threads)
     img = np.zeros((k.height, k.width, 3), np.float64)
-    lamp = 0.05 * len(scene.lights) if env.night else 0.0
+    spill = MIRROR_LAMP_SPILL if env.night and len(scene.lights) else 0.0
     env_f = _env_vector(env)
     sun_color, zenith, horizon = (env.sun_color.astype(np.float64), env.sky_zenith.astype(np.float64),
                                   env.sky_horizon.astype(np.float64))
+    view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)
     run_bands(lambda band, bands: shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission,
-                                               packed.face_normal, env.sun_dir_world, sun_color, env_f, zenith,
-                                               horizon, lamp, img, band, bands), threads)
+                                               packed.face_normal, view, env.sun_dir_world, sun_color, env_f,
+                                               zenith, horizon, spill, img, band, bands), threads)
     blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)), threads)
     return img, frags.depth
 
@@ -126,9 +129,10 @@ def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment) 
         return np.ascontiguousarray(lamps_world)
     R = camera.R_world_camera
     forward, right, down = R[:, 2], R[:, 0], R[:, 1]
+    heading = np.array([forward[0], forward[1], 0.0]) / max(float(np.hypot(forward[0], forward[1])), 1e-9)
     lamps = [camera.p_world_camera + forward * 1.5 + right * side * 0.75 + down * 2.3 for side in (-1.0, 1.0)]
-    rows = np.array([[*p, 1.0, 0.95, 0.85, env.headlights] for p in lamps])
-    return np.concatenate([lamps_world, rows])
+    rows = np.array([light_row(p, HEADLIGHT_COLOR, env.headlights, heading, "low") for p in lamps])
+    return np.concatenate([lamps_world.reshape(-1, LIGHT_COLUMNS), rows])
 
 
 def _needs_mirror(scene: CompiledScene, packed: PackedScene) -> bool:
@@ -203,6 +207,7 @@ def render_view(scene: CompiledScene, camera: PinholeCamera, threads: int = 1, f
     hdr, depth, object_id = _radiance(scene, camera, threads, lap)
     k = camera.intrinsics
     rgb = np.empty((k.height, k.width, 3), np.uint8)
+    glare(hdr, scene.env.exposure)
     finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
     lap("post")
     return Frame(rgb, depth, object_id, camera, timings)
@@ -279,9 +284,11 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
         depth[mask] = mount.bonnet.reach
     rgb = np.empty((k.height, k.width, 3), np.uint8)
     if sensor is None:
+        glare(hdr, scene.env.exposure)
         finish(hdr, object_id, scene.env.exposure, SRGB_LUT, rgb, threads)
     else:
         dev = development(hdr, sensor)
+        glare(hdr, dev.gain)
         develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
                 sensor.saturation, _noise_seed(scene.ego.seed, frame), dev.lut, rgb, threads, object_id, streaks)
         if sensor.sharpen > 0.0:

@@ -25,11 +25,18 @@ from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
 from .lighting import (
+    BEAM_LOW,
     FOOTPRINT_TAP_TEXELS,
+    LIGHT_BEAM,
+    LIGHT_POWER,
+    LIGHT_R,
+    RETROREFLECTION,
     SKY_AMBIENT_GAIN,
     SUN_BIAS,
     SUN_OFFSET,
     SUN_SCALE,
+    WET_RETRO_LOSS,
+    beam_weight,
     fresnel_schlick,
     glossy_lobe,
     lobe_shape,
@@ -55,6 +62,9 @@ MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
 STANDING_WATER_ROUGHNESS = 0.03
+PUDDLE_RAGGED = 0.3  # share of the puddle noise that is a finer octave: ragged shores
+PUDDLE_SHORE_TEXEL_M = 0.12  # texel of that octave (m)
+PUDDLE_SHORE_SLOPE = 4.0  # standing water deepens from its shore over 1 / PUDDLE_SHORE_SLOPE of the noise
 CLUMP_TEXEL_M = 0.1  # photographic texture: texel of the clumps (leaves, tufts, stains; ~4 texels across) (m)
 MID_TEXEL_M = 0.03  # ... and of its grain (m)
 CLUMP_SHARPNESS = 4.0  # the clump noise is scaled and clipped to +-1: sharp-edged patches
@@ -336,7 +346,7 @@ def boundaries_near(lanes: float, lane_width: float, last: int, t: float, ft: fl
 @kernel(inline="always")
 def puddle_depth(shape: float, puddles: float) -> float:
     """Standing water in [0, 1] where the puddle noise is ``shape``, for the weather's puddle coverage."""
-    return min(max((shape - (0.55 - 1.2 * puddles)) * 6.0, 0.0), 1.0)
+    return min(max((shape - (0.55 - 1.2 * puddles)) * PUDDLE_SHORE_SLOPE, 0.0), 1.0)
 
 
 @kernel(inline="always")
@@ -372,9 +382,11 @@ def sun_lit(sun_dir: np.ndarray, sun: np.ndarray, visibility: float, n_dot_l: fl
 
 @kernel(inline="always")
 def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float, dx: float,
-               dy: float, dz: float, roughness: float, fresnel: float,
-               shiny: float) -> tuple[float, float, float, float, float, float]:
-    """(diffuse irradiance rgb, specular radiance rgb) of every lamp at world point p."""
+               dy: float, dz: float, roughness: float, fresnel: float, shiny: float,
+               retro: float) -> tuple[float, float, float, float, float, float]:
+    """(diffuse irradiance rgb, specular radiance rgb) of every lamp at world point p, each through its beam
+    (``beam_weight``); the ego's low beams also come back from the road by ``retro`` (its retroreflection, as a
+    share of the beam's irradiance square to it; 0 off the road)."""
     light_r = light_g = light_b = 0.0
     spec_r = spec_g = spec_b = 0.0
     if lights.shape[0] == 0:
@@ -389,17 +401,20 @@ def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, n
         ndl = (nx * lx + ny * ly + nz * lz) * inv_dl
         if ndl <= 0.0:
             continue
-        power = lights[i, 6] / (d2 + 1.0)
+        power = lights[i, LIGHT_POWER] / (d2 + 1.0) * beam_weight(lights, i, -lx * inv_dl, -ly * inv_dl,
+                                                                  -lz * inv_dl)
+        if power <= 0.0:
+            continue
         hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
         n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
         k_spec = power * glossy_lobe(n_dot_h, lobe[0], lobe[1], lobe[2]) * fresnel * (0.1 + shiny)
-        k_diff = power * ndl
-        light_r += lights[i, 3] * k_diff
-        light_g += lights[i, 4] * k_diff
-        light_b += lights[i, 5] * k_diff
-        spec_r += lights[i, 3] * k_spec
-        spec_g += lights[i, 4] * k_spec
-        spec_b += lights[i, 5] * k_spec
+        k_diff = power * (ndl + (retro if lights[i, LIGHT_BEAM] == BEAM_LOW else 0.0))
+        light_r += lights[i, LIGHT_R] * k_diff
+        light_g += lights[i, LIGHT_R + 1] * k_diff
+        light_b += lights[i, LIGHT_R + 2] * k_diff
+        spec_r += lights[i, LIGHT_R] * k_spec
+        spec_g += lights[i, LIGHT_R + 1] * k_spec
+        spec_b += lights[i, LIGHT_R + 2] * k_spec
     return light_r, light_g, light_b, spec_r, spec_g, spec_b
 
 
@@ -477,16 +492,16 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             if k != span:
                 c0, c1 = k * SKY_STEP, min((k + 1) * SKY_STEP, width - 1)
                 ex, ey, ez, _ = pixel_ray(R, (c0 + 0.5 - cx) / fx, y_cam)
-                r0, g0, b0 = sky_radiance(ex, ey, ez, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                r0, g0, b0 = sky_radiance(ex, ey, ez, sun_dir, sun_color, sun_i, zenith, horizon, cloud, coarse)
                 qx, qy, qz, _ = pixel_ray(R, (c1 + 0.5 - cx) / fx, y_cam)
-                r1, g1, b1 = sky_radiance(qx, qy, qz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                r1, g1, b1 = sky_radiance(qx, qy, qz, sun_dir, sun_color, sun_i, zenith, horizon, cloud, coarse)
                 near_sun = max(ex * sun_dir[0] + ey * sun_dir[1] + ez * sun_dir[2],
                                qx * sun_dir[0] + qy * sun_dir[1] + qz * sun_dir[2]) > SKY_EXACT_NEAR_SUN
                 exact = near_sun or (ez < 0.0) != (qz < 0.0) or c1 == c0
                 span = k
             if exact:
                 dx, dy, dz, _ = pixel_ray(R, (col + 0.5 - cx) / fx, y_cam)
-                r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud)
+                r, g, b = sky_radiance(dx, dy, dz, sun_dir, sun_color, sun_i, zenith, horizon, cloud, coarse)
             else:
                 w = (col - k * SKY_STEP) / (min((k + 1) * SKY_STEP, width - 1) - k * SKY_STEP)
                 r, g, b = r0 + (r1 - r0) * w, g0 + (g1 - g0) * w, b0 + (b1 - b0) * w
@@ -536,8 +551,9 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                                 g, b, chips)
                 r, g, b, wet_over = sample_layers(texels, table, first, piece, s, t, fs, ft, True, r, g, b)
                 wet = max(wet, wet_over)
-                if puddles > 0.0:
-                    shape = sample_noise(coarse, COARSE_TEXEL_M, s * 0.7 + 37.0, t * 0.7, footprint)
+                if puddles > 0.0:  # coarse blobs with ragged, soft shores (a finer octave)
+                    shape = sample_noise(coarse, COARSE_TEXEL_M, s * 0.7 + 37.0, t * 0.7, footprint) \
+                        + PUDDLE_RAGGED * sample_noise(fine, PUDDLE_SHORE_TEXEL_M, s + 17.0, t, footprint)
                     wet = max(wet, puddle_depth(shape, puddles))
             up *= sky_openness(overhead, overhead_params, px, py)  # ground under a roof sees less sky
         else:
@@ -568,7 +584,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
                                      cells, shadow_params, R_light, penumbra)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
-        lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
+        retro = RETROREFLECTION * (1.0 - WET_RETRO_LOSS * surface_wet) if material >= 0 else 0.0
+        lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny, retro)
         r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
         if shiny > 0.0:  # wet road or glossy paint: a mirror of the sky, or on the road of the objects
             strength = fresnel_schlick(n_dot_v, surface[kind, MIRROR_F0]) * (
@@ -579,7 +596,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             else:
                 mx, my, mz = mirrored_ray(dx, dy, dz, nx, ny, nz)
                 ref = sky_radiance(mx, my, mz, sun_dir, sun_color, sun_i * (1.0 - roughness), zenith, horizon,
-                                   cloud)
+                                   cloud, coarse)
             r, g, b = blend(r, g, b, ref, strength)
         write_fogged(fog_lut, fog_color, out, row, col, dist, r, g, b)
 
@@ -596,19 +613,28 @@ def shade(face: np.ndarray, depth: np.ndarray, bary: np.ndarray, view: View, geo
 
 @kernel
 def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.ndarray, face_emission: np.ndarray,
-                 face_normal: np.ndarray, sun_dir: np.ndarray, sun_color: np.ndarray, env_f: np.ndarray,
-                 zenith: np.ndarray, horizon: np.ndarray, lights_rgb_scale: float, out: np.ndarray, band: int,
+                 face_normal: np.ndarray, view: View, sun_dir: np.ndarray, sun_color: np.ndarray, env_f: np.ndarray,
+                 zenith: np.ndarray, horizon: np.ndarray, lamp_spill: float, out: np.ndarray, band: int,
                  bands: int) -> None:
-    """Flat-shade the mirrored objects (no shadows) of one row band: what a wet road reflects."""
+    """Shade the mirrored objects of one row band (no shadows): what a wet road reflects.
+
+    A pixel sees the real object from the camera mirrored below the ground, along its ray with z flipped: each
+    face is lit on the side that camera sees (the underside of a crown, the back of a backlit tree stay dark), so
+    a reflection is never brighter than what it reflects. ``lamp_spill`` is the lamps' light on objects at night."""
     height, width = face_buf.shape
+    R = view.R_world_camera
+    sun_x, sun_y, sun_z = sun_dir[0], sun_dir[1], sun_dir[2]
     for row in band_rows(height, band, bands):
+        y_cam = (row + 0.5 - view.cy) / view.fy
         for col in range(width):
             f = face_buf[row, col]
             if f < 0:
                 continue
-            n_dot_l = abs(face_normal[f, 0] * sun_dir[0] + face_normal[f, 1] * sun_dir[1]
-                          + face_normal[f, 2] * sun_dir[2])
+            dx, dy, dz, _ = pixel_ray(R, (col + 0.5 - view.cx) / view.fx, y_cam)
+            nx, ny, nz, _ = facing_normal(face_normal, f, dx, dy, -dz)
+            n_dot_l = max(nx * sun_x + ny * sun_y + nz * sun_z, 0.0)
+            up = 0.6 + 0.4 * nz
             for c in range(3):
-                amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * SKY_AMBIENT_GAIN + lights_rgb_scale
+                amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * SKY_AMBIENT_GAIN * up + lamp_spill
                 out[row, col, c] = face_color[f, c] * (SUN_SCALE * env_f[SUN_I] * sun_color[c] * n_dot_l + amb) \
                     + face_emission[f, c]

@@ -16,7 +16,15 @@ if TYPE_CHECKING:  # the case model imports the illusions, which use sun_directi
 
 NIGHT_EXPOSURE = 2.2
 PHOTO_DETAIL = 1.5  # surface texture of a case seen through a real camera's sensor (0 in the ideal render)
-HEADLIGHT_INTENSITY = 35.0  # radiance scale at 1 m of each of the ego's two headlights (on at night)
+# Radiance scale at 1 m, on the beam's axis, of each of the ego's two low-beam headlights (on at night). The beam
+# is cut off just below the horizon (render.lighting.beam_weight), so it lights the road ahead and the paint on it,
+# not the houses and trees beside it.
+HEADLIGHT_INTENSITY = 120.0
+# The night sky (linear rgb at the zenith and the horizon): a moonless sky a few hundred times darker than a lit
+# road (about 0.003 cd/m2 against 1 cd/m2 under street lamps), a little lighter and warmer low down where the
+# towns' light scatters.
+NIGHT_ZENITH = np.array([0.0002, 0.0003, 0.0007], np.float32)
+NIGHT_HORIZON = np.array([0.0016, 0.0014, 0.0015], np.float32)
 
 # Daylight of a photographed case (docs/realism.md, "Sun and sky in proportion"). Clear-sky beam and diffuse by the
 # ASHRAE clear-sky model (ASHRAE Handbook of Fundamentals; Threlkeld & Jordan 1958), its 21 April row:
@@ -121,9 +129,9 @@ def environment_for(case: Case) -> Environment:
     sun_color = _mix([1.0, 0.97, 0.92], [1.0, 0.62, 0.32], low * 0.8)
     clear_zenith, clear_horizon = np.array([0.16, 0.32, 0.75]), np.array([0.62, 0.74, 0.92])
     grey = np.array([0.55, 0.57, 0.6])
-    zenith = _mix(clear_zenith, grey * 0.8, cloud) * day + np.array([0.004, 0.006, 0.015]) * (1 - day)
+    zenith = _mix(clear_zenith, grey * 0.8, cloud) * day + NIGHT_ZENITH * (1 - day)
     horizon = _mix(_mix(clear_horizon, [0.95, 0.7, 0.5], low * 0.6 * (1 - cloud)), grey, cloud)
-    horizon = horizon * day + np.array([0.01, 0.012, 0.02]) * (1 - day)
+    horizon = horizon * day + NIGHT_HORIZON * (1 - day)
     photographed = case.camera.sensor is not None
     direct = sun.intensity * day * (_beam_through_clouds(altitude, cloud) if photographed else 1.0 - 0.85 * cloud)
     return Environment(

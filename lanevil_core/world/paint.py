@@ -28,7 +28,7 @@ BOTTS_DOT_SPACING_M = 1.2
 MATERIAL_ALBEDO = np.array([
     [0.055, 0.055, 0.058],  # asphalt
     [0.30, 0.29, 0.27],  # concrete
-    [0.07, 0.12, 0.035],  # grass
+    [0.075, 0.11, 0.045],  # grass (mown lawn and verge, a little yellow and grey in it)
     [0.16, 0.145, 0.13],  # gravel
     [0.38, 0.37, 0.35],  # kerb
     [0.13, 0.10, 0.07],  # dirt

@@ -7,6 +7,8 @@ Dimensions are real (metres); colours are linear albedo.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import trimesh
 
@@ -16,6 +18,9 @@ from .scene import Mesh
 
 # Linear albedos shared by several props.
 GLASS = (0.012, 0.016, 0.022)
+WINDOW_FRAMES = ((0.55, 0.55, 0.52), (0.08, 0.08, 0.08))  # white-painted and dark aluminium
+WINDOW_FRAME_M = 0.07
+SILL_DEPTH_M = 0.12
 TYRE = (0.018, 0.018, 0.02)
 RIM = (0.22, 0.22, 0.23)
 TRIM = (0.03, 0.03, 0.032)
@@ -34,7 +39,7 @@ HAIRS = ((0.02, 0.015, 0.01), (0.12, 0.06, 0.02), (0.35, 0.25, 0.1), (0.3, 0.3, 
 FACADES = ((0.45, 0.4, 0.33), (0.3, 0.3, 0.3), (0.35, 0.12, 0.07), (0.55, 0.53, 0.5), (0.4, 0.3, 0.2),
            (0.2, 0.22, 0.25))
 ROOFS = ((0.2, 0.05, 0.03), (0.06, 0.06, 0.07), (0.15, 0.1, 0.07))
-LEAVES = ((0.04, 0.11, 0.025), (0.06, 0.14, 0.03), (0.03, 0.08, 0.03), (0.08, 0.13, 0.02))
+LEAVES = ((0.05, 0.1, 0.035), (0.07, 0.12, 0.04), (0.04, 0.075, 0.035), (0.09, 0.12, 0.035), (0.06, 0.09, 0.045))
 
 
 def _pick(rng: np.random.Generator, palette: tuple[tuple[float, float, float], ...]) -> FloatArray:
@@ -281,43 +286,123 @@ def _rider(hip_c: FloatArray, bracket: FloatArray, grips: FloatArray, shirt: Flo
 
 def tree(rng: np.random.Generator, *, conifer: bool | None = None, height: float | None = None,
          name: str = "tree") -> Mesh:
-    """A tree 4-12 m tall: trunk and a lumpy icosphere crown, or a conifer of three stacked cones."""
+    """A tree 4-12 m tall of one of several species: a spruce (a tapering trunk under a dozen drooping, ragged
+    whorls of branches), or a broadleaf (``BROADLEAVES``: a round crown, a pale slender birch, a columnar
+    poplar), whose trunk forks into branches each ending in a lumpy leaf cluster."""
     conifer = bool(rng.random() < 0.35) if conifer is None else conifer
     height = float(rng.uniform(5.0, 11.0)) if height is None else height
     if conifer:
-        trunk_h = 0.2 * height
-        parts = [cylinder(0.1 + 0.012 * height, trunk_h + 0.3, (0.0, 0.0, trunk_h / 2 - 0.15), BARK, sections=6)]
-        for i, frac in enumerate((0.0, 0.3, 0.55)):
-            radius = 0.22 * height * (1.0 - 0.3 * i)
-            base = trunk_h + frac * (height - trunk_h)
-            cone = trimesh.creation.cone(radius, height - base, sections=8, transform=translation((0, 0, base)))
-            parts.append(to_mesh(cone, _leaf_colors(rng, len(cone.faces), 0.7)))
-        return merge(parts, name=name, kind="tree")
-    radius = float(rng.uniform(0.28, 0.36)) * height
-    trunk_h = height - 1.7 * radius
-    parts = [cylinder(0.08 + 0.02 * height, trunk_h + 0.5, (0.0, 0.0, trunk_h / 2), BARK, sections=6)]
-    crown = trimesh.creation.icosphere(subdivisions=1, radius=radius)
-    crown.vertices = crown.vertices * (1.0 + 0.18 * rng.uniform(-1.0, 1.0, (len(crown.vertices), 1)))
-    crown.apply_scale((1.0, 1.0, float(rng.uniform(0.85, 1.1))))
-    crown.apply_translation((0.0, 0.0, height - radius))
-    parts.append(to_mesh(crown, _leaf_colors(rng, len(crown.faces))))
-    return merge(parts, name=name, kind="tree")
+        return merge(_spruce(rng, height), name=name, kind="tree")
+    species = BROADLEAVES[int(rng.choice(len(BROADLEAVES), p=BROADLEAF_SHARES))]
+    return merge(_broadleaf(rng, height, species), name=name, kind="tree")
+
+
+@dataclass(frozen=True)
+class Broadleaf:
+    """What sets a broadleaf species apart: its crown's radius and its height as shares of the tree's height,
+    its bark, its branches and leaf clusters, and the palette of its leaves."""
+
+    crown: float
+    crown_height: float
+    bark: tuple[float, float, float]
+    branches: tuple[int, int]
+    leaves: tuple[tuple[float, float, float], ...]
+    trunk: float = 1.0
+
+
+BROADLEAF_SHARES = (0.7, 0.15, 0.15)  # most roadside broadleaves have round crowns; birches and poplars are fewer
+BROADLEAVES = (
+    Broadleaf(crown=0.32, crown_height=0.62, bark=BARK, branches=(4, 7), leaves=LEAVES),  # oak, maple, lime
+    Broadleaf(crown=0.22, crown_height=0.6, bark=(0.42, 0.4, 0.36), branches=(3, 5),
+              leaves=((0.09, 0.13, 0.035), (0.1, 0.14, 0.045)), trunk=0.6),  # birch
+    Broadleaf(crown=0.14, crown_height=0.8, bark=(0.12, 0.1, 0.08), branches=(4, 6),
+              leaves=((0.05, 0.09, 0.03), (0.06, 0.1, 0.035))),  # poplar
+)
+
+
+def _broadleaf(rng: np.random.Generator, height: float, species: Broadleaf) -> list[Mesh]:
+    """Trunk, branches forking from its top and a lumpy cluster of leaves at each branch's end (local frame, foot
+    at the origin)."""
+    radius = species.crown * height * float(rng.uniform(0.85, 1.1))
+    crown_h = species.crown_height * height
+    centre_z = height - crown_h / 2
+    fork = height - crown_h * 0.8
+    trunk_r = (0.06 + 0.018 * height) * species.trunk
+    parts = [cylinder(trunk_r, fork + 0.3, (0.0, 0.0, fork / 2 - 0.15), species.bark, sections=7)]
+    count = int(rng.integers(species.branches[0], species.branches[1] + 1))
+    detail = 1  # the first clusters are smooth (subdivided once), the rest coarse: about 250 faces a tree
+    green = _pick(rng, species.leaves)
+    for k in range(count):
+        angle = 2 * np.pi * (k + float(rng.uniform(-0.3, 0.3))) / count
+        reach = radius * float(rng.uniform(0.35, 0.5))  # the crown stays within the footprint scenery gives a tree
+        lift = float(rng.uniform(-0.25, 0.45)) * crown_h / 2
+        end = np.array([reach * np.cos(angle), reach * np.sin(angle), centre_z + lift])
+        parts.append(beam((0.0, 0.0, fork - 0.2), end, trunk_r * 0.9, color=species.bark))
+        size = radius * float(rng.uniform(0.45, 0.55))
+        parts.append(_leaf_cluster(rng, size, end, (1.0, 1.0, crown_h / (2 * radius) * 0.8), green,
+                                   detail if k < 1 else 0))
+    top = np.array([0.0, 0.0, height - radius * 0.75])  # the leader closes the crown's middle and top
+    parts.append(_leaf_cluster(rng, radius * 0.62, top, (1.0, 1.0, crown_h / (2 * radius) * 0.9), green, detail))
+    return parts
+
+
+def _spruce(rng: np.random.Generator, height: float) -> list[Mesh]:
+    """A spruce or fir: a tapering trunk and whorls of drooping branches, each whorl a ragged cone whose rim dips
+    below its top, narrowing up the tree to a spire."""
+    trunk_h = 0.15 * height
+    base_r = 0.21 * height * float(rng.uniform(0.9, 1.1))
+    parts = [cylinder(0.08 + 0.012 * height, height * 0.9, (0.0, 0.0, height * 0.45), BARK, sections=6)]
+    green = _pick(rng, LEAVES) * 0.75
+    tiers = 7
+    for i in range(tiers):
+        share = i / tiers
+        z_rim = trunk_h + share * (height - trunk_h) * 0.92
+        r = base_r * (1.0 - share) ** 0.9 + 0.15
+        sections = 8
+        angles = 2 * np.pi * (np.arange(sections) + float(rng.uniform(0, 1))) / sections
+        reach = r * rng.uniform(0.8, 1.15, sections)
+        rim = np.stack([reach * np.cos(angles), reach * np.sin(angles),
+                        z_rim - rng.uniform(0.0, 0.25, sections) * r], 1)
+        apex = np.array([0.0, 0.0, z_rim + 0.9 * r + 0.3])
+        vertices = np.vstack([rim, apex, (0.0, 0.0, z_rim - 0.1 * r)])
+        ring, nxt = np.arange(sections), (np.arange(sections) + 1) % sections
+        faces = np.concatenate([np.stack([ring, nxt, np.full(sections, sections)], 1),
+                                np.stack([nxt, ring, np.full(sections, sections + 1)], 1)])
+        tm = trimesh.Trimesh(vertices, faces, process=False)
+        parts.append(to_mesh(tm, _leaf_colors(green, rng, len(faces))))
+    return parts
+
+
+def _leaf_cluster(rng: np.random.Generator, size: float, centre: FloatArray, squash: tuple[float, float, float],
+                  green: FloatArray, subdivisions: int = 1) -> Mesh:
+    """A clump of leaves: a lumpy, squashed icosphere whose faces vary in shade (the lit and shaded leaves)."""
+    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=size)
+    tm.vertices = tm.vertices * (1.0 + 0.28 * rng.uniform(-1.0, 1.0, (len(tm.vertices), 1)))
+    tm.apply_scale(squash)
+    tm.apply_translation(centre)
+    return to_mesh(tm, _leaf_colors(green, rng, len(tm.faces)))
 
 
 def bush(rng: np.random.Generator, *, radius: float | None = None, name: str = "bush") -> Mesh:
-    """A low shrub (80 faces): a squashed, lumpy icosphere sitting on the ground."""
+    """A low shrub: two or three lumpy, squashed leaf clusters side by side on the ground."""
     radius = float(rng.uniform(0.6, 1.3)) if radius is None else radius
-    tm = trimesh.creation.icosphere(subdivisions=1, radius=radius)
-    tm.vertices = tm.vertices * (1.0 + 0.15 * rng.uniform(-1.0, 1.0, (len(tm.vertices), 1)))
-    tm.apply_scale((1.0, 1.0, 0.65))
-    tm.apply_translation((0.0, 0.0, 0.45 * radius))
-    return to_mesh(tm, _leaf_colors(rng, len(tm.faces)), name=name, kind="bush")
+    green = _pick(rng, LEAVES)
+    parts = []
+    for k in range(int(rng.integers(2, 4))):
+        size = radius * float(rng.uniform(0.55, 0.8))
+        angle = float(rng.uniform(0, 2 * np.pi))
+        offset = 0.0 if k == 0 else radius * 0.45
+        centre = np.array([offset * np.cos(angle), offset * np.sin(angle), 0.4 * size])
+        parts.append(_leaf_cluster(rng, size, centre, (1.0, 1.0, 0.7), green, 1 if k == 0 else 0))
+    return merge(parts, name=name, kind="bush")
 
 
-def _leaf_colors(rng: np.random.Generator, m: int, shade: float = 1.0) -> FloatArray:
-    """(m, 3) foliage colours: one green from the palette, varied face by face so flat shading reads as leaves."""
-    base = _pick(rng, LEAVES) * shade
-    return base * rng.uniform(0.75, 1.25, (m, 1))
+def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatArray:
+    """(m, 3) foliage colours around ``green``: shade and hue varied face by face (sunlit leaves yellower,
+    inner ones darker and bluer) so flat shading reads as leaves."""
+    shade = rng.uniform(0.7, 1.25, (m, 1))
+    warm = rng.uniform(-1.0, 1.0, (m, 1)) * np.array([0.12, 0.0, -0.12])
+    return np.clip(green * shade * (1.0 + warm), 0.0, 1.0)
 
 
 def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0, height: float = 15.0, *,
@@ -325,7 +410,7 @@ def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0,
     """An apartment or office block: ``width`` along X, ``depth`` along Y, a grid of dark windows on every
     facade, a parapet; ``shopfront`` darkens the ground floor of the front (+Y) facade."""
     facade = _choose(rng, facade, FACADES)
-    hx, hy = width / 2, depth / 2
+    hy = depth / 2
     parts = [box((width, depth, height + 0.5), (0.0, 0.0, height / 2 - 0.25), facade),
              box((width + 0.2, depth + 0.2, 0.6), (0.0, 0.0, height + 0.1), facade * 0.7)]
     storeys = max(int(height // 3.2), 1)
@@ -334,15 +419,23 @@ def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0,
     first = 1 if shopfront else 0
     if shopfront:
         parts.append(box((width - 1.0, 0.1, 2.6), (0.0, hy, 1.6), glass))
-    for axis_len, across, sign, along_x in ((width, hy, 1.0, True), (width, hy, -1.0, True),
-                                           (depth, hx, 1.0, False), (depth, hx, -1.0, False)):
-        parts += _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass)
+    for axis_len, across, sign, along_x in _facades_seen(width, depth):
+        parts += _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass, rng)
     return merge(parts, name=name, kind="building", gloss=0.1)
 
 
+def _facades_seen(width: float, depth: float) -> tuple[tuple[float, float, float, bool], ...]:
+    """(span, distance from the centre, sign, runs along X) of the facades with windows: the front (+Y, towards the
+    road) and both ends; the back is never seen from the road."""
+    hx, hy = width / 2, depth / 2
+    return (width, hy, 1.0, True), (depth, hx, 1.0, False), (depth, hx, -1.0, False)
+
+
 def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys: int, pitch: float,
-                 first_storey: int, color: FloatArray) -> list[Mesh]:
-    """Window quads on one facade: the facade plane sits at ``sign * across`` (y if ``along_x`` else x)."""
+                 first_storey: int, color: FloatArray, rng: np.random.Generator | None = None) -> list[Mesh]:
+    """Windows on one facade (the facade plane at ``sign * across``: y if ``along_x`` else x): each a frame, a
+    pane and a sill under it. The panes' colours (``color`` times a drawn factor per pane, when ``rng`` is given)
+    stand for what glass shows by day: the sky mirrored (pale, more so up the facade), a dark room, a curtain."""
     columns = max(int(span // pitch), 1)
     centres = (np.arange(columns) - (columns - 1) / 2) * (span / columns)
     half_w = min(0.7, 0.3 * span / columns)
@@ -350,18 +443,34 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
     if levels.size == 0:
         return []
     c, z = (grid.ravel() for grid in np.meshgrid(centres, levels))
-    a, b, z0, z1 = c - half_w, c + half_w, z + 0.95, z + 2.55
-    plane = np.full_like(a, sign * (across + 0.01))
-    u = np.stack([a, b, b, a], 1)  # (n, 4) along the facade
-    v = np.stack([z0, z0, z1, z1], 1)
-    w = np.broadcast_to(plane[:, None], u.shape)
-    corners = np.stack([u, w, v] if along_x else [w, u, v], -1).reshape(-1, 3)
-    quads = np.arange(len(a))[:, None] * 4
-    faces = np.concatenate([quads + [0, 1, 2], quads + [0, 2, 3]])
-    # The (u, v) order is counter-clockwise seen from +Y for an x-running facade and from -X otherwise.
-    if (sign > 0) == along_x:
-        faces = faces[:, ::-1]
-    return [Mesh(corners, faces, np.asarray(color, np.float32))]
+    n = len(c)
+    frame = WINDOW_FRAME_M
+    # (n, 4) corners along the facade (u) and up it (v), and their offsets off the wall (w): frame, pane and sill
+    # (a quad jutting out and down from the frame's foot)
+    rects = [(c - half_w - frame, c + half_w + frame, z + 0.95 - frame, z + 2.55 + frame, 0.01, 0.01),
+             (c - half_w, c + half_w, z + 0.95, z + 2.55, 0.02, 0.02),
+             (c - half_w - 0.08, c + half_w + 0.08, z + 0.95 - frame, z + 0.95 - frame - 0.05, 0.01, SILL_DEPTH_M)]
+    if rng is None:
+        pane = np.broadcast_to(np.asarray(color, np.float32), (n, 3))
+    else:
+        sky = np.clip(0.25 + 0.12 * z / 3.2 + rng.uniform(-0.1, 0.25, n), 0.0, 1.0)[:, None]
+        pane = np.asarray(color) * (1.0 + 5.0 * sky) * rng.uniform(0.7, 1.3, (n, 1))
+        curtains = rng.random(n) < 0.2
+        pane[curtains] = rng.choice([0.35, 0.5], curtains.sum())[:, None] * np.array([0.55, 0.5, 0.42])
+    frame_color = np.broadcast_to(np.asarray(WINDOW_FRAMES[0 if rng is None else int(rng.integers(2))]), (n, 3))
+    meshes = []
+    for (a, b, z0, z1, w0, w1), colors in zip(rects, (frame_color, pane, frame_color)):
+        u = np.stack([a, b, b, a], 1)
+        v = np.stack([z0, z0, z1, z1], 1)
+        w = sign * (across + np.stack([np.full(n, w0), np.full(n, w0), np.full(n, w1), np.full(n, w1)], 1))
+        corners = np.stack([u, w, v] if along_x else [w, u, v], -1).reshape(-1, 3)
+        quads = np.arange(n)[:, None] * 4
+        faces = np.concatenate([quads + [0, 1, 2], quads + [0, 2, 3]])
+        # The (u, v) order is counter-clockwise seen from +Y for an x-running facade and from -X otherwise.
+        if (sign > 0) == along_x:
+            faces = faces[:, ::-1]
+        meshes.append(Mesh(corners, faces, np.concatenate([colors, colors]).astype(np.float32)))
+    return meshes
 
 
 def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
@@ -377,13 +486,45 @@ def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, 
                    -hx - 0.3, hx + 0.3, _pick(rng, ROOFS), axis="x")]
     glass = np.asarray(GLASS) * 2.0
     pitch = float(rng.uniform(2.8, 3.6))
-    for span, across, sign, along_x in ((width, hy, 1.0, True), (width, hy, -1.0, True),
-                                        (depth, hx, 1.0, False), (depth, hx, -1.0, False)):
-        parts += _window_grid(span, across, sign, along_x, storeys, pitch, 0, glass)
+    for span, across, sign, along_x in _facades_seen(width, depth):
+        parts += _window_grid(span, across, sign, along_x, storeys, pitch, 0, glass, rng)
     parts.append(_panel([(hx * 0.5 - 0.5, hy + 0.02, 0.0), (hx * 0.5 + 0.5, hy + 0.02, 0.0),
                          (hx * 0.5 + 0.5, hy + 0.02, 2.1), (hx * 0.5 - 0.5, hy + 0.02, 2.1)],
                         (0.0, 1.0, 0.0), (0.12, 0.06, 0.03)))
     return merge(parts, name=name, kind="building", gloss=0.05)
+
+
+# Street furniture on the sidewalk: litter bins, bollards and sign posts (a traffic sign facing the oncoming
+# driver: the red ring of a prohibition or speed limit, the blue disc of a mandatory sign, a yellow warning plate).
+STREET_GREEN = (0.03, 0.07, 0.04)
+BOLLARD_GREY = (0.1, 0.1, 0.1)
+SIGN_FACES = ((0.55, 0.03, 0.02), (0.02, 0.1, 0.45), (0.7, 0.5, 0.02))
+SIGN_BACK = (0.35, 0.35, 0.35)
+
+
+def litter_bin(name: str = "bin") -> Mesh:
+    """A round street litter bin (0.9 m tall): a dark green body under a lid."""
+    return merge([cylinder(0.28, 0.85, (0.0, 0.0, 0.425), STREET_GREEN, sections=10),
+                  cylinder(0.31, 0.08, (0.0, 0.0, 0.89), np.asarray(STREET_GREEN) * 0.7, sections=10)],
+                 name=name, kind="pole", gloss=0.2)
+
+
+def bollard(name: str = "bollard") -> Mesh:
+    """A steel bollard (1 m tall) with a white reflective band near its top."""
+    return merge([cylinder(0.09, 0.82, (0.0, 0.0, 0.41), BOLLARD_GREY, sections=8),
+                  cylinder(0.095, 0.1, (0.0, 0.0, 0.87), (0.7, 0.7, 0.68), sections=8),
+                  cylinder(0.09, 0.08, (0.0, 0.0, 0.96), BOLLARD_GREY, sections=8)], name=name, kind="pole",
+                 gloss=0.3)
+
+
+def sign_post(rng: np.random.Generator, name: str = "sign") -> Mesh:
+    """A traffic sign on a 2.6 m galvanised post, its face towards -X (the driver coming along +X)."""
+    face = _pick(rng, SIGN_FACES)
+    plate = [box((0.03, 0.62, 0.62), (0.02, 0.0, 2.55), SIGN_BACK),
+             box((0.01, 0.56, 0.56), (-0.005, 0.0, 2.55), (0.75, 0.75, 0.72)),
+             box((0.012, 0.44, 0.44), (-0.012, 0.0, 2.55), face)]
+    return merge([cylinder(0.035, 2.9, (0.03, 0.0, 1.45), (0.45, 0.46, 0.47), sections=6), *plate], name=name,
+                 kind="pole", gloss=0.3)
 
 
 # New Jersey barrier cross-section (y, z), metres: 0.61 m base, 0.15 m top, 0.81 m tall.

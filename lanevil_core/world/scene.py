@@ -105,13 +105,22 @@ class SurfaceLayer:
 
 @dataclass
 class PointLight:
-    """A lamp: position, linear RGB colour and intensity (radiance scale at 1 m)."""
+    """A lamp: position, linear RGB colour and intensity (radiance scale at 1 m), and how its light is spread
+    (``beam``, one of ``BEAMS``): ``omni`` alike in every direction, ``street`` a full cut-off street lamp (its light
+    falls downwards, nothing above about 80 degrees from the nadir, so a lamp lights a pool of road and the foot of
+    the walls near it, not the houses and trees around it)."""
 
     p_world: FloatArray
     color: Float32Array
     intensity: float
     name: str = "lamp"
     source: int = -1
+    beam: str = "omni"
+
+
+# How a lamp spreads its light (``PointLight.beam``, the light table's beam column; ``low`` is the ego's low-beam
+# headlights, which the renderer adds per frame).
+BEAMS = ("omni", "street", "low")
 
 
 @dataclass

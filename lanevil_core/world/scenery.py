@@ -18,7 +18,8 @@ from . import props
 from .environment import is_night
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
-from .scene import Mesh
+from .scene import Mesh, PointLight
+from .structures import WARM_LAMP, streetlight, streetlight_lamp_offset
 
 if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
     from ..case import Case
@@ -167,14 +168,21 @@ def _grouped(placed: list[tuple[float, Mesh]], name: str, kind: str) -> list[Mes
             for k, meshes in sorted(groups.items())]
 
 
+def own_rng(rng: np.random.Generator) -> np.random.Generator:
+    """A generator of a prop's own, seeded by one draw of the placement's: what a prop's builder draws (its shape,
+    its colours) never moves the props placed after it."""
+    return np.random.default_rng(int(rng.integers(2**63)))
+
+
 def plant(rng: np.random.Generator, bush_share: float, conifer_share: float) -> tuple[float, Callable[[], Mesh]]:
     """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh."""
+    own = own_rng(rng)
     if rng.random() < bush_share:
         radius = float(rng.uniform(0.6, 1.3))
-        return 1.2 * radius, lambda: props.bush(rng, radius=radius)
+        return 1.2 * radius, lambda: props.bush(own, radius=radius)
     conifer = bool(rng.random() < conifer_share)
     height = float(rng.uniform(5.0, 11.0))
-    return (0.23 if conifer else 0.43) * height, lambda: props.tree(rng, conifer=conifer, height=height)
+    return (0.23 if conifer else 0.43) * height, lambda: props.tree(own, conifer=conifer, height=height)
 
 
 def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, spacing: float,
@@ -202,7 +210,7 @@ def rows_of(network: RoadNetwork, clear: Clearance, rng: np.random.Generator,
     for index, piece, side in sides(network):
         s = piece.s_start + float(rng.uniform(0.0, gap[1]))
         while s < piece.line.length:
-            width, depth, build = make(rng)
+            width, depth, build = make(own_rng(rng))
             t = side * (corridor_half_width(piece) + float(rng.uniform(*setback)) + depth / 2)
             spot = Spot(index, s + width / 2, t, facing_yaw(side), width / 2, depth / 2)
             if try_place(clear, piece, spot):
@@ -234,29 +242,82 @@ def barriers(network: RoadNetwork, clear: Clearance, segment: float = 4.0) -> li
     return out
 
 
-def streetlights(network: RoadNetwork, clear: Clearance, spacing: float, emissive: bool) -> list[Mesh]:
-    """Street lamps on the sidewalk (the first raised strip), every ``spacing`` m on both sides, arms over the
-    road; none where a junction arm or its sidewalk passes."""
-    try:
-        from .structures import streetlight
-    except ImportError:  # streetlights are optional
-        return []
-    template = streetlight(emissive=emissive)
-    out: list[Mesh] = []
+STREETLIGHT_SPACING_M = 30.0  # street lamps along urban and suburban streets, on both sides
+STREETLIGHT_KINDS = ("urban", "suburban")  # the scene kinds with street lamps on their sidewalks
+STREET_LAMP_INTENSITY = 30.0  # radiance scale at 1 m of a roadside lamp: about 15 lux on the road below it
+
+
+def streetlight_poses(network: RoadNetwork, clear: Clearance,
+                      spacing: float) -> list[tuple[str, int, float, FloatArray]]:
+    """(side label, piece index, s, T_world_local) of every street lamp on the sidewalk (the first raised strip),
+    every ``spacing`` m on both sides, arms over the road; none where a junction arm or its sidewalk passes."""
+    poses = []
     for index, piece, side in sides(network):
         raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
         if not raised:
             continue
         t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.6)
         h = piece.strips[raised[0]].height
-        placed = []
         offset = spacing / 2 if side > 0 else 0.0
         for s in np.arange(piece.s_start + 5.0 + offset, piece.line.length - 2.0, spacing):
-            T = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
-            if not clear.on_road(T[None, :2, 3], margin=1.0, skip=index):
-                placed.append((float(s), transformed(template, T)))
-        label = "left" if side > 0 else "right"
+            T_world_local = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
+            if not clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
+                poses.append(("left" if side > 0 else "right", index, float(s), T_world_local))
+    return poses
+
+
+def streetlights(network: RoadNetwork, clear: Clearance, spacing: float, emissive: bool) -> list[Mesh]:
+    """Street lamps at ``streetlight_poses``, grouped per side, piece and stretch of road."""
+    template = streetlight(emissive=emissive)
+    groups: dict[tuple[str, int], list[tuple[float, Mesh]]] = {}
+    for label, index, s, T_world_local in streetlight_poses(network, clear, spacing):
+        groups.setdefault((label, index), []).append((s, transformed(template, T_world_local)))
+    out: list[Mesh] = []
+    for (label, index), placed in groups.items():
         out += _grouped(placed, f"streetlights {label} piece {index}", "pole")
+    return out
+
+
+def street_lamps(case: Case, network: RoadNetwork) -> list[PointLight]:
+    """The lights of the roadside's street lamps when they are lit (a night case of a scene kind with lamps):
+    warm LED heads with a full cut-off beam at each lamp of ``streetlights``."""
+    if case.scene.kind not in STREETLIGHT_KINDS or not is_night(case.sun.altitude):
+        return []
+    offset = streetlight_lamp_offset()
+    return [PointLight(T_world_local[:3, :3] @ offset + T_world_local[:3, 3], np.asarray(WARM_LAMP, np.float32),
+                       STREET_LAMP_INTENSITY, name=f"street lamp {label} {index} {s:.0f}", beam="street")
+            for label, index, s, T_world_local in streetlight_poses(network, Clearance(network),
+                                                                  STREETLIGHT_SPACING_M)]
+
+
+FURNITURE_SPACING_M = 22.0  # mean distance between pieces of street furniture along each sidewalk
+
+
+def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """Litter bins, bollards and sign posts (facing the traffic on their side) on the sidewalks (the first raised
+    strip), about every FURNITURE_SPACING_M, at the sidewalk's kerb side like the lamps; none where a junction arm
+    passes or within 2 m of a lamp."""
+    templates = (props.litter_bin(), props.bollard())
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+        if not raised:
+            continue
+        t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.5)
+        h = piece.strips[raised[0]].height
+        lamp_first = piece.s_start + 5.0 + (STREETLIGHT_SPACING_M / 2 if side > 0 else 0.0)
+        placed = []
+        for s in stations(piece.s_start + 12.0, piece.line.length - 5.0, FURNITURE_SPACING_M, rng):
+            choice = int(rng.integers(3))
+            mesh = props.sign_post(own_rng(rng)) if choice == 2 else templates[choice]
+            from_lamp = (s - lamp_first) % STREETLIGHT_SPACING_M
+            if min(from_lamp, STREETLIGHT_SPACING_M - from_lamp) < 2.0:
+                continue  # a lamp stands there
+            T_world_local = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
+            if not clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
+                placed.append((float(s), transformed(mesh, T_world_local)))
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"street furniture {label} piece {index}", "pole")
     return out
 
 
@@ -298,11 +359,12 @@ def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
         shop = bool(r.random() < 0.5)
         return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop)
 
-    meshes = streetlights(network, clear, 30.0, emissive=is_night(case.sun.altitude))
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
     if density > 0:  # a few street trees first; the blocks fill the frontage around them
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
         meshes += rows_of(network, clear, rng, block, (0.5, 2.5), (1.0 / density, 10.0 / density), "building")
+        meshes += street_furniture(network, clear, own_rng(rng))
     return meshes
 
 
@@ -315,8 +377,10 @@ def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear:
         width, depth = float(r.uniform(8.0, 14.0)), float(r.uniform(7.0, 10.0))
         return width, depth, lambda: props.house(r, width, depth)
 
-    meshes = greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
+    meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
+    meshes += street_furniture(network, clear, own_rng(rng))
     return meshes
 
 

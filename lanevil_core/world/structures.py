@@ -39,7 +39,7 @@ CABLE: Color = (0.03, 0.03, 0.03)
 WARM_LAMP: Color = (1.0, 0.78, 0.45)
 
 FOOTING_M = 0.3  # posts and piers reach this far below the ground, so kerbs and ditches never show a gap
-LAMP_EMISSION = 4.0  # radiance of a glowing lamp glass relative to its colour
+LAMP_EMISSION = 30.0  # radiance of a glowing lamp glass relative to its colour: far above the road it lights
 
 # W-beam guard rail front face, walking bottom to top: (u towards the traffic, v above the ground) in metres.
 # A real W-beam is 310 mm tall and 83 mm deep; its top sits about 0.75 m above the ground.

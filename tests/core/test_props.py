@@ -132,8 +132,13 @@ def test_building_and_house_fill_their_footprint() -> None:
     assert_renderable(block)
     np.testing.assert_allclose(extents(block), (20.2, 12.2, 16.9), atol=0.1)  # parapet, footing
     assert outward_share(block) > 0.85  # all but the parapet's underside
-    windows = block.colors.max(1) < 0.06
-    assert windows.sum() >= 2 * 4 * 5  # a grid of dark windows on the facades
+    tri = block.vertices[block.faces]
+    on_pane = (np.abs(np.abs(tri[..., 1]) - 6.02) < 1e-6).all(1) | (np.abs(np.abs(tri[..., 0]) - 10.02) < 1e-6).all(1)
+    assert on_pane.sum() >= 2 * 2 * 4 * 5  # a grid of window panes (two triangles each) on the facades
+    sills = (np.abs(np.abs(tri[..., 1]) - 6.0 - props.SILL_DEPTH_M) < 1e-6).any(1) \
+        | (np.abs(np.abs(tri[..., 0]) - 10.0 - props.SILL_DEPTH_M) < 1e-6).any(1)
+    assert sills.sum() == on_pane.sum()  # each with a sill jutting out under it
+    assert len(np.unique(block.colors[on_pane].round(4), axis=0)) > 10  # panes show the sky, rooms, curtains
     home = props.house(RNG(1), 10.0, 8.0, storeys=2)
     size = extents(home)
     assert 10.0 <= size[0] < 11.0 and 8.0 <= size[1] < 9.0 and 7.0 < size[2] < 10.0
