@@ -57,7 +57,7 @@ UPRIGHT_TYPES = ("pole", "streetLamp")
 OBJECT_TYPES: dict[str, str] = {
     "barrier": "barrier", "guard_rail": "barrier", "fence": "barrier", "pole": "pole", "lamp": "streetLamp",
     "streetlight": "streetLamp", "power_lines": "pole", "tree": "tree", "bush": "vegetation",
-    "building": "building", "bridge": "gantry", "tunnel": "building",
+    "building": "building", "bridge": "gantry", "tunnel": "building", "street_furniture": "obstacle",
 }
 # the paint's line type -> (OpenDRIVE road-mark type, colour, the kinds of its lines left to right)
 MARK_TYPES: dict[str, tuple[str, str, tuple[str, ...]]] = {

@@ -317,7 +317,7 @@ def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Gene
             if not clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
                 placed.append((float(s), transformed(mesh, T_world_local)))
         label = "left" if side > 0 else "right"
-        out += _grouped(placed, f"street furniture {label} piece {index}", "pole")
+        out += _grouped(placed, f"street furniture {label} piece {index}", "street_furniture")
     return out
 
 
