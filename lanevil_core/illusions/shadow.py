@@ -41,7 +41,8 @@ STRUCTURES_BEYOND_DRIVE_M = 40.0  # structures reach this far past the ego's las
 # own reach; base.BEYOND_DRIVE_M is that of crowds and road damage)
 ROAD_END_MARGIN_M = 5.0
 MAX_AHEAD_DEG = 75.0  # the sun never stands further ahead than this when its azimuth is solved for
-UPRIGHT_KINDS = ("streetlight", "pole", "street_furniture")  # props already standing beside the road that our posts must not hit
+# props already standing beside the road that our posts must not hit
+UPRIGHT_KINDS = ("streetlight", "pole", "street_furniture")
 UPRIGHT_CLEARANCE_M = 1.5
 MIN_FENCE_SUN_DEG = 10.0  # the fence shadow's solved sun sinks no lower than this
 FENCE_EDGE_LANES = 0.5  # the level-5 fence's shadow ends this many ego lane widths past the lane's near line
