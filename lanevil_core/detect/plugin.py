@@ -18,6 +18,7 @@ The HTTP and ONNX detectors (``http_detector``, ``onnx_head``) follow the same c
 
 from __future__ import annotations
 
+import abc
 import functools
 import importlib.metadata
 import os
@@ -54,14 +55,16 @@ class LaneDetectorPlugin(Protocol):
         ...
 
 
-class LaneDetector:
-    """A base class for plug-ins: subclass it, set the class attributes and write ``detect``."""
+class LaneDetector(abc.ABC):
+    """A base class for plug-ins: subclass it, set the class attributes and write ``detect`` (a subclass without it
+    cannot be made)."""
 
     input_size: ClassVar[tuple[int, int] | None] = None
     real_trained: ClassVar[bool] = False
 
+    @abc.abstractmethod
     def detect(self, rgb: UInt8Array) -> Polylines:
-        raise NotImplementedError
+        """Lane polylines ``[[[x, y], ...], ...]`` in ``rgb``'s pixels for one (H, W, 3) uint8 RGB frame."""
 
 
 @dataclass(frozen=True)

@@ -247,17 +247,25 @@ STREETLIGHT_KINDS = ("urban", "suburban")  # the scene kinds with street lamps o
 STREET_LAMP_INTENSITY = 30.0  # radiance scale at 1 m of a roadside lamp: about 15 lux on the road below it
 
 
+def sidewalk_kerb(piece: RoadPiece) -> tuple[float, float] | None:
+    """(lateral distance from the reference line, height) of the kerb side of a piece's sidewalk (its first raised
+    strip), or None where the piece has none."""
+    raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+    if not raised:
+        return None
+    return piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]), piece.strips[raised[0]].height
+
+
 def streetlight_poses(network: RoadNetwork, clear: Clearance,
                       spacing: float) -> list[tuple[str, int, float, FloatArray]]:
     """(side label, piece index, s, T_world_local) of every street lamp on the sidewalk (the first raised strip),
     every ``spacing`` m on both sides, arms over the road; none where a junction arm or its sidewalk passes."""
     poses = []
     for index, piece, side in sides(network):
-        raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
-        if not raised:
+        kerb = sidewalk_kerb(piece)
+        if kerb is None:
             continue
-        t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.6)
-        h = piece.strips[raised[0]].height
+        t, h = side * (kerb[0] + 0.6), kerb[1]
         offset = spacing / 2 if side > 0 else 0.0
         for s in np.arange(piece.s_start + 5.0 + offset, piece.line.length - 2.0, spacing):
             T_world_local = pose_on_road(piece.line, float(s), t, facing_yaw(side), h)
@@ -300,11 +308,10 @@ def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Gene
     templates = (props.litter_bin(), props.bollard())
     out: list[Mesh] = []
     for index, piece, side in sides(network):
-        raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
-        if not raised:
+        kerb = sidewalk_kerb(piece)
+        if kerb is None:
             continue
-        t = side * (piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]) + 0.5)
-        h = piece.strips[raised[0]].height
+        t, h = side * (kerb[0] + 0.5), kerb[1]
         lamp_first = piece.s_start + 5.0 + (STREETLIGHT_SPACING_M / 2 if side > 0 else 0.0)
         placed = []
         for s in stations(piece.s_start + 12.0, piece.line.length - 5.0, FURNITURE_SPACING_M, rng):

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import pytest
+from test_editor_save_browser import open_tab  # same folder, by its base name
 
 from app.editor import Editor, EditorTab
 from app.state import AppState
@@ -18,15 +19,6 @@ pytestmark = [pytest.mark.browser, pytest.mark.slow]
 WAIT_S = 90.0
 SLOW_MS = 180_000  # SwiftShader draws slowly on a busy machine
 ROAD_CLICK = (470, 660)  # on the ego's carriageway in the start view of a new straight road
-
-
-def open_page(browser, editor: Editor, url: str):
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.set_default_timeout(SLOW_MS)
-    newest = max(editor.tabs, default=-1)
-    page.goto(url)
-    page.get_by_role("button", name="Save", exact=True).wait_for()
-    return page, editor.tab(timeout=WAIT_S, after=newest)
 
 
 def open_folder(page, title: str) -> None:
@@ -61,7 +53,7 @@ def place_and_move(page, tab: EditorTab, pick, wait_for, illusion_type: str, s: 
 
 def test_author_a_case_from_scratch_save_reopen_and_export(browser, editor: Editor, editor_url: str, pick, wait_for,
                                                           state: AppState, screenshot_dir: Path) -> None:
-    page, tab = open_page(browser, editor, editor_url)
+    page, tab = open_tab(browser, editor, editor_url)
     open_folder(page, "New case")
     page.get_by_role("button", name="Create and open", exact=True).click()
     wait_for(lambda: tab.session is not None and tab.case.title == "New straight road", "the new case")
@@ -97,7 +89,7 @@ def test_author_a_case_from_scratch_save_reopen_and_export(browser, editor: Edit
     authored = tab.case
     page.close()
 
-    page, tab = open_page(browser, editor, editor_url)  # a new page: a fresh tab on the stored case
+    page, tab = open_tab(browser, editor, editor_url)  # a new page: a fresh tab on the stored case
     pick(page, tab.cases.case_id.value, case_id)
     wait_for(lambda: tab.session is not None and tab.session.case_id == case_id, "the reopened case")
     assert tab.case == authored
@@ -116,7 +108,7 @@ def test_author_a_case_from_scratch_save_reopen_and_export(browser, editor: Edit
 
 def test_arrow_keys_on_a_focused_slider_never_move_the_3d_camera(browser, editor: Editor, editor_url: str,
                                                                  wait_for) -> None:
-    page, tab = open_page(browser, editor, editor_url)
+    page, tab = open_tab(browser, editor, editor_url)
     wait_for(lambda: tab.view.surface is not None, "the scene")
     assert tab.preview.wait_idle(WAIT_S)
     time.sleep(3)  # the start view is set and reported back
@@ -135,7 +127,7 @@ def test_arrow_keys_on_a_focused_slider_never_move_the_3d_camera(browser, editor
 
 def test_a_second_sun_is_placed_only_once_confirmed_and_its_owner_is_named(browser, editor: Editor, editor_url: str,
                                                                          pick, wait_for, screenshot_dir: Path) -> None:
-    page, tab = open_page(browser, editor, editor_url)
+    page, tab = open_tab(browser, editor, editor_url)
     tab.cases.open_case("fence_shadow-00_uphill_rural_noon-03_level3")  # a fence shadow: it places the sun
     wait_for(lambda: tab.view.surface is not None and tab.preview.wait_idle(WAIT_S), "the fence case")
     page.get_by_text("Sun set by illusion").first.wait_for()
