@@ -147,8 +147,9 @@ def sides(network: RoadNetwork) -> Iterator[tuple[int, RoadPiece, int]]:
 
 
 def stations(s0: float, s1: float, spacing: float, rng: np.random.Generator, jitter: float = 0.4) -> FloatArray:
-    """Positions from s0 to s1 about ``spacing`` apart, each moved by up to +-jitter * spacing."""
-    if spacing <= 0 or s1 <= s0:
+    """Positions from s0 to s1 about ``spacing`` apart, each moved by up to +-jitter * spacing (none for a spacing
+    that is not positive and finite: a density of next to nothing)."""
+    if not 0 < spacing < np.inf or s1 <= s0:
         return np.zeros(0)
     base = np.arange(s0 + 0.5 * spacing, s1, spacing)
     return base + rng.uniform(-jitter, jitter, base.size) * spacing
@@ -207,6 +208,8 @@ def rows_of(network: RoadNetwork, clear: Clearance, rng: np.random.Generator,
             setback: tuple[float, float], gap: tuple[float, float], kind: str) -> list[Mesh]:
     """Buildings in a row along both sides of every piece: ``make`` returns (width, depth, local mesh builder)."""
     out: list[Mesh] = []
+    if not np.isfinite(gap[1]):  # a density of next to nothing: no row
+        return out
     for index, piece, side in sides(network):
         s = piece.s_start + float(rng.uniform(0.0, gap[1]))
         while s < piece.line.length:

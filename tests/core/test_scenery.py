@@ -76,6 +76,15 @@ def test_triangle_budget(kind: SceneKind) -> None:
         assert faces < (30_000 if density == 1.0 else 60_000), (kind, density, faces)
 
 
+@pytest.mark.parametrize("kind", SCENE_KINDS)
+@pytest.mark.parametrize("density", [5e-324, 1e-300, 1e-9])
+def test_a_density_of_next_to_nothing_places_next_to_nothing(kind: SceneKind, density: float) -> None:
+    # the props' spacings divide by the density: a subnormal one makes them infinite, which must mean "none"
+    _, meshes = scenery(kind, "crossroad", density)
+    rows = [mesh.name for mesh in meshes if mesh.name.split()[0] in ("building", "house", "farmhouse")]
+    assert not rows, (kind, density, rows)
+
+
 def test_scenery_is_deterministic_and_seeded() -> None:
     _, a = scenery("suburban", "bend", seed=4)
     _, b = scenery("suburban", "bend", seed=4)
