@@ -403,7 +403,9 @@ def _parapet(line: ReferenceLine, s0: float, s1: float, t_road: float, top: floa
 def wire(points_world: FloatArray, radius: float, sides: int = 4) -> tuple[FloatArray, IntArray]:
     """A thin closed prism along a polyline (n, 3): vertices (n*sides, 3), faces; cross-section width 2*radius."""
     tangent = np.gradient(points_world, axis=0)
-    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    length = np.linalg.norm(tangent, axis=1, keepdims=True)
+    # a polyline that does not move (a zero span) has no direction: any will do for a prism of no length
+    tangent = np.where(length > 0, tangent / np.where(length > 0, length, 1.0), [[1.0, 0.0, 0.0]])
     up = np.where(np.abs(tangent[:, 2:3]) > 0.9, [[1.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
     side = np.cross(tangent, up)
     side /= np.linalg.norm(side, axis=1, keepdims=True)

@@ -23,6 +23,7 @@ from lanevil_core.world.structures import (
     power_lines,
     streetlight,
     streetlight_lamp_offset,
+    wire,
 )
 
 
@@ -163,6 +164,12 @@ def test_power_line_wires_have_the_requested_thickness() -> None:
     assert wire[:, 1].max() - wire[:, 1].min() == pytest.approx(0.1, abs=1e-6)
     with pytest.raises(ValueError, match="wire_radius"):
         power_lines(line, 40.0, 75.0, t_poles=(-10.0,), wire_radius=0.01)
+
+
+def test_a_wire_that_does_not_move_is_finite() -> None:
+    # a zero span (both ends at one point) has no direction; its prism must still be finite, not NaN
+    vertices, _ = wire(np.array([[5.0, 2.0, 9.0], [5.0, 2.0, 9.0], [6.0, 2.0, 9.0]]), 0.05)
+    assert np.isfinite(vertices).all()
 
 
 def test_builders_are_deterministic(bend: ReferenceLine) -> None:
