@@ -7,12 +7,13 @@ from fastapi.responses import RedirectResponse
 
 from lanevil_core import __version__
 
-from .api import BodyLimitMiddleware
 from .api import openapi as api_openapi
-from .api import router as api_router
 from .api.allow import AllowMiddleware
 from .api.case_bodies import CASE_BODY_SCHEMAS
 from .api.errors import error_response, handle_exception, handle_server_error
+from .api.limits import BodyLimitMiddleware
+from .api.routes import router as api_router
+from .api.routes.study import SCHEMAS as STUDY_SCHEMAS
 from .docs import mount_docs
 from .headers import SecurityHeadersMiddleware
 from .jobs import JobNotFound
@@ -20,8 +21,7 @@ from .settings import Settings
 from .site import mount_static
 from .state import AppState
 from .store import InvalidId, StoreError
-from .study import router as study_router
-from .study.api import SCHEMAS as STUDY_SCHEMAS
+from .study.pages import router as study_router
 
 
 def create_app(settings: Settings | None = None, state: AppState | None = None) -> FastAPI:
@@ -39,8 +39,8 @@ def create_app(settings: Settings | None = None, state: AppState | None = None) 
     for error in (StoreError, JobNotFound):  # the API's error body for store/job errors raised by any route
         app.add_exception_handler(error, handle_exception)
     app.add_exception_handler(Exception, handle_server_error)  # any other exception: a 500 with the headers
-    app.include_router(api_router, prefix="/api")
-    app.include_router(study_router)
+    app.include_router(api_router)  # every resource under /api
+    app.include_router(study_router)  # the study's pages
     mount_docs(app)  # /docs and /redoc with their scripts served here, not from a CDN
     api_openapi.install(app, settings, {**STUDY_SCHEMAS, **CASE_BODY_SCHEMAS})
     mount_static(app)

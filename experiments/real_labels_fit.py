@@ -124,9 +124,9 @@ def seed_slopes(mask: np.ndarray, camera: Camera) -> dict[str, float | None]:
     slopes = (xs - vx) / (ys + band - vy)
     hist, edges = np.histogram(slopes, bins=np.linspace(-6, 6, 241))
     hist = np.convolve(hist, [1, 2, 1], "same")
-    centres = (edges[:-1] + edges[1:]) / 2
+    centers = (edges[:-1] + edges[1:]) / 2
     floor = max(60 * (mask.shape[1] / 1280) ** 2, 0.03 * hist.max())
-    peaks = [centres[i] for i in range(1, len(hist) - 1)
+    peaks = [centers[i] for i in range(1, len(hist) - 1)
              if hist[i] >= hist[i - 1] and hist[i] > hist[i + 1] and hist[i] > floor]
     own = (mask.shape[1] / 2 - vx) / (camera.bottom - vy)
     left, right = [c for c in peaks if c < own], [c for c in peaks if c > own]
@@ -164,9 +164,9 @@ def track(mask: np.ndarray, seed: Point, seed_slope: float, camera: Camera) -> l
         window = max(6.0, 0.16 * distance)
         low, high = int(max(0, predicted - window)), int(min(mask.shape[1], predicted + window + 1))
         runs = _paint_runs(mask[y, low:high], max(3.0, 0.12 * distance)) if high > low else []
-        centres = [low + (start + end - 1) / 2 for start, end in runs if end - start <= max(4.0, 0.5 * distance)]
-        if centres:
-            observations.append((min(centres, key=lambda x: abs(x - predicted)), float(y)))
+        centers = [low + (start + end - 1) / 2 for start, end in runs if end - start <= max(4.0, 0.5 * distance)]
+        if centers:
+            observations.append((min(centers, key=lambda x: abs(x - predicted)), float(y)))
             last_seen = y
         if last_seen is not None and last_seen - y > max(25.0, 0.9 * distance):
             break
@@ -243,12 +243,12 @@ def how(hand: dict[str, dict[str, Any]]) -> str:
 def draw(bgr: np.ndarray, rows: list[int], lanes: list[list[int]], title: str) -> np.ndarray:
     """The labels over the frame: left red, right magenta."""
     image = bgr.copy()
-    for lane, colour in zip(lanes, ((0, 0, 255), (255, 0, 255))):
+    for lane, color in zip(lanes, ((0, 0, 255), (255, 0, 255))):
         points = [(x, y) for x, y in zip(lane, rows) if x >= 0]
         for a, b in zip(points, points[1:]):
-            cv2.line(image, a, b, colour, 1)
+            cv2.line(image, a, b, color, 1)
         for point in points:
-            cv2.circle(image, point, 2, colour, -1)
+            cv2.circle(image, point, 2, color, -1)
     cv2.putText(image, title, (10, 30), cv2.FONT_HERSHEY_SIMPLEX, 0.9, (0, 0, 255), 2)
     return image
 

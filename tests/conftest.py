@@ -133,8 +133,8 @@ class LaneServer:
         self.content_types.append(content_type)
         bright = np.concatenate([[False], gray.mean(axis=0) > 200, [False]])
         edges = np.flatnonzero(np.diff(bright.astype(np.int8)))
-        centres = [(start + end - 1) / 2.0 for start, end in zip(edges[::2], edges[1::2], strict=True)]
-        lanes = [[[x, 0.0], [x, height - 1.0]] for x in centres]
+        centers = [(start + end - 1) / 2.0 for start, end in zip(edges[::2], edges[1::2], strict=True)]
+        lanes = [[[x, 0.0], [x, height - 1.0]] for x in centers]
         return 200, json.dumps({"lanes": lanes, "scores": [1.0] * len(lanes)}).encode()
 
     def close(self) -> None:

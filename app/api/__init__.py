@@ -1,14 +1,5 @@
-"""The REST API under ``/api``: cases, frames, detectors, labels, exports, drives, the illusion registry,
-uploaded meshes (``docs/api.md``)."""
-
-from fastapi import APIRouter
-
-from . import cases, detectors, drives, exports, illusions, images, labels, meshes
-from .errors import ApiError, ErrorBody
-from .limits import BodyLimitMiddleware
-
-router = APIRouter()
-for _module in (cases, images, detectors, labels, exports, drives, illusions, meshes):
-    router.include_router(_module.router)
-
-__all__ = ["ApiError", "BodyLimitMiddleware", "ErrorBody", "router"]
+"""The REST API under ``/api`` (``docs/api.md``): its resources in ``routes/`` (one router module each, mounted in
+``routes/__init__.py``), and here what every route shares: the error body and route class (``errors``), body
+limits (``limits``), ``Allow`` headers (``allow``), dependencies (``deps``), query parameters (``params``), strict
+JSON and form bodies (``json_body``, ``forms``), request and job bodies (``case_bodies``, ``job_bodies``) and the
+OpenAPI document (``openapi``)."""

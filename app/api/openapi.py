@@ -21,7 +21,7 @@ from fastapi import FastAPI
 
 from .errors import ErrorBody
 
-API_PREFIX = "/api/"
+API_PREFIX = "/api"  # where app/api/routes mounts every resource
 ERROR_REF = {"$ref": f"#/components/schemas/{ErrorBody.__name__}"}
 FASTAPI_VALIDATION_SCHEMAS = ("HTTPValidationError", "ValidationError")
 BODY_ERRORS: dict[str, str] = {
@@ -44,7 +44,7 @@ def document_errors(schema: dict[str, Any], schemas: Mapping[str, dict[str, Any]
     """``schema`` with ErrorBody as the body of every 4xx of ``/api``, 413/415 on every operation with a body, and
     ``schemas`` (models that request bodies described by hand refer to) among its components."""
     for path, item in schema.get("paths", {}).items():
-        if not path.startswith(API_PREFIX):
+        if not path.startswith(f"{API_PREFIX}/"):
             continue
         for operation in item.values():
             if not isinstance(operation, dict) or "responses" not in operation:

@@ -9,7 +9,7 @@ from typing import Any, get_type_hints
 from pydantic import BaseModel, Field, create_model
 from pydantic.dataclasses import dataclass
 
-from ..api.exports import JobState
+from ..api.job_bodies import JobState
 from .records import Study, StudyItem
 from .stats import Score
 

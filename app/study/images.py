@@ -17,7 +17,7 @@ from .spec import ACR_LABELS
 
 UPLOAD_FORMATS: dict[str, tuple[str, str]] = {"PNG": ("image/png", ".png"), "JPEG": ("image/jpeg", ".jpg")}
 GARBLE_TILES = 8  # tiles per side of the scrambled grid
-BANNER_GREY = (32, 32, 32)
+BANNER_GRAY = (32, 32, 32)
 OBJECT_REPR = re.compile(r"\s*<[^<>]* at 0x[0-9a-fA-F]+>")
 
 
@@ -100,7 +100,7 @@ def trap_banner(rgb: np.ndarray, answer: int) -> np.ndarray:
     band_h = int(size * 3.4)
     top = (height - band_h) // 2
     draw = ImageDraw.Draw(image)
-    draw.rectangle([0, top, width, top + band_h], fill=BANNER_GREY)
+    draw.rectangle([0, top, width, top + band_h], fill=BANNER_GRAY)
     for row, text in enumerate(lines):
         y_px = top + size * 0.5 + row * size * 1.4
         x_px = (width - draw.textlength(text, font=font)) / 2

@@ -12,7 +12,7 @@ from pathlib import Path
 from fastapi import APIRouter, HTTPException
 from fastapi.responses import FileResponse, HTMLResponse
 
-from .api import DbDep
+from .deps import DbDep
 from .records import NotFound, get_study
 
 STATIC_STUDY = Path(__file__).resolve().parents[2] / "static" / "study"

@@ -4,7 +4,7 @@ The renderer hands over scene-referred linear radiance (the old ideal pipeline m
 module works out, per frame, the numbers of the sensor kernel (``render.develop``):
 
 - **Auto-exposure** meters the frame as a camera does: the mean log luminance of the frame's middle 90 %
-  (trimmed, so neither the sun's glint nor black tyres rule it) is brought to middle grey (``KEY``), within the
+  (trimmed, so neither the sun's glint nor black tires rule it) is brought to middle grey (``KEY``), within the
   sensor's gain limits. The sky is in the metered frame, so shadowed asphalt falls dark and highlights clip.
 - **Gain and noise**: beyond ``BASE_GAIN`` the camera raises its analogue gain (ISO) instead of the exposure
   time; shot noise (Poisson, ~ sqrt(signal / full well)) and read noise (Gaussian) grow with it (EMVA 1288).

@@ -67,10 +67,10 @@ LANES_PER_DIRECTION_CHOICES = (1, 2, 2, 3)
 LANE_WIDTH_RANGE_M = (2.9, 4.0)
 NO_EDGE_LINE_SHARE = 0.2  # per edge line
 NO_LANE_LINES_SHARE = 0.1  # all lane lines of a variation
-NO_CENTRE_LINE_SHARE = 0.1
+NO_CENTER_LINE_SHARE = 0.1
 NO_PAINT_SHARE = 0.06  # a variation with no paint at all: no lanes to find
 LANE_LINE_CHOICES: tuple[LineType, ...] = ("white_dashed", "white_solid", "botts_dots", "white_solid_dashed")
-CENTRE_LINE_CHOICES: tuple[LineType, ...] = (
+CENTER_LINE_CHOICES: tuple[LineType, ...] = (
     "yellow_double_solid", "yellow_solid", "yellow_dashed", "yellow_solid_dashed", "white_double_solid",
 )
 
@@ -289,14 +289,14 @@ def _markings(lanes_per_direction: int, rng: np.random.Generator) -> list[dict[s
     white solid edges, each of them possibly left unpainted (``none``); always ten draws."""
     draws = rng.uniform(0.0, 1.0, 6)
     lane_line = LANE_LINE_CHOICES[int(draws[0] * len(LANE_LINE_CHOICES))]
-    centre_line = CENTRE_LINE_CHOICES[int(draws[1] * len(CENTRE_LINE_CHOICES))]
+    center_line = CENTER_LINE_CHOICES[int(draws[1] * len(CENTER_LINE_CHOICES))]
     if draws[2] < NO_LANE_LINES_SHARE:
         lane_line = "none"
-    if draws[3] < NO_CENTRE_LINE_SHARE:
-        centre_line = "none"
+    if draws[3] < NO_CENTER_LINE_SHARE:
+        center_line = "none"
     edges = ["none" if u < NO_EDGE_LINE_SHARE else "white_solid" for u in draws[4:6]]
     n = lanes_per_direction
-    names = [edges[0]] + [lane_line] * (n - 1) + [centre_line] + [lane_line] * (n - 1) + [edges[1]]
+    names = [edges[0]] + [lane_line] * (n - 1) + [center_line] + [lane_line] * (n - 1) + [edges[1]]
     if rng.uniform() < NO_PAINT_SHARE:
         names = ["none"] * len(names)
     return [{"type": name} for name in names]

@@ -129,7 +129,7 @@ class _Memory:
             return None
         return fit_path(_to_vehicle(self.p_world, state))
 
-    def centre_line(self, estimate: LaneEstimate | None, state: VehicleState) -> tuple[LanePath | None, str]:
+    def center_line(self, estimate: LaneEstimate | None, state: VehicleState) -> tuple[LanePath | None, str]:
         """The centre line to steer by and where it came from: ``both``/``left``/``right`` (the boundaries seen this
         frame), ``memory`` (the last one, re-read from the new pose) or ``none``."""
         if estimate is not None:
@@ -181,7 +181,7 @@ def drive_case(case: Case, settings: DriveSettings, on_step: StepCallback | None
         lanes = detect(frame.rgb, h_samples, gt_lanes)
         detect_ms = (time.perf_counter() - clock) * 1e3
         estimate = estimate_lane(lanes, h_samples, camera_vehicle, memory.width)
-        path, source = memory.centre_line(estimate, state)
+        path, source = memory.center_line(estimate, state)
         command = controller.steer(path, state.speed, params) if path is not None else 0.0
         steps.append(DriveStep(
             index, round(index * dt, 6), point.s_road, point.t_road, point.deviation, point.heading_error,

@@ -1,4 +1,4 @@
-"""Road damage: cracks, repairs and sealant, tyre marks on the main road's surface, and guard rails beside it.
+"""Road damage: cracks, repairs and sealant, tire marks on the main road's surface, and guard rails beside it.
 
 Surface damage becomes ``SurfaceLayer`` textures on road piece 0: crack stains and repainted repairs lie under the
 paint; open cracks, patches laid after the paint, sealant and rubber over it. Guard rails are W-beam meshes swept
@@ -31,7 +31,7 @@ PAINT_CLEARANCE_M = 0.12  # lateral gap from a lane line's centre to damage that
 # ahead of the vehicle, so damage starting here is in view from the first frame.
 NEAR_AHEAD_M = 6.0
 COUNT_LENGTH_M = 80.0  # the length of road the damage counts of a severity table are for
-INCIDENT_SPACING_M = 40.0  # tyre marks: one incident's marks every this many metres along the stretch
+INCIDENT_SPACING_M = 40.0  # tire marks: one incident's marks every this many metres along the stretch
 
 
 @dataclass(frozen=True)
@@ -337,7 +337,7 @@ class TireMarksLevel(Level):
 
 @register
 class TireMarks(_SurfaceDamage):
-    """Dark rubber tyre tracks from emergency braking, swerves across lane lines and sideways yaw slides."""
+    """Dark rubber tire tracks from emergency braking, swerves across lane lines and sideways yaw slides."""
 
     TEXEL: ClassVar[float] = 0.04
     # on_line: straight marks of a vehicle braking astride a lane line, one track running along the paint;
@@ -364,7 +364,7 @@ class TireMarks(_SurfaceDamage):
     swerve: StrictInt | None = Field(None, ge=0, le=40, description="swerving marks that cross a lane line")
     yaw: StrictInt | None = Field(None, ge=0, le=40, description="curved sideways-sliding marks")
     darkness: StrictFloat | None = Field(None, ge=0, le=1, description="peak opacity of the rubber")
-    track_width: StrictFloat | None = Field(None, ge=0.1, le=0.4, description="width of one tyre track (m)")
+    track_width: StrictFloat | None = Field(None, ge=0.1, le=0.4, description="width of one tire track (m)")
     length_min: StrictFloat = Field(20.0, gt=1, le=200, description="shortest mark (m)")
     length_max: StrictFloat = Field(45.0, gt=1, le=200, description="longest mark (m)")
 
@@ -387,7 +387,7 @@ class TireMarks(_SurfaceDamage):
         rgba = None
         for site in range(max(1, math.ceil(area.length_m / INCIDENT_SPACING_M))):
             lo, hi = self._starts(min(INCIDENT_SPACING_M, area.length_m), self.level().cluster)
-            marks, _ = tex.skid_marks(
+            marks, _ = tex.tire_marks(
                 rng if site == 0 else np.random.default_rng(int(rng.integers(0, 2**63 - 1))), area.shape,
                 area.texel, straight=straight, swerve=swerve, yaw=yaw,
                 center_t=[area.local_t(t) for t in center_t], swerve_m=ctx.network.lane_width,
@@ -396,7 +396,7 @@ class TireMarks(_SurfaceDamage):
                 start_m=(lo + site * INCIDENT_SPACING_M, hi + site * INCIDENT_SPACING_M))
             rgba = marks if rgba is None else tex.composite(marks, rgba)
         assert rgba is not None
-        self._emit(ctx, area, rgba, None, over_paint=True, name="tyre marks")
+        self._emit(ctx, area, rgba, None, over_paint=True, name="tire marks")
 
     def _starts(self, span_m: float, cluster: float) -> tuple[float, float]:
         """s range (m from the incident's site) of one incident's mark starts: the whole ``span_m`` at

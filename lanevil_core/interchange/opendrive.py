@@ -18,7 +18,7 @@
   and wires do not widen them; nothing stands on the carriageway: a part across it is written as its pieces beside
   the road and, where it is high enough to drive under, the piece above it. Objects lie within their road's s.
 
-What does not carry over: illusion surface textures (cracks, repairs, tyre marks, puddles), exact prop shapes,
+What does not carry over: illusion surface textures (cracks, repairs, tire marks, puddles), exact prop shapes,
 traffic participants (they are OpenSCENARIO entities), weather and sun (the OpenSCENARIO environment).
 """
 

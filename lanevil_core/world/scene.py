@@ -89,7 +89,7 @@ class SurfaceLayer:
         texel: texel size (m).
         rgba: (h, w, 4) float32: linear albedo and coverage alpha; blended over the asphalt.
         wet: (h, w) float32 puddle depth/coverage in [0, 1] (mirror-like water), or None.
-        over_paint: drawn over lane paint (sealant, skid marks) instead of under it (cracks in the asphalt).
+        over_paint: drawn over lane paint (sealant, tire marks) instead of under it (cracks in the asphalt).
     """
 
     piece: int

@@ -80,7 +80,7 @@ def test_cover_camera_sees_every_ray_of_a_barrel_lens() -> None:
     assert np.allclose(cover.T_world_camera, camera.T_world_camera) and corners_world.shape == (1, 3)
 
 
-def test_metering_brings_the_frame_to_middle_grey_within_limits() -> None:
+def test_metering_brings_the_frame_to_middle_gray_within_limits() -> None:
     flat = np.full((64, 64, 3), 0.05, np.float32)
     assert metered_gain(flat, Sensor()) == pytest.approx(KEY / 0.05, rel=1e-3)
     assert metered_gain(flat * 1e-4, Sensor()) == Sensor().max_gain  # night: the gain limit holds
@@ -194,8 +194,8 @@ def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: C
         case = make_case(illusions=[{"type": "fence_shadow", "severity": 5}],
                          camera={"width": 320, "height": 180, "sensor": sensor})
         frame = render_frame(compile_scene(case), 5)
-        grey = frame.rgb.mean(axis=-1)[frame.object_id == ID_ROAD]
-        ratios.append(np.percentile(grey, 10) / np.percentile(grey, 90))
+        gray = frame.rgb.mean(axis=-1)[frame.object_id == ID_ROAD]
+        ratios.append(np.percentile(gray, 10) / np.percentile(gray, 90))
     assert ratios[1] < ratios[0]
 
 

@@ -65,10 +65,10 @@ def test_constant_steering_drives_a_circle_of_radius_l_over_tan_delta():
     state = VehicleState(0.0, 0.0, 0.0, delta, 10.0)
     radius = params.wheelbase_m / math.tan(delta)
     # The rear axle turns about (-b, R); the origin, b ahead of it, about the same centre at sqrt(R^2 + b^2).
-    centre = np.array([-params.rear_axle_m, radius])
+    center = np.array([-params.rear_axle_m, radius])
     for _ in range(40):
         state = advance(state, delta, 0.1, params)
-        assert abs(np.hypot(state.x - centre[0], state.y - centre[1]) - math.hypot(radius, params.rear_axle_m)) < 1e-9
+        assert abs(np.hypot(state.x - center[0], state.y - center[1]) - math.hypot(radius, params.rear_axle_m)) < 1e-9
     assert abs(state.yaw - math.atan2(math.sin(40.0 / radius), math.cos(40.0 / radius))) < 1e-9
 
 
@@ -120,7 +120,7 @@ def test_lane_estimate_from_projected_labels_finds_the_true_offset(make_case, of
     assert estimate.width == pytest.approx(case.road.lane_width, abs=0.05)
 
 
-def test_one_boundary_gives_the_centre_half_a_lane_away(make_case):
+def test_one_boundary_gives_the_center_half_a_lane_away(make_case):
     case = make_case()
     scene = compile_scene(case)
     route = Route.of_case(case, scene.network)

@@ -69,7 +69,7 @@ def test_detect_frame_on_a_render(make_case, method: str) -> None:
                                     "run_time_ms"}
 
 
-def test_detections_are_drawn_in_their_own_colour() -> None:
+def test_detections_are_drawn_in_their_own_color() -> None:
     assert DETECTION_COLOR not in LANE_COLORS
     # no ground-truth colour is near magenta (a hue between red and blue with little green)
     assert all(not (r > 200 and b > 200 and g < 100) for r, g, b in LANE_COLORS)
@@ -77,8 +77,8 @@ def test_detections_are_drawn_in_their_own_colour() -> None:
     rows = list(range(30, 90, 10))
     lanes = [[40] * len(rows), [-2] * len(rows)]
     drawn = draw_detections(image, lanes, rows)
-    colours = {tuple(c) for c in drawn.reshape(-1, 3)} - {(0, 0, 0)}
-    assert colours and all(c[1] < 60 and c[0] > 100 and c[2] > 100 for c in colours)  # magenta (antialiased)
+    colors = {tuple(c) for c in drawn.reshape(-1, 3)} - {(0, 0, 0)}
+    assert colors and all(c[1] < 60 and c[0] > 100 and c[2] > 100 for c in colors)  # magenta (antialiased)
     labelled = draw_lanes(drawn, {"lanes": lanes, "h_samples": rows})
     assert tuple(labelled[50, 40]) == LANE_COLORS[0]  # a label's dot sits on top of the band
 

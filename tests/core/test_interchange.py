@@ -53,7 +53,7 @@ def exported() -> dict[str, tuple[Path, ET.Element]]:
 
 
 @pytest.mark.parametrize("path", CLEAN, ids=lambda p: p.stem)
-def test_opendrive_matches_the_case_within_a_centimetre(exported, path):
+def test_opendrive_matches_the_case_within_a_centimeter(exported, path):
     case = load_case(path)
     network = compile_scene(case).network
     _, root = exported[path.stem]

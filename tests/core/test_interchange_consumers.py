@@ -128,8 +128,8 @@ def test_each_connecting_road_is_one_connection_joined_to_its_ends(exports, name
 def test_connecting_road_marks_follow_the_case(exports, name):
     root, _ = exports[name]
     case = load_case(SCENES / name)
-    centre = case.road.markings[case.road.lanes_per_direction]
-    mark_type, color, _ = MARK_TYPES[centre.type]
+    center = case.road.markings[case.road.lanes_per_direction]
+    mark_type, color, _ = MARK_TYPES[center.type]
     for road in _connecting(root):
         mark = road.find("lanes/laneSection/center/lane/roadMark")
         if road.get("id") == str(THROUGH_ROAD_ID):
@@ -138,7 +138,7 @@ def test_connecting_road_marks_follow_the_case(exports, name):
             assert all(m.get("type") == "none" for m in road.findall("lanes/laneSection/*/lane/roadMark"))
 
 
-def test_junction_roads_start_the_turning_radius_from_the_centre(exports):
+def test_junction_roads_start_the_turning_radius_from_the_center(exports):
     name = JUNCTIONS[0]
     root, _ = exports[name]
     case = load_case(SCENES / name)

@@ -203,7 +203,7 @@ def _paint_score(rgb: np.ndarray) -> np.ndarray:
     return np.maximum(rgb.mean(axis=-1), 0.5 * (rgb[..., 0] + rgb[..., 1]) - rgb[..., 2] + 60.0)
 
 
-def _stripe_centre(score_row: np.ndarray, column: int, reach: int) -> float | None:
+def _stripe_center(score_row: np.ndarray, column: int, reach: int) -> float | None:
     """Centre (column coordinate) of the paint run within 2 px of ``column``, or None if no paint is there.
 
     Paint must beat the road surface ``reach`` px to either side (the darker side, each the median of 5 px there, so
@@ -248,12 +248,12 @@ def _paint_errors(case, frame_index, size=(640, 360)):
             if k.fx * marking.width / depth < 2.0 or (marking.type.endswith("dashed") and not in_dash):
                 continue
             reach = int(np.ceil(k.fx * (marking.width / 2 + 0.25) / depth)) + 2
-            centres = []
+            centers = []
             for t_road in {label.boundary.t_road + offset, label.boundary.t_road - offset}:
                 uv, _ = camera.project(line.to_world(s_road, t_road))
-                centres.append(_stripe_centre(score[rows[j]], int(round(uv[0] - 0.5)), reach))
-            assert None not in centres, f"no paint at row {rows[j]} near x={label.x_image[j]:.1f} ({marking.type})"
-            errors.append(abs(np.mean(centres) - (label.x_image[j] - 0.5)))
+                centers.append(_stripe_center(score[rows[j]], int(round(uv[0] - 0.5)), reach))
+            assert None not in centers, f"no paint at row {rows[j]} near x={label.x_image[j]:.1f} ({marking.type})"
+            errors.append(abs(np.mean(centers) - (label.x_image[j] - 0.5)))
     return np.array(errors)
 
 

@@ -30,7 +30,7 @@ def _one_pred(lane: list[float]) -> LaneRecord:
 GT = record([line(200, -0.8), line(500, -0.1), line(800, 0.1), line(1100, 0.8)])
 
 
-def test_the_ego_pair_is_nearest_the_centre_on_each_side():
+def test_the_ego_pair_is_nearest_the_center_on_each_side():
     assert ego_lanes(GT, 1280) == {"left": 1, "right": 2}
     shuffled = record([line(800, 0.3), line(1100, 0.8), line(600, -0.1), line(200, -0.8)])
     assert ego_lanes(shuffled, 1280) == {"left": 2, "right": 0}

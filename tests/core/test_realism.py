@@ -28,9 +28,9 @@ from lanevil_core.report.realism import verdict
 HEIGHT, WIDTH = 720, 1280  # the analysis size, so no resize blurs the synthetic properties
 
 
-def grey_rgb(grey: np.ndarray) -> np.ndarray:
+def gray_rgb(gray: np.ndarray) -> np.ndarray:
     """(H, W) grey -> (H, W, 3) uint8 RGB."""
-    return np.repeat(np.clip(np.round(grey), 0, 255).astype(np.uint8)[..., None], 3, axis=2)
+    return np.repeat(np.clip(np.round(gray), 0, 255).astype(np.uint8)[..., None], 3, axis=2)
 
 
 def power_law_image(seed: int, exponent: float = 2.0) -> np.ndarray:
@@ -48,7 +48,7 @@ def checkerboard(square: int = 16) -> np.ndarray:
     return ((np.indices((HEIGHT, WIDTH)) // square).sum(axis=0) % 2 * 255).astype(np.uint8)
 
 
-def test_flat_grey_has_no_saturation_edges_contrast_or_noise():
+def test_flat_gray_has_no_saturation_edges_contrast_or_noise():
     stats = frame_statistics(np.full((HEIGHT, WIDTH, 3), 128, np.uint8))
     assert stats.saturation == 0.0 and stats.edge_density == 0.0
     assert stats.contrast == pytest.approx(0.0, abs=1e-12) and stats.noise == 0.0 and stats.sharpness == 0.0
@@ -56,7 +56,7 @@ def test_flat_grey_has_no_saturation_edges_contrast_or_noise():
 
 
 @pytest.mark.parametrize("channel", [0, 1, 2])
-def test_a_pure_colour_is_fully_saturated(channel):
+def test_a_pure_color_is_fully_saturated(channel):
     rgb = np.zeros((HEIGHT, WIDTH, 3), np.uint8)
     rgb[..., channel] = 200
     assert frame_statistics(rgb).saturation == 255.0
@@ -65,14 +65,14 @@ def test_a_pure_colour_is_fully_saturated(channel):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_noise_estimate_of_gaussian_noise_on_a_flat_image(seed):
     noisy = 128 + np.random.default_rng(seed).normal(0.0, 5.0, (HEIGHT, WIDTH))
-    assert noise_sigma(grey_rgb(noisy)[..., 0]) == pytest.approx(5.0, rel=0.15)
+    assert noise_sigma(gray_rgb(noisy)[..., 0]) == pytest.approx(5.0, rel=0.15)
 
 
 def test_noise_estimate_ignores_smooth_shading_and_edges():
     ramp = np.linspace(40, 220, WIDTH)[None, :].repeat(HEIGHT, axis=0)
     ramp[:, WIDTH // 2:] -= 30  # one hard vertical edge
     noisy = ramp + np.random.default_rng(2).normal(0.0, 5.0, (HEIGHT, WIDTH))
-    assert noise_sigma(grey_rgb(noisy)[..., 0]) == pytest.approx(5.0, rel=0.15)
+    assert noise_sigma(gray_rgb(noisy)[..., 0]) == pytest.approx(5.0, rel=0.15)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -81,7 +81,7 @@ def test_spectrum_slope_of_1_over_f_squared_noise_is_minus_2(seed):
 
 
 def test_spectrum_slope_of_white_noise_is_flat():
-    white = grey_rgb(128 + np.random.default_rng(3).normal(0.0, 20.0, (HEIGHT, WIDTH)))[..., 0]
+    white = gray_rgb(128 + np.random.default_rng(3).normal(0.0, 20.0, (HEIGHT, WIDTH)))[..., 0]
     assert spectrum_slope(white) == pytest.approx(0.0, abs=0.3)
 
 
@@ -101,17 +101,17 @@ def test_analysis_size_keeps_the_aspect():
 
 
 def test_clipped_share_counts_both_ends():
-    grey = np.full((HEIGHT, WIDTH), 128.0)
-    grey[:180] = 255
-    grey[180:270] = 0
-    assert frame_statistics(grey_rgb(grey)).clipped == pytest.approx(0.375)
+    gray = np.full((HEIGHT, WIDTH), 128.0)
+    gray[:180] = 255
+    gray[180:270] = 0
+    assert frame_statistics(gray_rgb(gray)).clipped == pytest.approx(0.375)
 
 
 def _write_frames(folder: Path, level: float, sigma: float, count: int, suffix: str = ".png") -> None:
     rng = np.random.default_rng(int(level))
     for index in range(count):
         (folder / f"sub{index % 2}").mkdir(parents=True, exist_ok=True)
-        rgb = grey_rgb(level + rng.normal(0.0, sigma, (HEIGHT // 4, WIDTH // 4)))
+        rgb = gray_rgb(level + rng.normal(0.0, sigma, (HEIGHT // 4, WIDTH // 4)))
         cv2.imwrite(str(folder / f"sub{index % 2}" / f"{index:03d}{suffix}"), rgb)
 
 

@@ -64,7 +64,7 @@ def test_lane_band_effect_rises_with_the_level_on_every_original(illusion_type, 
 
 @pytest.mark.parametrize(("illusion_type", "index"), SAMPLE, ids=[f"{n}-{i}" for n, i in SAMPLE])
 def test_level5_is_in_view_over_the_drive(illusion_type, index):
-    """The full test split scores every frame of a case: crowds, cracks and tyre marks run on along the drive
+    """The full test split scores every frame of a case: crowds, cracks and tire marks run on along the drive
     instead of being passed in its first seconds (experiments/in_view.py measures every original)."""
     case = with_illusion(original_case(illusion_type, index), {"type": illusion_type, "severity": 5})
     assert shown_share(case) >= SHOWN_SHARE_MIN, original_id(illusion_type, index)

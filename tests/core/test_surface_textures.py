@@ -25,10 +25,10 @@ def generate(name: str, seed: int = 7, **kw) -> tex.Texture:
     if name == "worn_paint":
         return tex.worn_paint(rng(seed), SHAPE, TEXEL, **{"t_local": (4.5,), "wear": 0.5,
                                                             "asphalt_rgb": (0.055, 0.055, 0.058), **kw})
-    return tex.skid_marks(rng(seed), SHAPE, TEXEL, **{"straight": 1, "swerve": 1, "yaw": 1, **kw})
+    return tex.tire_marks(rng(seed), SHAPE, TEXEL, **{"straight": 1, "swerve": 1, "yaw": 1, **kw})
 
 
-GENERATORS = (*tex.CRACK_KINDS, "patches", "skid_marks", "ghost_lines", "worn_paint")
+GENERATORS = (*tex.CRACK_KINDS, "patches", "tire_marks", "ghost_lines", "worn_paint")
 
 
 @pytest.mark.parametrize("name", GENERATORS)
@@ -108,8 +108,8 @@ def test_parallel_strip_runs_along_its_line() -> None:
     assert alpha[:, ~band].max() == 0.0
 
 
-def test_skid_marks_are_track_pairs_that_fade_at_their_ends() -> None:
-    rgba, _ = tex.skid_marks(rng(), SHAPE, TEXEL, straight=1, center_t=(4.5,), length_m=(12.0, 12.0),
+def test_tire_marks_are_track_pairs_that_fade_at_their_ends() -> None:
+    rgba, _ = tex.tire_marks(rng(), SHAPE, TEXEL, straight=1, center_t=(4.5,), length_m=(12.0, 12.0),
                              darkness=0.8, gauge_m=(1.6, 1.6))
     alpha = rgba[..., 3]
     cols = (np.arange(SHAPE[1]) + 0.5) * TEXEL
@@ -121,14 +121,14 @@ def test_skid_marks_are_track_pairs_that_fade_at_their_ends() -> None:
     marked = np.flatnonzero(along > 0)
     first, last = marked[0], marked[-1]
     assert np.isclose((last - first) * TEXEL, 12.0, atol=0.5)
-    assert along[first + 2] < 0.3 * along[(first + last) // 2]  # rubber builds up after the tyre locks
+    assert along[first + 2] < 0.3 * along[(first + last) // 2]  # rubber builds up after the tire locks
     # Antialiased edges: partial coverage beside the full track.
     edge = (alpha > 0.02) & (alpha < 0.6 * along.max())
     assert edge.any()
 
 
-def test_skid_count_and_darkness_raise_coverage() -> None:
-    values = [tex.skid_marks(rng(), SHAPE, TEXEL, straight=n, swerve=n, darkness=d)[0][..., 3].mean()
+def test_tire_mark_count_and_darkness_raise_coverage() -> None:
+    values = [tex.tire_marks(rng(), SHAPE, TEXEL, straight=n, swerve=n, darkness=d)[0][..., 3].mean()
               for n, d in ((1, 0.4), (2, 0.6), (3, 0.8))]
     assert values[0] < values[1] < values[2]
 
@@ -186,13 +186,13 @@ def test_failed_joint_is_a_band_of_alligator_cracking_along_its_line() -> None:
     assert 0.05 < alpha[:, band].mean() < 0.4  # a network of cells, not a solid strip
 
 
-def test_skid_marks_start_where_asked_even_before_the_texture() -> None:
-    alpha = tex.skid_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
+def test_tire_marks_start_where_asked_even_before_the_texture() -> None:
+    alpha = tex.tire_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
                            length_m=(8.0, 10.0), darkness=0.9, start_m=(-4.0, -2.0))[0][..., 3]
     along = alpha.max(axis=1)
     assert along[: int(1.0 / TEXEL)].max() > 0.5  # already dark where the texture begins
     assert along[int(8.5 / TEXEL):].max() == 0.0  # and over before 8 m past its start
-    spread = tex.skid_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
+    spread = tex.tire_marks(rng(), SHAPE, TEXEL, straight=3, swerve=2, center_t=(3.0, 4.5, 6.0),
                             length_m=(8.0, 10.0), darkness=0.9)[0][..., 3]
     assert spread.max(axis=1)[int(8.5 / TEXEL):].max() > 0.5  # without a range they spread over the texture
 

@@ -59,7 +59,7 @@ def test_paint_mask_covers_the_painted_lines_and_little_else():
     assert not paint_mask([], SIZE).any()
 
 
-def test_recolouring_changes_the_road_and_keeps_the_paint_brighter_than_its_road():
+def test_recoloring_changes_the_road_and_keeps_the_paint_brighter_than_its_road():
     image, keep, _ = _scene()
     painted = (image[..., 0] > 200) & keep
     painted[: int(SIZE[1] * 0.6)] = False
@@ -148,7 +148,7 @@ def test_mirror_agreement_keeps_lanes_read_alike_and_drops_the_rest():
     assert len(kept) == 1 and kept[0] is left
 
 
-def test_adabn_re_estimates_the_normalisation_statistics_only():
+def test_adabn_re_estimates_the_normalization_statistics_only():
     model = build_model(ModelSpec(family="seg", width=0.125, input_size=(128, 72)))
     statistics = ("running", "num_batches")
     weights_before = {k: v.clone() for k, v in model.state_dict().items() if not any(s in k for s in statistics)}

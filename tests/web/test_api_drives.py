@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from app.api.drives import DriveJob
+from app.api.routes.drives import DriveJob
 
 CASE_ID = "clean-01_bend_suburban"
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from app.api.illusions import IllusionRegistry
 from app.api.json_body import MAX_DEPTH, line_column
+from app.api.routes.illusions import IllusionRegistry
 
 ADMIN = {"Authorization": "Bearer test-admin"}
 JSON = {"content-type": "application/json"}

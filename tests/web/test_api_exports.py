@@ -10,7 +10,7 @@ import zipfile
 import pytest
 from PIL import Image
 
-import app.api.exports as exports
+import app.api.routes.exports as exports
 from lanevil_core.case import Case
 
 SHADOW_ID = "fence_shadow-00_uphill_rural_noon-03_level3"

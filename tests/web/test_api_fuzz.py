@@ -33,8 +33,8 @@ from schemathesis.core.failures import FailureGroup
 from schemathesis.core.result import Ok
 from schemathesis.generation import GenerationMode
 
-import app.api.exports as exports
-import app.api.labels as labels
+import app.api.routes.exports as exports
+import app.api.routes.labels as labels
 from app.main import create_app
 from app.settings import Settings
 from app.state import AppState

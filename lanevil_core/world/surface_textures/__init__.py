@@ -1,4 +1,4 @@
-"""Procedural road-surface textures in road coordinates: cracks, repair patches and sealant, tyre marks.
+"""Procedural road-surface textures in road coordinates: cracks, repair patches and sealant, tire marks.
 
 A texture's rows run along the road (s) and its columns across it (t); texels are ``texel`` metres square and
 texel (i, j) has its centre at ``s_local = (i + 0.5) * texel``, ``t_local = (j + 0.5) * texel`` from the texture's
@@ -34,7 +34,7 @@ from ._canvas import (
 )
 from .cracks import CrackLayers, crack_layers, crack_mix, crack_network
 from .repairs import PatchKind, ghost_lines, patches
-from .skid_marks import SkidKind, skid_marks
+from .tire_marks import TireMarkKind, tire_marks
 from .wear import worn_paint
 
 __all__ = [
@@ -54,14 +54,14 @@ __all__ = [
     "RUBBER_RGB",
     "SEALANT_BRIGHT_RGB",
     "SEALANT_DARK_RGB",
-    "SkidKind",
     "Texture",
+    "TireMarkKind",
     "composite",
     "crack_layers",
     "crack_mix",
     "crack_network",
     "ghost_lines",
     "patches",
-    "skid_marks",
+    "tire_marks",
     "worn_paint",
 ]

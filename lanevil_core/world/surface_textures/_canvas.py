@@ -17,14 +17,14 @@ CRACK_KINDS: tuple[CrackKind, ...] = ("transverse", "longitudinal", "alligator")
 
 Texture = tuple[Float32Array, Float32Array | None]
 
-# Linear albedos (fresh asphalt 0.02-0.03, worn asphalt 0.05-0.08, tyre rubber 0.012-0.02).
+# Linear albedos (fresh asphalt 0.02-0.03, worn asphalt 0.05-0.08, tire rubber 0.012-0.02).
 CRACK_RGB = (0.010, 0.010, 0.011)
 CRACK_HALO_RGB = (0.024, 0.024, 0.025)
 FRESH_ASPHALT_RGB = (0.025, 0.025, 0.027)
 SEALANT_DARK_RGB = (0.012, 0.012, 0.013)
 SEALANT_BRIGHT_RGB = (0.30, 0.30, 0.29)  # weathered or sun-glossy crack filler, reads like faded paint
 GROUND_OFF_RGB = (0.26, 0.26, 0.25)  # a marking ground off the asphalt: scoured stone and paint residue
-RUBBER_RGB = (0.015, 0.015, 0.016)  # tyre rubber laid on the asphalt
+RUBBER_RGB = (0.015, 0.015, 0.016)  # tire rubber laid on the asphalt
 
 HALO_OPACITY = 0.4  # the crushed, stained rim either side of a crack, relative to its core
 HALO_SCALE = 5.0  # halo radius in crack half widths

@@ -21,9 +21,9 @@ from lanevil_core.detect.registry import ready_detector
 from lanevil_core.detect.split import METHODS
 from lanevil_core.metrics.formats import LaneFileError
 
-from .deps import FramePath, RecordDep, StateDep
-from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiError, ApiRoute, ErrorBody
-from .params import ScrubQueryDep, check_frame, detector_enum, image_size
+from ..deps import FramePath, RecordDep, StateDep
+from ..errors import ERROR_RESPONSES, RENDER_BUSY, ApiError, ApiRoute, ErrorBody
+from ..params import ScrubQueryDep, check_frame, detector_enum, image_size
 
 router = APIRouter(tags=["detectors"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 

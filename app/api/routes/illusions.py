@@ -12,7 +12,7 @@ from lanevil_core.case import case_schema
 from lanevil_core.illusions import CATEGORIES, REGISTRY
 from lanevil_core.illusions.info import illusion_info
 
-from .errors import ApiRoute
+from ..errors import ApiRoute
 
 router = APIRouter(tags=["illusions"], route_class=ApiRoute)
 

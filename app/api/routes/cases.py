@@ -24,12 +24,12 @@ from lanevil_core.illusions import CATEGORIES, REGISTRY, MeshFileError
 from lanevil_core.library.benchmark_layout import MIXED_CATEGORY
 from lanevil_core.pipeline.compile import check_mesh_files
 
-from ..state import AppState
-from ..store import CaseRecord, InvalidId, VersionConflict, check_id
-from .case_bodies import PATCH_BODY, CaseBody, PatchBody, ReplaceBody
-from .deps import CaseIdPath, RecordDep, StateDep
-from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
-from .params import VERSION_PATTERN, etag_matches, parse_version
+from ...state import AppState
+from ...store import CaseRecord, InvalidId, VersionConflict, check_id
+from ..case_bodies import PATCH_BODY, CaseBody, PatchBody, ReplaceBody
+from ..deps import CaseIdPath, RecordDep, StateDep
+from ..errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody, first_error
+from ..params import VERSION_PATTERN, etag_matches, parse_version
 
 router = APIRouter(prefix="/cases", tags=["cases"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 

@@ -12,21 +12,17 @@ import secrets
 import sqlite3
 from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import FileResponse, JSONResponse, Response
 from pydantic import ValidationError
 from starlette.datastructures import UploadFile
 
-from ..api.deps import StateDep
-from ..api.errors import ApiError, ApiRoute, ErrorBody, first_error
-from ..api.forms import read_form
-from ..api.json_body import BodyError, check_json_type, is_json_type, parse_json
-from ..state import AppState
-from .auth import AdminDep
-from .bodies import (
+from ...state import AppState
+from ...study.auth import AdminDep
+from ...study.bodies import (
     Completed,
     OpenStudy,
     ParticipantPlan,
@@ -36,11 +32,12 @@ from .bodies import (
     StudyResults,
     StudyRow,
 )
-from .create import SpecError, create_study, items_folder
-from .db import connect, db_path
-from .images import CheckedUpload, UploadError, check_upload
-from .order import participant_order
-from .records import (
+from ...study.create import SpecError, create_study, items_folder
+from ...study.db import connect, db_path
+from ...study.deps import DbDep
+from ...study.images import CheckedUpload, UploadError, check_upload
+from ...study.order import participant_order
+from ...study.records import (
     NotFound,
     Study,
     add_participant,
@@ -56,9 +53,13 @@ from .records import (
     study_participants,
     study_ratings,
 )
-from .spec import ConsentIn, RatingIn, StudySpec
-from .stats import exclusions, summarize
-from .tables import raw_ratings_csv, summary_csv
+from ...study.spec import ConsentIn, RatingIn, StudySpec
+from ...study.stats import exclusions, summarize
+from ...study.tables import raw_ratings_csv, summary_csv
+from ..deps import StateDep
+from ..errors import ApiError, ApiRoute, ErrorBody, first_error
+from ..forms import read_form
+from ..json_body import BodyError, check_json_type, is_json_type, parse_json
 
 MAX_UPLOAD_FILES = 1000
 FORM_TYPES = ("multipart/form-data", "application/x-www-form-urlencoded")
@@ -74,7 +75,7 @@ ORGANISER: dict[int | str, dict[str, Any]] = {
 }
 NO_STUDY: dict[int | str, dict[str, Any]] = {404: _error("no such study (or participant, or item): `field` says which")}
 NOT_READY: dict[int | str, dict[str, Any]] = {409: _error("the study is not ready yet (still rendering, or failed)")}
-router = APIRouter(prefix="/api/study", tags=["study"], route_class=ApiRoute,
+router = APIRouter(prefix="/study", tags=["study"], route_class=ApiRoute,
                    responses={422: _error("invalid input; `field` names it")})
 
 # ``POST /studies`` reads its body itself (a multipart form or JSON), so its request body is described here.
@@ -97,18 +98,6 @@ CREATE_BODY: dict[str, Any] = {"requestBody": {"required": True, "content": {
         "encoding": {"spec": {"contentType": "application/json"}, "files": {"contentType": "image/png, image/jpeg"}}},
     "application/json": {"schema": {"$ref": "#/components/schemas/StudySpec"}, "example": SPEC_EXAMPLE},
 }}}
-
-
-def get_db(state: StateDep) -> Iterator[sqlite3.Connection]:
-    """One SQLite connection for the request, closed after the response."""
-    connection = connect(db_path(state.settings.data_dir))
-    try:
-        yield connection
-    finally:
-        connection.close()
-
-
-DbDep = Annotated[sqlite3.Connection, Depends(get_db)]
 
 
 def http_error(status: int, field: str, message: str) -> ApiError:

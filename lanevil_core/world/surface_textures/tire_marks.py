@@ -1,4 +1,4 @@
-"""Tyre marks: pairs of dark rubber tracks along straight, swerving and yawing paths."""
+"""Tire marks: pairs of dark rubber tracks along straight, swerving and yawing paths."""
 
 from __future__ import annotations
 
@@ -21,10 +21,10 @@ from ._canvas import (
     _walk,
 )
 
-SkidKind = Literal["straight", "swerve", "yaw"]
+TireMarkKind = Literal["straight", "swerve", "yaw"]
 
 
-def _skid_centerline(rng: np.random.Generator, kind: SkidKind, size_m: tuple[float, float], center_t: float,
+def _mark_center_line(rng: np.random.Generator, kind: TireMarkKind, size_m: tuple[float, float], center_t: float,
                      swerve_m: float, length_m: tuple[float, float], spot: float,
                      start_m: tuple[float, float] | None = None) -> tuple[FloatArray, FloatArray]:
     """(n, 2) (s, t) centre path of a vehicle's skid and (n,) its heading, sampled every 0.1 m. The path starts
@@ -49,11 +49,11 @@ def _skid_centerline(rng: np.random.Generator, kind: SkidKind, size_m: tuple[flo
     return _walk(start, theta, step), theta
 
 
-def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, straight: int = 1,
+def tire_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *, straight: int = 1,
                swerve: int = 0, yaw: int = 0, center_t: Sequence[float] = (), swerve_m: float = 3.5,
                length_m: tuple[float, float] = (15.0, 35.0), darkness: float = 0.7, track_width_m: float = 0.2,
                gauge_m: tuple[float, float] = (1.5, 1.8), start_m: tuple[float, float] | None = None) -> Texture:
-    """Pairs of dark rubber tyre tracks along smooth curves, fading in and out at their ends.
+    """Pairs of dark rubber tire tracks along smooth curves, fading in and out at their ends.
 
     Args:
         shape: (h, w) texels, rows along s; texel: texel size (m).
@@ -66,7 +66,7 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
         swerve_m: lateral sweep of a swerve (m).
         length_m: range of mark lengths (m).
         darkness: peak opacity of the rubber in [0, 1].
-        track_width_m: width of one tyre track (m).
+        track_width_m: width of one tire track (m).
         gauge_m: range of track spacing, centre to centre (m).
         start_m: (lo, hi) s (m from the texture's start) over which the marks' starts spread, so the marks of
             one incident bunch together; lo < 0 lets a mark begin before the texture (only the rest is drawn).
@@ -78,7 +78,7 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
     bases = _children(rng)
     size_m = (shape[0] * texel, shape[1] * texel)
     cover = np.zeros(shape, np.float32)
-    kinds: list[tuple[SkidKind, int, int]] = (
+    kinds: list[tuple[TireMarkKind, int, int]] = (
         [("straight", bases[0], k) for k in range(straight)] + [("swerve", bases[1], k) for k in range(swerve)]
         + [("yaw", bases[2], k) for k in range(yaw)]
     )
@@ -88,7 +88,7 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
         sweep = swerve_m if k % 2 == 0 else -swerve_m
         if not 0.5 <= t_c + sweep <= size_m[1] - 0.5:
             sweep = -sweep
-        path, theta = _skid_centerline(child, kind, size_m, t_c, sweep, length_m, _spot(base, k), start_m)
+        path, theta = _mark_center_line(child, kind, size_m, t_c, sweep, length_m, _spot(base, k), start_m)
         _stamp_tracks(child, cover, path, theta, kind, texel, darkness, track_width_m, gauge_m)
     canvas = _Canvas.empty(shape)
     canvas.paint(RUBBER_RGB, cover)
@@ -96,14 +96,14 @@ def skid_marks(rng: np.random.Generator, shape: tuple[int, int], texel: float, *
 
 
 def _stamp_tracks(rng: np.random.Generator, cover: np.ndarray, path: FloatArray, theta: FloatArray,
-                  kind: SkidKind, texel: float, darkness: float, track_width_m: float,
+                  kind: TireMarkKind, texel: float, darkness: float, track_width_m: float,
                   gauge_m: tuple[float, float]) -> None:
-    """Stamp the two tyre tracks either side of a centre path into ``cover`` (h, w)."""
+    """Stamp the two tire tracks either side of a centre path into ``cover`` (h, w)."""
     n = len(path)
     u = np.linspace(0.0, 1.0, n)
     gauge = rng.uniform(*gauge_m) * (1.0 + (0.3 * u if kind == "yaw" else 0.0))
     normal = np.stack([-np.sin(theta), np.cos(theta)], axis=1)
-    # Rubber builds up as the tyre locks and fades where the vehicle stops or regains grip.
+    # Rubber builds up as the tire locks and fades where the vehicle stops or regains grip.
     onset = _smoothstep(u / rng.uniform(0.1, 0.25)) * _smoothstep((1.0 - u) / rng.uniform(0.05, 0.15))
     for side in (-1.0, 1.0):
         patchy = _smooth_random(rng, n, 16, 0.75, 1.0)

@@ -21,15 +21,15 @@ from lanevil_core.drive.loop import DriveSettings
 from lanevil_core.drive.outputs import PATH_PLOT_FILE, SUMMARY_FILE, TRACE_FILE, TRACE_PLOT_FILE
 from lanevil_core.pipeline.compile import check_mesh_files
 
-from ..frames import case_hash
-from ..jobs import Job, drive_job
-from ..settings import Settings
-from ..store import ID_PATTERN
-from .deps import StateDep
+from ...frames import case_hash
+from ...jobs import Job, drive_job
+from ...settings import Settings
+from ...store import ID_PATTERN
+from ..deps import StateDep
+from ..errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
+from ..job_bodies import JobBody
+from ..params import HEIGHT_HELP, WIDTH_HELP, detector_enum, image_size, size_schema
 from .detectors import checked_detector
-from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
-from .exports import JobBody
-from .params import HEIGHT_HELP, WIDTH_HELP, detector_enum, image_size, size_schema
 
 router = APIRouter(tags=["drives"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 

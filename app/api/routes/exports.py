@@ -17,45 +17,24 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import FileResponse, JSONResponse
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from lanevil_core.library.benchmark_layout import case_folder
 from lanevil_core.pipeline.compile import check_mesh_files
 
-from ..frames import case_hash
-from ..jobs import Job, JobStatus, export_zip
-from ..state import AppState
-from ..store import ID_PATTERN, CaseRecord
-from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
-from .params import FRAMES_PATTERN, frame_range
+from ...frames import case_hash
+from ...jobs import Job, export_zip
+from ...state import AppState
+from ...store import ID_PATTERN, CaseRecord
+from ..deps import RecordDep, StateDep
+from ..errors import ERROR_RESPONSES, TOO_MANY, ApiError, ApiRoute, ErrorBody
+from ..job_bodies import JobBody
+from ..params import FRAMES_PATTERN, frame_range
 
 router = APIRouter(tags=["exports"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 
 SYNC_EXPORT_FRAMES = 10  # more frames than this (~0.2 s each at 1280x720) go to a background job
 ZIP = "application/zip"
-
-
-class JobState(BaseModel):
-    """A background job's state (``Job.to_dict``); the job's inputs (``case_id`` …) come with it."""
-
-    model_config = ConfigDict(extra="allow")
-
-    id: str
-    kind: str
-    status: JobStatus
-    done: int = Field(description="steps done (frames of an export, steps of a drive)")
-    total: int
-    progress: float = Field(description="done / total, 0..1")
-    error: str | None = Field(description="why the job failed, or null")
-    created_at: float = Field(description="seconds since the epoch")
-    finished_at: float | None = Field(description="seconds since the epoch, or null while it runs")
-
-
-class JobBody(JobState):
-    """A job's state and its URLs."""
-
-    links: dict[str, str] = Field(description="self: the job's URL (and download: its zip, for an export)")
 
 
 class ExportJob(JobBody):

@@ -13,13 +13,13 @@ from fastapi import APIRouter, Header, Query, Response
 
 from lanevil_core.case import Case, Ego
 
-from ..state import AppState
-from .case_bodies import CaseBody
+from ...state import AppState
+from ..case_bodies import CaseBody
+from ..deps import FramePath, RecordDep, StateDep
+from ..errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
+from ..params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
 from .cases import split_body, validate_case
-from .deps import FramePath, RecordDep, StateDep
 from .detectors import checked_detector, detector_errors
-from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
-from .params import ImageFormat, RenderQuery, RenderQueryDep, check_frame, etag_matches, image_size
 
 router = APIRouter(tags=["frames"], route_class=ApiRoute, responses=ERROR_RESPONSES)
 

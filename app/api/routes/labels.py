@@ -15,9 +15,9 @@ from fastapi import APIRouter, Query, Response
 
 from lanevil_core.labels.lanes import CULANE_SIZE, TUSIMPLE_SIZE
 
-from .deps import RecordDep, StateDep
-from .errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
-from .params import FRAMES_PATTERN, frame_range
+from ..deps import RecordDep, StateDep
+from ..errors import ERROR_RESPONSES, RENDER_BUSY, ApiRoute, ErrorBody
+from ..params import FRAMES_PATTERN, frame_range
 
 router = APIRouter(tags=["labels"], route_class=ApiRoute, responses={**ERROR_RESPONSES, **RENDER_BUSY})
 

@@ -11,10 +11,10 @@ from starlette.datastructures import UploadFile
 
 from lanevil_core.illusions.traffic import MAX_OBSTACLE_FACES
 
-from ..meshes import MAX_GLTF_DEPTH, MeshUploadError, list_meshes, store_mesh
-from .deps import StateDep
-from .errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
-from .forms import read_form
+from ...meshes import MAX_GLTF_DEPTH, MeshUploadError, list_meshes, store_mesh
+from ..deps import StateDep
+from ..errors import ERROR_RESPONSES, ApiError, ApiRoute, ErrorBody
+from ..forms import read_form
 
 
 class MeshList(BaseModel):
