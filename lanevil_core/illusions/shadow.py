@@ -2,7 +2,8 @@
 
 Each illusion builds real meshes (``structures``) and sets the sun; the shadows themselves come only from the
 renderer's sun shadow map. Severity lowers the sun (longer shadows), raises its intensity and narrows the
-penumbra (harder, darker edges) and makes the structure denser or bigger.
+penumbra (harder, darker edges) and makes the structure denser or bigger; the fence keeps one sun at every level
+and grows the fence only.
 
 The sun's default azimuth is chosen from the road heading at the illusion: the sun stands on the structure's side,
 ``sun_ahead`` degrees from square-on towards the ego's direction of travel, so shadows reach across the lanes and
