@@ -42,9 +42,9 @@ class EgoDrive:
 
 @dataclass
 class CompileContext:
-    """What an illusion may read (the case's seed, the ego's drive, the road) and add to (meshes, layers, lights,
-    environment); the shadow of a low sun may also leave out roadside buildings that would swallow it. Built by
-    ``compile_scene`` from the case, so the illusions need not know the case model."""
+    """What an illusion may read (the case's seed and sun, the ego's drive, the road) and add to (meshes, layers,
+    lights, environment); the shadow of a low sun may also leave out roadside buildings that would swallow it. Built
+    by ``compile_scene`` from the case, so the illusions need not know the case model."""
 
     seed: int  # the case's seed
     drive: EgoDrive
@@ -55,6 +55,7 @@ class CompileContext:
     lights: list[PointLight] = field(default_factory=list)
     source: int = -1  # index of the illusion being compiled
     user_meshes: dict[int, Mesh] = field(default_factory=dict)  # illusion index -> its ``mesh_file``, as read
+    case_sun_altitude: float = 90.0  # the case's own sun (degrees), whatever illusions before this one set
 
     def rng(self, seed: int) -> np.random.Generator:
         """The one source of randomness for an illusion: case seed, illusion index and illusion seed."""

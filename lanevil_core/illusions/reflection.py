@@ -12,7 +12,14 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt
 
-from ..world.environment import HEADLIGHT_INTENSITY, NIGHT_EXPOSURE, NIGHT_HORIZON, NIGHT_ZENITH, sun_direction
+from ..world.environment import (
+    HEADLIGHT_INTENSITY,
+    NIGHT_EXPOSURE,
+    NIGHT_HORIZON,
+    NIGHT_ZENITH,
+    is_night,
+    sun_direction,
+)
 from ..world.primitives import pose_on_road, transformed
 from ..world.props import car, van
 from ..world.scene import PointLight, SurfaceLayer
@@ -94,6 +101,9 @@ class SunlightReflection(Illusion):
 
     CATEGORY: ClassVar[Category] = "reflection"
     SETS_SUN: ClassVar[bool] = True
+    # The sun stands ahead and sinks with the level while the road grows wetter, the puddles wider and the sun
+    # harder. It never stands higher than the case's own day sun (``glare_altitude``): on a sunset a level-1 sun of
+    # 24 deg lifted the road out of the buildings' shade, a change that outweighed the level-2 glare.
     SEVERITY: ClassVar[tuple[SunlightReflectionLevel, ...]] = (
         SunlightReflectionLevel(sun_altitude=24.0, sun_intensity=1.0, wetness=0.35, puddles=0.08),
         SunlightReflectionLevel(sun_altitude=17.0, sun_intensity=1.15, wetness=0.5, puddles=0.16),
@@ -113,11 +123,19 @@ class SunlightReflection(Illusion):
         """This illusion's row of ``SEVERITY``."""
         return self.SEVERITY[self.severity - 1]
 
+    def glare_altitude(self, case_sun_altitude: float) -> float:
+        """The sun's altitude (degrees): the level's, but no higher than a day case's own sun and no lower than the
+        level-5 sun for it (a sunset case's levels 1 and 2 share its sun); a night case takes the table's."""
+        table = self.level().sun_altitude
+        if is_night(case_sun_altitude):
+            return table
+        return min(table, max(case_sun_altitude, self.SEVERITY[-1].sun_altitude))
+
     def compile(self, ctx: CompileContext) -> None:
         level = self.level()
         s0 = self.start_s(ctx.drive) - 20.0
         heading = _road_heading_deg(ctx, s0 + 40.0)
-        _set_sun(ctx, heading + self.sun_offset, level.sun_altitude, level.sun_intensity)
+        _set_sun(ctx, heading + self.sun_offset, self.glare_altitude(ctx.case_sun_altitude), level.sun_intensity)
         ctx.env.penumbra = min(ctx.env.penumbra, 0.01)
         _wet_road(ctx, ctx.rng(self.seed), max(s0, 0.0), self.length, level.wetness, level.puddles,
                   self.puddle_size, "sun-glare puddles")

@@ -485,11 +485,11 @@ class GuardRail(Illusion):
         shadow_m = _setting(self, "shadow_m")
         if shadow_m > 0:
             # The sun stands on the side of the main rail and throws its shadow over the lanes beside it; the same
-            # sun at every level, whatever other rails the level adds.
-            nearest = rails_t[0]
-            ground = ground_height(main, nearest) if abs(nearest) > main.half_width else 0.0
+            # sun at every level, whatever rails the level adds and wherever it sets them: it is solved for a rail
+            # top over the carriageway's surface, not over the verge at this level's offset (a verge a few cm
+            # lower tilted the sun between levels, and the change of the roadside's shadows drowned a level's step).
             ctx.env.sun_dir_world = _shadow_sun(float(main.line.heading_at(0.5 * (s0 + s1))),
-                                                1.0 if nearest >= 0 else -1.0, RAIL_TOP_M + ground, shadow_m)
+                                                1.0 if rails_t[0] >= 0 else -1.0, RAIL_TOP_M, shadow_m)
 
     def _rails_t(self, ctx: CompileContext) -> list[float]:
         """Lateral positions of the rails: main side first, then the far side and the median if asked for."""

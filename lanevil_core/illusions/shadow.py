@@ -2,7 +2,8 @@
 
 Each illusion builds real meshes (``structures``) and sets the sun; the shadows themselves come only from the
 renderer's sun shadow map. Severity lowers the sun (longer shadows), raises its intensity and narrows the
-penumbra (harder, darker edges) and makes the structure denser or bigger.
+penumbra (harder, darker edges) and makes the structure denser or bigger; the fence keeps one sun at every level
+and grows the fence only.
 
 The sun's default azimuth is chosen from the road heading at the illusion: the sun stands on the structure's side,
 ``sun_ahead`` degrees from square-on towards the ego's direction of travel, so shadows reach across the lanes and
@@ -256,19 +257,23 @@ class FenceShadow(SunShadowIllusion):
     # A board fence (horizontal boards with narrow gaps between them) under a low sun nearly square-on from its
     # side: the fence's shadow lies across the lanes and each gap lets through a line of light parallel to them, a
     # bright lane-like line in the shade where the real paint falls dark (a camera exposed for the sunlit road).
-    # One sun at every level, its altitude solved from the road so that the shadow of the level-5 fence ends in
-    # the middle of the ego lane (``FENCE_EDGE_LANES``; the table's altitude is the highest it may stand,
-    # ``MIN_FENCE_SUN_DEG`` the lowest); the fence grows taller and the sun harder with the level, so the shade
-    # reaches from beside the ego lane (level 1) into it, with more lines of light. A shadow edge in the lane, with
-    # lines of light in the shade, fools the detectors more than a shade over the whole lane.
+    # One sun at every level (bearing, hardness, and altitude solved from the road so that the shadow of the
+    # level-5 fence ends in the middle of the ego lane: ``FENCE_EDGE_LANES``; the table's altitude is the highest
+    # it may stand, ``MIN_FENCE_SUN_DEG`` the lowest); only the fence grows with the level, its boards laid from the
+    # bottom, so each level's fence is the one before with more board on top and its shade holds the one before:
+    # from beside the ego lane (level 1) into it, with more lines of light. (A sun hardening with the level
+    # brightened the sunlit road back towards the original's and moved the roadside's shadows, and boards hung
+    # from the top moved the lines of light on and off the edge line from level to level: the lane band's change
+    # then fell at two steps on four originals.) A shadow edge in the lane, with lines of light in the shade, fools
+    # the detectors more than a shade over the whole lane.
     SEVERITY: ClassVar[tuple[FenceShadowLevel, ...]] = (
-        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.05, penumbra=0.008, height=1.2,
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=1.2,
                          board=0.95, gap=0.16),  # a low fence: its shadow beside the ego lane
-        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.15, penumbra=0.008, height=1.7,
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=1.7,
                          board=0.95, gap=0.16),
-        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.25, penumbra=0.008, height=2.2,
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=2.2,
                          board=0.95, gap=0.16),
-        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.4, penumbra=0.008, height=2.65,
+        FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=2.65,
                          board=0.95, gap=0.16),
         FenceShadowLevel(sun_altitude=50.0, sun_ahead=5.0, sun_intensity=1.5, penumbra=0.008, height=3.1,
                          board=0.95, gap=0.16),  # tall: shade to the ego lane's middle, lines of light in it

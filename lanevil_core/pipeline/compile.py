@@ -90,7 +90,7 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     """
     network, roadside = _roadside(case, reuse)
     ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
-                         user_meshes=load_user_meshes(case, meshes_dir))
+                         user_meshes=load_user_meshes(case, meshes_dir), case_sun_altitude=case.sun.altitude)
     ctx.meshes.extend(roadside)
     ctx.lights.extend(street_lamps(case, network))  # lit at night only
     case_sun = ctx.env.sun_intensity

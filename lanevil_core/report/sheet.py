@@ -18,7 +18,8 @@ HEADER_H = 26
 GAP = 2
 
 
-def _font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
+def label_font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
+    """Pillow's default font at ``size`` px (its fixed small font on Pillow < 10.1)."""
     try:
         return ImageFont.load_default(size=size)
     except TypeError:  # Pillow < 10.1 has no sized default font
@@ -45,7 +46,7 @@ def contact_sheet(size: tuple[int, int] = (320, 180), frame: int = 0, types: lis
     sheet = Image.new("RGB", (LABEL_W + len(columns) * (width + GAP), HEADER_H + len(names) * (height + GAP)),
                       (24, 24, 28))
     draw = ImageDraw.Draw(sheet)
-    font = _font(15)
+    font = label_font(15)
     for j, title in enumerate(columns):
         draw.text((LABEL_W + j * (width + GAP) + 6, 5), title, fill=(230, 230, 230), font=font)
     for i, name in enumerate(names):

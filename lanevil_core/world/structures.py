@@ -39,6 +39,7 @@ CABLE: Color = (0.03, 0.03, 0.03)
 WARM_LAMP: Color = (1.0, 0.78, 0.45)
 
 FOOTING_M = 0.3  # posts and piers reach this far below the ground, so kerbs and ditches never show a gap
+BOARD_FOOT_M = 0.1  # a board fence's lowest board starts this high above the ground
 LAMP_EMISSION = 30.0  # radiance of a glowing lamp glass relative to its colour: far above the road it lights
 
 # W-beam guard rail front face, walking bottom to top: (u towards the traffic, v above the ground) in metres.
@@ -291,7 +292,7 @@ def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1
 
     The slats (``slat_width`` along the road, ``slat_gap`` apart, 2.5 cm thick) make its shadow striped. With
     ``boards`` the slats lie horizontally instead and replace the rails (``slat_width`` high, ``slat_gap`` apart,
-    the top one ending at ``height``, see ``_boards``): under a low sun from the fence's side each gap lets
+    laid from the bottom, see ``_boards``): under a low sun from the fence's side each gap lets
     through a line of light parallel to the road.
 
     Returns:
@@ -321,13 +322,13 @@ def fence(line: ReferenceLine, s0: float, s1: float, t: float, height: float = 1
 
 def _boards(line: ReferenceLine, s0: float, s1: float, t: float, ground: float, height: float, board: float,
             gap: float, toward: float, color: Color) -> list[Mesh]:
-    """Horizontal boards ``board`` m high, ``gap`` m apart, 2.5 cm thick, the top one ending at ``height`` and the
-    lowest no lower than 0.1 m."""
+    """Horizontal boards ``board`` m high, ``gap`` m apart, 2.5 cm thick, laid from 0.1 m up and the top one cut at
+    ``height``: a taller fence is a lower one with more board on top, so its shadow holds the lower one's."""
     stations = _stations(s0, s1, 2.0)
-    tops = np.arange(height, 0.12, -(board + gap))  # a board under 2 cm high is left out
-    return [Mesh(*sweep(line, stations, t, ground, _rect_uv(-0.0125, 0.0125, max(top - board, 0.1), top), toward),
-                 np.asarray(color, np.float32))
-            for top in tops]
+    bottoms = np.arange(BOARD_FOOT_M, height - 0.02, board + gap)  # a board under 2 cm high is left out
+    return [Mesh(*sweep(line, stations, t, ground, _rect_uv(-0.0125, 0.0125, bottom, min(bottom + board, height)),
+                        toward), np.asarray(color, np.float32))
+            for bottom in bottoms]
 
 
 # ---------------------------------------------------------------------------------------------------------------

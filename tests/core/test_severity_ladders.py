@@ -18,20 +18,10 @@ FRAMES = (0, 6, 12)  # the illusions stand about 14-22 m ahead of the ego's star
 SIZE = (256, 144)
 SAMPLE = [(name, position % len(ORIGINALS[name])) for position, name in enumerate(sorted(REGISTRY))]
 EVERY = [(name, index) for name in sorted(REGISTRY) for index in range(len(ORIGINALS[name]))]
-# Originals whose ladder no longer rises at every level since the roadside grew photographic (trees with branches
-# and leaf clusters, street furniture, a sun of its true size): the fence sets its own low sun at every level, and
-# the shadows of the new trees moved by that sun change the lane band about as much as the fence does, so the
-# levels' increments drown (fence_shadow on the rural noon originals: about 3.0, 2.9, 3.2, 3.0, 3.1). A known
-# defect of these ladders, kept visible: each must fail until the level tables are re-tuned (strict).
-FLAT_LADDERS = {("fence_shadow", 0), ("fence_shadow", 1), ("fence_shadow", 5), ("fence_shadow", 6),
-                ("guard_rail", 4), ("sunlight_reflection", 5)}
 
 
-def _cases(pairs: list[tuple[str, int]]) -> list:
-    return [pytest.param(name, index, id=f"{name}-{index}",
-                         marks=[pytest.mark.xfail(strict=True, reason="ladder flat since the photographic roadside")]
-                         if (name, index) in FLAT_LADDERS else [])
-            for name, index in pairs]
+def _ids(pairs: list[tuple[str, int]]) -> list[str]:
+    return [f"{name}-{index}" for name, index in pairs]
 
 
 def test_lane_band_covers_the_lanes_only():
@@ -51,18 +41,18 @@ def test_the_sample_covers_every_type_once():
     assert len({index for _, index in SAMPLE}) == max(len(originals) for originals in ORIGINALS.values())
 
 
-@pytest.mark.parametrize(("illusion_type", "index"), _cases(SAMPLE))
+@pytest.mark.parametrize(("illusion_type", "index"), SAMPLE, ids=_ids(SAMPLE))
 def test_lane_band_effect_rises_with_the_level_on_a_sample(illusion_type, index):
     _assert_rises(illusion_type, index)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("illusion_type", "index"), _cases(EVERY))
+@pytest.mark.parametrize(("illusion_type", "index"), EVERY, ids=_ids(EVERY))
 def test_lane_band_effect_rises_with_the_level_on_every_original(illusion_type, index):
     _assert_rises(illusion_type, index)
 
 
-@pytest.mark.parametrize(("illusion_type", "index"), SAMPLE, ids=[f"{n}-{i}" for n, i in SAMPLE])
+@pytest.mark.parametrize(("illusion_type", "index"), SAMPLE, ids=_ids(SAMPLE))
 def test_level5_is_in_view_over_the_drive(illusion_type, index):
     """The full test split scores every frame of a case: crowds, cracks and tire marks run on along the drive
     instead of being passed in its first seconds (experiments/in_view.py measures every original)."""

@@ -223,9 +223,19 @@ def test_posts_keep_clear_of_the_lamps_already_there(name: str) -> None:
 def test_fence_sun_stays_while_the_fence_grows() -> None:
     scenes = [compiled({"type": "fence_shadow", "severity": level}) for level in LEVELS]
     assert np.ptp([s.env.sun_dir_world for s in scenes], axis=0).max() < 1e-9
+    assert len({s.env.sun_intensity for s in scenes}) == 1  # one sun, its strength too: only the fence grows
     height = np.array([own_vertices(s)[:, 2].max() for s in scenes])
     assert all(a < b for a, b in zip(height, height[1:]))  # so its shadow reaches further across
-    assert all(a < b for a, b in zip([s.env.sun_intensity for s in scenes], [s.env.sun_intensity for s in scenes][1:]))
+
+
+def test_each_level_fence_holds_the_one_before() -> None:
+    """The boards are laid from the bottom: below its own top, a lower level's fence has its boards' edges where the
+    next level's has them, so its shade and its lines of light stay where they were and the next level adds."""
+    scenes = [compiled({"type": "fence_shadow", "severity": level}) for level in LEVELS]
+    heights = [level.height for level in FenceShadow.SEVERITY]
+    edges = [set(np.round(own_vertices(s)[:, 2], 3)) for s in scenes]
+    for lower, higher, height in zip(edges, edges[1:], heights):
+        assert {z for z in lower if z < height - 1e-3} <= higher
 
 
 @pytest.mark.parametrize("lanes", [1, 2, 3])
