@@ -19,7 +19,7 @@ from .files import write_atomic
 from .illusions import IllusionSpec
 from .illusions.base import MAX_ROAD_LENGTH_M, RGB
 from .presets import camera_preset_values, preset_values
-from .typed import LineType, Pavement, RoadType, SceneKind, Turn
+from .typed import LineType, MarkingStandardName, Pavement, RoadType, SceneKind, Turn
 
 SCHEMA_VERSION: Literal[1] = 1
 
@@ -101,6 +101,12 @@ class Road(_Model):
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults; the defaults of another lane count are "
         "re-derived for this one)",
+    )
+    marking_standard: MarkingStandardName = Field(
+        "custom",
+        description="the country's and road class's marking manual whose dash, gap and line widths every marking "
+        "takes (us_mutcd: 10 ft / 30 ft; de_autobahn: 6 m / 12 m; de_urban: 3 m / 6 m; cn_fast: 6 m / 9 m; "
+        "cn_slow: 2 m / 4 m); custom: each marking's own width, dash and gap",
     )
     pavement: Pavement = Field(
         "asphalt",

@@ -15,14 +15,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..typed import Float32Array, FloatArray, IntArray
+from .marking_standards import standard_markings
 from .road_layout import RoadNetwork
 
 if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
     from ..case import Marking, Road
 
 DOUBLE_LINE_SPACING_M = 0.12  # clear space between the two lines of a double marking
-BOTTS_DOT_DIAMETER_M = 0.12
+# Botts' dots: round raised ceramic markers, 4 in across, every 4 ft along the line (Caltrans' non-reflective
+# Type A marker and lane-line spacing).
+BOTTS_DOT_DIAMETER_M = 0.10
 BOTTS_DOT_SPACING_M = 1.2
+WEAR_SHIFT_SPAN_M = 4096.0  # worn paint's chip pattern starts this far along the road or less, by the case's seed
 
 # Linear albedo of the cross-section materials (index = typed.MATERIALS).
 MATERIAL_ALBEDO = np.array([
@@ -49,11 +53,13 @@ PAINT_STEP_M = 1.0  # length of one paint quad along the road
 
 @dataclass(frozen=True)
 class RoadPaint:
-    """The main road's markings, resolved at compile time: one per lane boundary, left to right, and whether paint
-    is drawn at all (``painted`` False: the paint-free control; the labels still follow the markings)."""
+    """The main road's markings, resolved at compile time (a marking standard's dashes and widths applied): one per
+    lane boundary, left to right, whether paint is drawn at all (``painted`` False: the paint-free control; the
+    labels still follow the markings) and where along the road worn paint's chip pattern starts (by the seed)."""
 
     markings: tuple[Marking, ...]
     painted: bool = True
+    wear_shift_m: float = 0.0
 
     @property
     def line_types(self) -> tuple[str, ...]:
@@ -69,9 +75,12 @@ class RoadPaint:
         return paint_mesh(network, self.markings, self.painted)
 
 
-def road_paint(road: Road) -> RoadPaint:
-    """A road's markings and paint switch."""
-    return RoadPaint(markings=tuple(road.markings), painted=road.paint)
+def road_paint(road: Road, seed: int = 0) -> RoadPaint:
+    """A road's markings under its marking standard, its paint switch, and the chip pattern of the case ``seed``
+    (worn paint flakes differently under another seed)."""
+    shift = float(np.random.default_rng([seed, 0x3EA4]).uniform(0.0, WEAR_SHIFT_SPAN_M))
+    return RoadPaint(markings=standard_markings(road.markings, road.marking_standard), painted=road.paint,
+                     wear_shift_m=shift)
 
 
 def _color(marking: Marking) -> tuple[float, float, float]:
