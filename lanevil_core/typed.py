@@ -42,9 +42,11 @@ LINE_TYPES: tuple[LineType, ...] = (
 )
 
 # A country's and road class's marking standard (``world/marking_standards.py``); ``custom``: each marking's own.
-MarkingStandardName = Literal["custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow"]
+MarkingStandardName = Literal[
+    "custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow", "jp_expressway", "jp_general",
+]
 MARKING_STANDARD_NAMES: tuple[MarkingStandardName, ...] = (
-    "custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow",
+    "custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow", "jp_expressway", "jp_general",
 )
 
 SceneKind = Literal["urban", "suburban", "highway", "rural", "tunnel_approach"]

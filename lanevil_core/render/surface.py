@@ -107,12 +107,16 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
         t_c, half = stripes[k, 1], stripes[k, 2]
         if abs(t - t_c) > half + ft:
             continue
+        s0, s1 = stripes[k, 3], stripes[k, 4]
+        span = box_overlap(s, fs, s0, s1)
+        if span <= 0.0:
+            continue
         wear = stripes[k, PAINT_WEAR]
         dots = stripes[k, 5] > 1.5
         shade = 1.0
         if dots:
             period = stripes[k, 7]
-            ds = s - stripes[k, 3] - half
+            ds = s - s0 - half
             ds -= np.floor(ds / period + 0.5) * period  # from the nearest dot's centre
             cov, shade = dot_coverage(ds, t - t_c, fs, ft, half)
         elif wear > 0.0:  # worn edges: eaten in by up to RAGGED_BITE of the half width where ``ragged`` > 0
@@ -120,8 +124,7 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
             cov = box_overlap(t, ft, t_c - half + bite, t_c + half - bite)
         else:
             cov = box_overlap(t, ft, t_c - half, t_c + half)
-        s0, s1 = stripes[k, 3], stripes[k, 4]
-        cov *= box_overlap(s, fs, s0, s1)
+        cov *= span
         if cov <= 0.0:
             continue
         if stripes[k, 5] > 0.5 and not dots:

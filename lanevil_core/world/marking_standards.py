@@ -29,8 +29,8 @@ class MarkingStandard:
     road_class: str
     dash_m: float  # painted segment of a broken (dashed) line
     gap_m: float  # unpainted gap between two segments
-    line_width_m: float  # lane lines and the centre line
-    edge_width_m: float | None  # the carriageway's edge lines (None: the manual's same as line_width_m)
+    line_width_m: float | None  # lane lines and the centre line (None: each marking's own width)
+    edge_width_m: float | None  # the carriageway's edge lines (None: as line_width_m)
     source: str  # manual, part and section
 
 
@@ -51,6 +51,13 @@ MARKING_STANDARDS: dict[MarkingStandardName, MarkingStandard] = {
     "cn_slow": MarkingStandard(
         "China", "design speed under 60 km/h", 2.0, 4.0, 0.10, None,
         "GB 51038-2015, 12.3.2 (after GB 5768.3-2009): lane line 2 m / 4 m, 10 cm wide"),
+    "jp_expressway": MarkingStandard(
+        "Japan", "motorway, design speed 80 km/h and above", 8.0, 12.0, None, None,
+        "MLIT notice 区画線の設置様式について (1974), after the 標識令 (道路標識、区画線及び道路標示に関する命令): "
+        "車線境界線 broken 8 m / 12 m"),
+    "jp_general": MarkingStandard(
+        "Japan", "ordinary roads", 5.0, 5.0, None, None,
+        "MLIT notice 区画線の設置様式について (1974), after the 標識令: 車線境界線 broken 5 m / 5 m"),
 }
 
 
@@ -61,8 +68,10 @@ def standard_markings(markings: Sequence[Marking], standard: MarkingStandardName
         return tuple(markings)
     table = MARKING_STANDARDS[standard]
     last = len(markings) - 1
-    edge_width = table.edge_width_m or table.line_width_m
-    return tuple(marking.model_copy(update={
-        "dash": table.dash_m, "gap": table.gap_m,
-        "width": edge_width if index in (0, last) else table.line_width_m,
-    }) for index, marking in enumerate(markings))
+
+    def width(index: int, marking: Marking) -> float:
+        edge = table.edge_width_m if index in (0, last) else None
+        return edge or table.line_width_m or marking.width
+
+    return tuple(marking.model_copy(update={"dash": table.dash_m, "gap": table.gap_m, "width": width(index, marking)})
+                 for index, marking in enumerate(markings))

@@ -19,7 +19,7 @@ from lanevil_core.render import Frame, render_frame
 from lanevil_core.render.surface import dot_coverage, paint
 from lanevil_core.typed import MARKING_STANDARD_NAMES
 from lanevil_core.world.marking_standards import MARKING_STANDARDS
-from lanevil_core.world.paint import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, PAINT_WEAR, STRIPE_COLUMNS
+from lanevil_core.world.paint import BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, PAINT_WEAR, STRIPE_COLUMNS, dash_spans
 
 ASPHALT = 0.055
 RIGHT_LANE_LINE = 3  # boundaries of a two-lane-per-direction road, left to right: edge, lane, centre, lane, edge
@@ -60,9 +60,10 @@ def test_a_standard_paints_its_dash_and_gap(make_case: Callable[..., Case], stan
     near = np.abs(t_vertex - t_line) < 0.5
     quads = np.round(np.sort(np.unique(np.round(s_vertex[near], 3))), 3)
     assert np.isclose(np.diff(quads).max(), row.gap_m, atol=0.02)  # the longest jump between quads is a gap
-    assert np.isclose(np.ptp(t_vertex[near]), row.line_width_m, atol=1e-3)
+    own = scene.case.road.markings[RIGHT_LANE_LINE].width  # the width of a standard that names none
+    assert np.isclose(np.ptp(t_vertex[near]), row.line_width_m or own, atol=1e-3)
     edge = np.abs(t_vertex - float(scene.network.main.boundaries_t[-1])) < 0.5
-    assert np.isclose(np.ptp(t_vertex[edge]), row.edge_width_m or row.line_width_m, atol=1e-3)
+    assert np.isclose(np.ptp(t_vertex[edge]), row.edge_width_m or row.line_width_m or own, atol=1e-3)
 
 
 def test_custom_keeps_every_markings_own_numbers(make_case: Callable[..., Case]) -> None:
@@ -116,6 +117,24 @@ def test_a_dot_seen_from_far_keeps_its_area(ds: float, dt: float) -> None:
     coverage, shade = dot_coverage(ds, dt, foot, foot, r)
     assert np.isclose(coverage, np.pi * r * r / foot**2, rtol=1e-9)
     assert 0.7 < shade < 1.0
+
+
+@pytest.mark.parametrize("standard", ["custom", "us_mutcd"])
+def test_a_standard_groups_botts_dots_into_its_dashes(make_case: Callable[..., Case], standard: str) -> None:
+    """Under a standard a Botts'-dot line stands in for its broken line (MUTCD 3B.14): three dots 1.2 m apart in
+    each 10 ft dash, a group every 40 ft; a custom road keeps one dot every 1.2 m."""
+    markings = ["white_solid", "white_dashed", "yellow_double_solid", "botts_dots", "white_solid"]
+    scene = compile_scene(make_case(road={"markings": markings, "marking_standard": standard}))
+    rows = scene.paint.stripes(scene.network)
+    rows = rows[rows[:, 11] == RIGHT_LANE_LINE]
+    starts = np.array([a for row in rows for a, _ in dash_spans(row[3], row[4], 2, row[6], row[7])])
+    steps = set(np.round(np.diff(starts), 6))
+    if standard == "custom":
+        assert steps == {BOTTS_DOT_SPACING_M}
+        return
+    period = MARKING_STANDARDS["us_mutcd"].dash_m + MARKING_STANDARDS["us_mutcd"].gap_m
+    assert steps == {BOTTS_DOT_SPACING_M, round(period - 2 * BOTTS_DOT_SPACING_M, 6)}
+    np.testing.assert_allclose(np.diff(starts[::3]), period)
 
 
 def _along_line(scene: Any, frame: Frame, s_road: np.ndarray) -> np.ndarray:
