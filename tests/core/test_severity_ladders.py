@@ -23,7 +23,8 @@ EVERY = [(name, index) for name in sorted(REGISTRY) for index in range(len(ORIGI
 # the shadows of the new trees moved by that sun change the lane band about as much as the fence does, so the
 # levels' increments drown (fence_shadow on the rural noon originals: about 3.0, 2.9, 3.2, 3.0, 3.1). A known
 # defect of these ladders, kept visible: each must fail until the level tables are re-tuned (strict).
-FLAT_LADDERS = {("fence_shadow", 0), ("fence_shadow", 1), ("fence_shadow", 5), ("fence_shadow", 6),
+# (fence_shadow 5, the highway original, rises again since its Botts' dots are round: 5.29, 5.31, 5.40, 5.53, 5.60.)
+FLAT_LADDERS = {("fence_shadow", 0), ("fence_shadow", 1), ("fence_shadow", 6),
                 ("guard_rail", 4), ("sunlight_reflection", 5)}
 
 
