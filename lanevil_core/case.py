@@ -44,8 +44,9 @@ class Marking(_Model):
     gap: StrictFloat = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
     wear: StrictFloat = Field(
         0.0, ge=0.0, le=1.0,
-        description="how worn the paint is (0 = fresh): it flakes off in chips along the line, the rest is dirtier, "
-        "and far away the line fades evenly; the label stays (annotators label worn lines)",
+        description="how worn the paint is (0 = fresh): it flakes off in chips along the line (where, by the case's "
+        "seed), its edges are eaten in, the rest is dirtier, and far away the line fades evenly; the label stays "
+        "(annotators label worn lines)",
     )
 
     @model_validator(mode="before")
