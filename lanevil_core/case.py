@@ -19,7 +19,7 @@ from .files import write_atomic
 from .illusions import IllusionSpec
 from .illusions.base import MAX_ROAD_LENGTH_M, RGB
 from .presets import camera_preset_values, preset_values
-from .typed import LineType, Pavement, RoadType, SceneKind, Turn
+from .typed import LineType, MarkingStandardName, Pavement, RoadType, SceneKind, Turn
 
 SCHEMA_VERSION: Literal[1] = 1
 
@@ -44,8 +44,9 @@ class Marking(_Model):
     gap: StrictFloat = Field(GAP_M, ge=0.1, le=50, description="gap between dashes (m)")
     wear: StrictFloat = Field(
         0.0, ge=0.0, le=1.0,
-        description="how worn the paint is (0 = fresh): it flakes off in chips along the line, the rest is dirtier, "
-        "and far away the line fades evenly; the label stays (annotators label worn lines)",
+        description="how worn the paint is (0 = fresh): it flakes off in chips along the line (where, by the case's "
+        "seed), its edges are eaten in, the rest is dirtier, and far away the line fades evenly; the label stays "
+        "(annotators label worn lines)",
     )
 
     @model_validator(mode="before")
@@ -101,6 +102,12 @@ class Road(_Model):
         description="paint of every lane boundary, left to right as seen by the ego "
         "(2 * lanes_per_direction + 1 entries; empty = defaults; the defaults of another lane count are "
         "re-derived for this one)",
+    )
+    marking_standard: MarkingStandardName = Field(
+        "custom",
+        description="the country's and road class's marking manual whose dash, gap and line widths every marking "
+        "takes (us_mutcd: 10 ft / 30 ft; de_autobahn: 6 m / 12 m; de_urban: 3 m / 6 m; cn_fast: 6 m / 9 m; "
+        "cn_slow: 2 m / 4 m); custom: each marking's own width, dash and gap",
     )
     pavement: Pavement = Field(
         "asphalt",

@@ -41,6 +41,14 @@ LINE_TYPES: tuple[LineType, ...] = (
     "white_solid_dashed", "yellow_solid_dashed", "botts_dots", "none",
 )
 
+# A country's and road class's marking standard (``world/marking_standards.py``); ``custom``: each marking's own.
+MarkingStandardName = Literal[
+    "custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow", "jp_expressway", "jp_general",
+]
+MARKING_STANDARD_NAMES: tuple[MarkingStandardName, ...] = (
+    "custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "cn_slow", "jp_expressway", "jp_general",
+)
+
 SceneKind = Literal["urban", "suburban", "highway", "rural", "tunnel_approach"]
 SCENE_KINDS: tuple[SceneKind, ...] = ("urban", "suburban", "highway", "rural", "tunnel_approach")
 

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..case import Case, Marking
 from ..files import write_atomic
-from ..world.paint import DOUBLE_LINE_SPACING_M
+from ..world.paint import DOUBLE_LINE_SPACING_M, road_paint
 from ..world.road_geometry import Piece, ReferenceLine
 from ..world.road_layout import RoadNetwork, build_network, reference_pieces
 from ..world.scene import CompiledScene, Mesh
@@ -333,7 +333,7 @@ def opendrive(case: Case, scene: CompiledScene | None = None) -> xodr.OpenDrive:
     """The case's road network, marks and roadside objects as an OpenDRIVE document."""
     xodr = _xodr()
     network = scene.network if scene is not None else build_network(case.road, case.scene.kind)
-    markings = case.road.markings
+    markings = list(scene.paint.markings if scene is not None else road_paint(case.road).markings)
     pieces, _ = reference_pieces(case.road)
     line = network.main.line
     objects = roadside_objects(scene) if scene is not None else []

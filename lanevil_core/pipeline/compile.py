@@ -102,5 +102,5 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
             ctx.env.sun_set_by = (*ctx.env.sun_set_by, index)
     if case.camera.sensor is not None:  # a photograph: sun and sky in daylight's proportion for the final sun
         in_proportion(ctx.env, air_mass=ctx.env.sun_intensity == case_sun)
-    return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road),
+    return CompiledScene(case=case, network=network, env=ctx.env, paint=road_paint(case.road, case.seed),
                          ego=ego_path(case, network), meshes=ctx.meshes, layers=ctx.layers, lights=ctx.lights)

@@ -157,7 +157,7 @@ def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
     return RoadLook(SURFACE_TABLE, packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
                     float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
                     packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params,
-                    float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)))
+                    float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)), scene.paint.wear_shift_m)
 
 
 def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:

@@ -45,7 +45,7 @@ from .lighting import (
     sun_visibility,
     sun_visibility_over,
 )
-from .surface import CHIP_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
+from .surface import CHIP_TEXEL_M, RAGGED_STRETCH, RAGGED_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
@@ -129,6 +129,7 @@ class RoadLook(NamedTuple):
     overhead: Float32Array
     overhead_params: FloatArray
     paint_wear: float  # the most worn stripe's wear (0: fresh paint everywhere, no chip noise is sampled)
+    wear_shift: float  # where along the road worn paint's chip and edge noise starts (m; by the case's seed)
 
 
 class Lighting(NamedTuple):
@@ -466,7 +467,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss, \
         face_texture = geometry
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
-        overhead_params, paint_wear = road
+        overhead_params, paint_wear, wear_shift = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
     maps, cells, shadow_params, R_light, sun_terms = shadow
     refl_rgb, refl_depth = reflection
@@ -540,15 +541,19 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 r, g, b, wet = sample_layers(texels, table, first, piece, s, t, fs, ft, False, r, g, b)
                 k0, k1 = boundaries_near(lanes, lane_width, last, t, ft)
                 chips = 0.0
+                ragged = 0.0
                 if paint_wear > 0.0:  # flakes (fine) in worn stretches (coarse), along the line, filtered
                     chip_foot = max(fs * CHIP_STRETCH, ft)
-                    chips = CHIP_FLAKES * sample_noise(fine, CHIP_TEXEL_M, s * CHIP_STRETCH, t + 3.0, chip_foot) \
-                        + (1.0 - CHIP_FLAKES) * sample_noise(coarse, CHIP_TEXEL_M, s * CHIP_STRETCH, t, chip_foot)
+                    s_chip = (s + wear_shift) * CHIP_STRETCH
+                    chips = CHIP_FLAKES * sample_noise(fine, CHIP_TEXEL_M, s_chip, t + 3.0, chip_foot) \
+                        + (1.0 - CHIP_FLAKES) * sample_noise(coarse, CHIP_TEXEL_M, s_chip, t, chip_foot)
+                    ragged = sample_noise(fine, RAGGED_TEXEL_M, (s + wear_shift) * RAGGED_STRETCH, t + 9.0,
+                                          max(fs * RAGGED_STRETCH, ft))
                 for k in range(k0, k1 + 1):
                     r, g, b = paint(stripes, stripe_index[piece, k, 0], stripe_index[piece, k, 1], s, t, fs, ft, r,
-                                    g, b, chips)
+                                    g, b, chips, ragged)
                 r, g, b = paint(stripes, stripe_index[piece, last, 0], stripe_index[piece, last, 1], s, t, fs, ft, r,
-                                g, b, chips)
+                                g, b, chips, ragged)
                 r, g, b, wet_over = sample_layers(texels, table, first, piece, s, t, fs, ft, True, r, g, b)
                 wet = max(wet, wet_over)
                 if puddles > 0.0:  # coarse blobs with ragged, soft shores (a finer octave)

@@ -18,6 +18,14 @@ MAX_ANISO = 6
 CHIP_CONTRAST = 2.0
 CHIP_TEXEL_M = 0.05
 DIRT_DIMMING = 0.35
+# Worn paint's edges: where the edge noise is n > 0 an edge is eaten in by wear * RAGGED_BITE * n of the half width.
+RAGGED_BITE = 0.7
+RAGGED_TEXEL_M = 0.03
+RAGGED_STRETCH = 0.15  # the bites run about 7 times longer along the line than across it
+# Botts' dots: a ceramic dome; its rim, tilted away from the sky, is darker than its crown.
+DOME_RIM_DARKENING = 0.45
+DOME_MEAN_SHADE = 1.0 - DOME_RIM_DARKENING / 2  # the mean of 1 - k (d / r)^2 over the disc
+SQRT_PI = float(np.sqrt(np.pi))
 
 
 @kernel(inline="always")
@@ -74,26 +82,58 @@ def sample_noise(pyramid: np.ndarray, texel_m: float, s: float, t: float, footpr
 
 
 @kernel(inline="always")
+def dot_coverage(ds: float, dt: float, fs: float, ft: float, radius: float) -> tuple[float, float]:
+    """(coverage, shade) of a round raised marker of ``radius`` centred (ds, dt) from the pixel, over a footprint
+    (fs, ft). Near the camera the disc's edge is filtered over the footprint and the dome is lit less towards its
+    rim (its side faces away from the sky); a footprint over twice the diameter sees the disc's area spread over
+    the footprint, and the dome's mean shade."""
+    d = np.sqrt(ds * ds + dt * dt)
+    foot = 0.5 * (fs + ft)
+    disc = min(max((radius - d) / foot + 0.5, 0.0), 1.0)
+    rim = min(d / radius, 1.0)
+    near_shade = 1.0 - DOME_RIM_DARKENING * rim * rim
+    side = radius * SQRT_PI  # the square of the disc's area
+    spread = box_overlap(ds, fs, -0.5 * side, 0.5 * side) * box_overlap(dt, ft, -0.5 * side, 0.5 * side)
+    far = min(max(max(fs, ft) / (2.0 * radius) - 1.0, 0.0), 1.0)
+    return disc * (1.0 - far) + spread * far, near_shade * (1.0 - far) + DOME_MEAN_SHADE * far
+
+
+@kernel(inline="always")
 def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
-          r: float, g: float, b: float, chips: float) -> tuple[float, float, float]:
+          r: float, g: float, b: float, chips: float, ragged: float) -> tuple[float, float, float]:
     """(r, g, b) with the paint of stripes[lo:hi] blended over it; ``chips`` (noise in [-1, 1], filtered over the
-    pixel) is where worn paint has flaked off."""
+    pixel) is where worn paint has flaked off, ``ragged`` (likewise) where its edges are eaten away."""
     for k in range(lo, hi):
         t_c, half = stripes[k, 1], stripes[k, 2]
         if abs(t - t_c) > half + ft:
             continue
-        cov = box_overlap(t, ft, t_c - half, t_c + half)
         s0, s1 = stripes[k, 3], stripes[k, 4]
-        cov *= box_overlap(s, fs, s0, s1)
+        span = box_overlap(s, fs, s0, s1)
+        if span <= 0.0:
+            continue
+        wear = stripes[k, PAINT_WEAR]
+        dots = stripes[k, 5] > 1.5
+        shade = 1.0
+        if dots:
+            period = stripes[k, 7]
+            ds = s - s0 - half
+            ds -= np.floor(ds / period + 0.5) * period  # from the nearest dot's centre
+            cov, shade = dot_coverage(ds, t - t_c, fs, ft, half)
+        elif wear > 0.0:  # worn edges: eaten in by up to RAGGED_BITE of the half width where ``ragged`` > 0
+            bite = half * RAGGED_BITE * wear * max(ragged, 0.0)
+            cov = box_overlap(t, ft, t_c - half + bite, t_c + half - bite)
+        else:
+            cov = box_overlap(t, ft, t_c - half, t_c + half)
+        cov *= span
         if cov <= 0.0:
             continue
-        if stripes[k, 5] > 0.5:
+        if stripes[k, 5] > 0.5 and not dots:
             cov *= dash_coverage(s - s0, fs, stripes[k, 6], stripes[k, 7])
-        wear = stripes[k, PAINT_WEAR]
         dirt = 1.0
         if wear > 0.0:
             cov *= min(max(1.0 - wear * (1.0 + CHIP_CONTRAST * chips), 0.0), 1.0)
             dirt = 1.0 - DIRT_DIMMING * wear
+        dirt *= shade
         r = r * (1.0 - cov) + stripes[k, 8] * dirt * cov
         g = g * (1.0 - cov) + stripes[k, 9] * dirt * cov
         b = b * (1.0 - cov) + stripes[k, 10] * dirt * cov

@@ -15,14 +15,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..typed import Float32Array, FloatArray, IntArray
+from .marking_standards import standard_markings
 from .road_layout import RoadNetwork
 
 if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
     from ..case import Marking, Road
 
 DOUBLE_LINE_SPACING_M = 0.12  # clear space between the two lines of a double marking
-BOTTS_DOT_DIAMETER_M = 0.12
+# Botts' dots: round raised ceramic markers, 4 in across, every 4 ft along the line (Caltrans' non-reflective
+# Type A marker and lane-line spacing).
+BOTTS_DOT_DIAMETER_M = 0.10
 BOTTS_DOT_SPACING_M = 1.2
+WEAR_SHIFT_SPAN_M = 4096.0  # worn paint's chip pattern starts this far along the road or less, by the case's seed
 
 # Linear albedo of the cross-section materials (index = typed.MATERIALS).
 MATERIAL_ALBEDO = np.array([
@@ -49,11 +53,14 @@ PAINT_STEP_M = 1.0  # length of one paint quad along the road
 
 @dataclass(frozen=True)
 class RoadPaint:
-    """The main road's markings, resolved at compile time: one per lane boundary, left to right, and whether paint
-    is drawn at all (``painted`` False: the paint-free control; the labels still follow the markings)."""
+    """The main road's markings, resolved at compile time (a marking standard's dashes and widths applied): one per
+    lane boundary, left to right, whether paint is drawn at all (``painted`` False: the paint-free control; the
+    labels still follow the markings) and where along the road worn paint's chip pattern starts (by the seed)."""
 
     markings: tuple[Marking, ...]
     painted: bool = True
+    wear_shift_m: float = 0.0
+    dot_groups: bool = False  # Botts' dots in groups that stand in for the dashes (under a marking standard)
 
     @property
     def line_types(self) -> tuple[str, ...]:
@@ -62,34 +69,46 @@ class RoadPaint:
 
     def stripes(self, network: RoadNetwork) -> FloatArray:
         """The stripe table of this paint on ``network`` (see ``paint_stripes``)."""
-        return paint_stripes(network, self.markings, self.painted)
+        return paint_stripes(network, self.markings, self.painted, self.dot_groups)
 
     def mesh(self, network: RoadNetwork) -> tuple[FloatArray, IntArray, Float32Array]:
         """The paint as quads (see ``paint_mesh``)."""
-        return paint_mesh(network, self.markings, self.painted)
+        return paint_mesh(network, self.markings, self.painted, self.dot_groups)
 
 
-def road_paint(road: Road) -> RoadPaint:
-    """A road's markings and paint switch."""
-    return RoadPaint(markings=tuple(road.markings), painted=road.paint)
+def road_paint(road: Road, seed: int = 0) -> RoadPaint:
+    """A road's markings under its marking standard (which also groups Botts' dots into its dashes), its paint
+    switch, and the chip pattern of the case ``seed`` (worn paint flakes differently under another seed)."""
+    shift = float(np.random.default_rng([seed, 0x3EA4]).uniform(0.0, WEAR_SHIFT_SPAN_M))
+    return RoadPaint(markings=standard_markings(road.markings, road.marking_standard), painted=road.paint,
+                     wear_shift_m=shift, dot_groups=road.marking_standard != "custom")
 
 
 def _color(marking: Marking) -> tuple[float, float, float]:
     return YELLOW_PAINT if marking.type.startswith("yellow") else WHITE_PAINT
 
 
-def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: float) -> list[list[float]]:
-    """Stripes of one marking; for double lines the pair is centred on the boundary, the first on the left
-    (none for an unmarked boundary)."""
+def _dot_groups(s0: float, s1: float, marking: Marking) -> list[tuple[float, float]]:
+    """[start, end) of each group of Botts' dots standing in for a dash of ``marking`` (MUTCD 3B.14: a group of
+    markers in place of each segment of a broken line): as many dots, BOTTS_DOT_SPACING_M apart, as fit in the
+    dash, every dash + gap."""
+    count = int(np.floor(marking.dash / BOTTS_DOT_SPACING_M + 1e-9)) + 1
+    length = (count - 1) * BOTTS_DOT_SPACING_M + BOTTS_DOT_DIAMETER_M
+    return [(float(a), float(min(a + length, s1))) for a in np.arange(s0, s1, marking.dash + marking.gap)]
+
+
+def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: float,
+                         dot_groups: bool = False) -> list[list[float]]:
+    """Stripes of one marking; for double lines the pair is centred on the boundary, the first on the left; Botts'
+    dots in a row, or with ``dot_groups`` one stripe per group (none for an unmarked boundary)."""
     if marking.type == "none":
         return []
     offset = (marking.width + DOUBLE_LINE_SPACING_M) / 2
     rgb = list(_color(marking))
     period = marking.dash + marking.gap
 
-    def stripe(t_c: float, pattern: int, width: float = marking.width, on: float = marking.dash,
-               per: float = period) -> list[float]:
-        return [piece, t_c, width / 2, s0, s1, pattern, on, per, *rgb]
+    def stripe(t_c: float, pattern: int) -> list[float]:
+        return [piece, t_c, marking.width / 2, s0, s1, pattern, marking.dash, period, *rgb]
 
     kind = marking.type.split("_", 1)[1] if marking.type != "botts_dots" else "dots"
     if kind == "solid":
@@ -100,11 +119,15 @@ def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: 
         return [stripe(t + offset, 0), stripe(t - offset, 0)]
     if kind == "solid_dashed":
         return [stripe(t + offset, 0), stripe(t - offset, 1)]
-    return [stripe(t, 2, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M)]
+    spans = _dot_groups(s0, s1, marking) if dot_groups else [(s0, s1)]
+    return [[piece, t, BOTTS_DOT_DIAMETER_M / 2, a, b, 2, BOTTS_DOT_DIAMETER_M, BOTTS_DOT_SPACING_M, *rgb]
+            for a, b in spans]
 
 
-def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True) -> FloatArray:
-    """Every painted stripe of the network as rows of the stripe table (none when ``paint`` is False)."""
+def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True,
+                  dot_groups: bool = False) -> FloatArray:
+    """Every painted stripe of the network as rows of the stripe table (none when ``paint`` is False); Botts' dots
+    in groups with ``dot_groups``."""
     rows: list[list[float]] = []
     if not paint:
         return np.zeros((0, STRIPE_COLUMNS), np.float64)
@@ -117,7 +140,8 @@ def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool
                 if side and g_side == side:
                     spans = [(a, b) for a0, b0 in spans for a, b in ((a0, min(b0, g0)), (max(a0, g1), b0)) if b > a]
             for s0, s1 in spans:
-                rows += [[*row, k, marking.wear] for row in _stripes_of_boundary(index, float(t), marking, s0, s1)]
+                rows += [[*row, k, marking.wear]
+                         for row in _stripes_of_boundary(index, float(t), marking, s0, s1, dot_groups)]
         if index:  # a stop line across the arm's lanes that lead into the junction
             s0 = piece.s_start + 1.5
             rows.append([index, -piece.half_width / 2, piece.half_width / 2, s0, s0 + STOP_LINE_M, 0,
@@ -147,10 +171,10 @@ def dash_spans(s0: float, s1: float, pattern: int, on: float, period: float) -> 
     return [(float(a), float(min(a + on, s1))) for a in starts]
 
 
-def paint_mesh(network: RoadNetwork, markings: Sequence[Marking],
-               paint: bool = True) -> tuple[FloatArray, IntArray, Float32Array]:
+def paint_mesh(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True,
+               dot_groups: bool = False) -> tuple[FloatArray, IntArray, Float32Array]:
     """Quads of every paint stripe just above the road: vertices (n, 3), faces (m, 3), colours (m, 3)."""
-    stripes = paint_stripes(network, markings, paint).reshape(-1, STRIPE_COLUMNS)
+    stripes = paint_stripes(network, markings, paint, dot_groups).reshape(-1, STRIPE_COLUMNS)
     vertices, faces, colors = [], [], []
     count = 0
     for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary, _wear in stripes:

@@ -37,21 +37,21 @@ def _stripe(wear: float) -> np.ndarray:
 @settings(deadline=None)
 @given(chips=st.floats(-1.0, 1.0), t=st.floats(-0.2, 0.2))
 def test_fresh_paint_ignores_the_chip_noise(chips: float, t: float) -> None:
-    fresh = paint(_stripe(0.0), 0, 1, 5.0, t, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips)
-    assert fresh == paint(_stripe(0.0), 0, 1, 5.0, t, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, 0.0)
+    fresh = paint(_stripe(0.0), 0, 1, 5.0, t, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips, 0.0)
+    assert fresh == paint(_stripe(0.0), 0, 1, 5.0, t, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, 0.0, 0.0)
 
 
 @settings(deadline=None)
 @given(wear=st.floats(0.05, 1.0), chips=st.floats(-1.0, 1.0))
 def test_worn_paint_lies_between_the_asphalt_and_fresh_paint(wear: float, chips: float) -> None:
-    fresh = paint(_stripe(0.0), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips)[0]
-    worn = paint(_stripe(wear), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips)[0]
+    fresh = paint(_stripe(0.0), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips, 0.0)[0]
+    worn = paint(_stripe(wear), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, chips, 0.0)[0]
     assert ASPHALT - 1e-9 <= worn < fresh
 
 
 def test_far_away_worn_paint_fades_evenly() -> None:
     """Filtered chip noise tends to 0 far away: the line keeps 1 - wear of its paint, a little dirtier."""
-    half = paint(_stripe(0.5), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, 0.0)[0]
+    half = paint(_stripe(0.5), 0, 1, 5.0, 0.0, 0.01, 0.01, ASPHALT, ASPHALT, ASPHALT, 0.0, 0.0)[0]
     assert ASPHALT + 0.3 * (0.7 - ASPHALT) < half < ASPHALT + 0.5 * (0.7 - ASPHALT)
 
 

@@ -108,6 +108,8 @@ def test_create_envelope_with_id_and_conflict(client) -> None:
     ({"case": {}, "colour": "red"}, "colour"),
     ({"id": "Bad Id", "case": {}}, "id"),
     ({"illusions": [{"type": "no_such_illusion"}]}, "illusions.0"),
+    ({"road": {"marking_standard": "atlantis"}}, "road.marking_standard"),
+    ({"road": {"markings": [{"type": "botts_dots", "wear": 2.0}] * 5}}, "road.markings.0.wear"),
 ])
 def test_create_rejects_bad_cases_naming_the_field(client, body: dict, field: str) -> None:
     response = client.post("/api/cases", json=body)
