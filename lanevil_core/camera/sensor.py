@@ -6,6 +6,9 @@ module works out, per frame, the numbers of the sensor kernel (``render.develop`
 - **Auto-exposure** meters the frame as a camera does: the mean log luminance of the frame's middle 90 %
   (trimmed, so neither the sun's glint nor black tires rule it) is brought to middle grey (``KEY``), within the
   sensor's gain limits. The sky is in the metered frame, so shadowed asphalt falls dark and highlights clip.
+  In the dark (a gain beyond ``BASE_GAIN``) the camera protects its highlights as automotive cameras do: the
+  gain rises only as far as keeps ``HIGHLIGHT_PERCENTILE`` of the frame below clip, so the road in the
+  headlights' beam keeps its paint instead of burning out (never below ``BASE_GAIN``: daylight is unchanged).
 - **Gain and noise**: beyond ``BASE_GAIN`` the camera raises its analogue gain (ISO) instead of the exposure
   time; shot noise (Poisson, ~ sqrt(signal / full well)) and read noise (Gaussian) grow with it (EMVA 1288).
 - **White balance**: von Kries gains from the scene's daylight to the camera's set colour temperature.
@@ -29,6 +32,7 @@ KEY = 0.18  # middle grey the metered mean log luminance is brought to
 TRIM = (5.0, 95.0)  # percentiles of log luminance kept by the meter
 METER_STEP = 8  # the meter reads every 8th pixel of every 8th row
 BASE_GAIN = 2.0  # exposure gain reached at base ISO (longest shutter); above it the analogue gain rises
+HIGHLIGHT_PERCENTILE = 98.0  # above base ISO, the gain keeps this share of the metered frame below clip
 FULL_WELL_E = 5000.0  # electrons at clip of a small automotive sensor pixel
 READ_NOISE_E = 4.0  # read noise (electrons, rms) at base ISO
 DAYLIGHT_K = 5600.0  # colour temperature of the renderer's sun and sky
@@ -69,8 +73,11 @@ def metered_gain(hdr: np.ndarray, sensor: Sensor) -> float:
     lo, hi = np.percentile(log_l, TRIM)
     kept = log_l[(log_l >= lo) & (log_l <= hi)]
     mean_log = float(kept.mean()) if kept.size else float(log_l.mean())
-    gain = KEY * 2.0 ** (sensor.bias - mean_log)
-    return float(np.clip(gain, sensor.min_gain, sensor.max_gain))
+    gain = float(np.clip(KEY * 2.0 ** (sensor.bias - mean_log), sensor.min_gain, sensor.max_gain))
+    if gain > BASE_GAIN:  # in the dark, gain rises only while the lit road stays below clip (highlight priority)
+        protected = 1.0 / max(float(np.percentile(luminance, HIGHLIGHT_PERCENTILE)), 1e-9)
+        gain = max(BASE_GAIN, min(gain, protected))
+    return gain
 
 
 def blackbody_rgb(kelvin: float) -> FloatArray:

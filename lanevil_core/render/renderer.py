@@ -14,7 +14,7 @@ from ..camera import PinholeCamera
 from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
-from ..typed import Float32Array, IntArray, UInt8Array
+from ..typed import Float32Array, FloatArray, IntArray, UInt8Array
 from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
@@ -41,6 +41,9 @@ SURFACE_TABLE = surface_table(MATERIAL_ALBEDO)
 MIRROR_BLUR_PX_AT_1280 = 10
 MIRROR_LAMP_SPILL = 0.02  # irradiance of the street lamps on the objects a wet road mirrors at night
 HEADLIGHT_COLOR = (1.0, 0.95, 0.85)  # halogen-white low beams
+HEADLIGHT_HEIGHT_M = 0.7  # the low beams' height above the road (ECE R48: 0.5-1.2 m)
+HEADLIGHT_AHEAD_M = 1.5  # how far ahead of the camera the lamps stand
+HEADLIGHT_HALF_SPAN_M = 0.75  # half the distance between the two lamps
 LAMP_RANGE_M = 75.0
 LAMP_BEHIND_M = 12.0
 
@@ -113,8 +116,21 @@ def _ground_heights(packed: PackedScene) -> np.ndarray:
     return ground
 
 
-def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment) -> np.ndarray:
-    """The lamps near enough to matter this frame plus, when on, the ego's headlights (they move with it).
+def headlight_positions(camera: PinholeCamera, mount_height: float) -> tuple[FloatArray, FloatArray]:
+    """The ego's level heading (3,) and its two low beams' world positions (2, 3), left then right: on the car,
+    ``HEADLIGHT_HEIGHT_M`` above the road under a camera ``mount_height`` up, whatever the camera's pitch."""
+    forward = camera.R_world_camera[:, 2]
+    heading = np.array([forward[0], forward[1], 0.0]) / max(float(np.hypot(forward[0], forward[1])), 1e-9)
+    right = np.array([heading[1], -heading[0], 0.0])
+    drop = np.array([0.0, 0.0, HEADLIGHT_HEIGHT_M - mount_height])
+    lamps_world = np.array([camera.p_world_camera + heading * HEADLIGHT_AHEAD_M + right * side * HEADLIGHT_HALF_SPAN_M
+                            + drop for side in (-1.0, 1.0)])
+    return heading, lamps_world
+
+
+def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment, mount_height: float) -> np.ndarray:
+    """The lamps near enough to matter this frame plus, when on, the ego's headlights (they move with it; the
+    camera stands ``mount_height`` above the road).
 
     Lamps farther than LAMP_RANGE_M light the road below them to a few per cent of a near one and sit deep in
     the fog; leaving them out keeps the per-pixel light loop short.
@@ -127,11 +143,8 @@ def _frame_lights(packed: PackedScene, camera: PinholeCamera, env: Environment) 
         lamps_world = lamps_world[near]
     if env.headlights <= 0.0:
         return np.ascontiguousarray(lamps_world)
-    R = camera.R_world_camera
-    forward, right, down = R[:, 2], R[:, 0], R[:, 1]
-    heading = np.array([forward[0], forward[1], 0.0]) / max(float(np.hypot(forward[0], forward[1])), 1e-9)
-    lamps = [camera.p_world_camera + forward * 1.5 + right * side * 0.75 + down * 2.3 for side in (-1.0, 1.0)]
-    rows = np.array([light_row(p, HEADLIGHT_COLOR, env.headlights, heading, "low") for p in lamps])
+    heading, beams_world = headlight_positions(camera, mount_height)
+    rows = np.array([light_row(p, HEADLIGHT_COLOR, env.headlights, heading, "low") for p in beams_world])
     return np.concatenate([lamps_world.reshape(-1, LIGHT_COLUMNS), rows])
 
 
@@ -235,7 +248,7 @@ def _radiance(scene: CompiledScene, camera: PinholeCamera, threads: int,
     view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)
     lighting = frame_lighting(_env_vector(env), env.sun_dir_world, env.sun_color.astype(np.float64),
                               env.sky_zenith.astype(np.float64), env.sky_horizon.astype(np.float64),
-                              _frame_lights(packed, camera, env))
+                              _frame_lights(packed, camera, env, scene.ego.mount.z))
     geometry, road = _geometry(packed), _road_look(scene, packed)
     sun_shadow = SunShadow(shadows.depth, shadows.cells, shadows.params, shadows.R_light_world,
                            _sun_terms(scene, packed))

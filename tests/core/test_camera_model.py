@@ -13,11 +13,25 @@ from hypothesis import strategies as st
 from lanevil_core.camera import intrinsics_for, mounted_camera
 from lanevil_core.camera.cover import cover_camera
 from lanevil_core.camera.lens import distort, undistort
-from lanevil_core.camera.sensor import KEY, LUMA, development, filmic, metered_gain, white_balance_gains
+from lanevil_core.camera.sensor import (
+    BASE_GAIN,
+    KEY,
+    LUMA,
+    development,
+    filmic,
+    metered_gain,
+    white_balance_gains,
+)
 from lanevil_core.case import Camera, Case, CaseError, Sensor, parse_case
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.presets import CAMERA_PRESET_NAMES
 from lanevil_core.render import render_frame
+from lanevil_core.render.renderer import (
+    HEADLIGHT_AHEAD_M,
+    HEADLIGHT_HALF_SPAN_M,
+    HEADLIGHT_HEIGHT_M,
+    headlight_positions,
+)
 from lanevil_core.world.environment import SKY_AMBIENT_GAIN, SUN_SCALE, clear_sky, daylight
 
 
@@ -88,6 +102,31 @@ def test_metering_brings_the_frame_to_middle_gray_within_limits() -> None:
     dark = development(flat * 0.01, Sensor())
     bright = development(flat, Sensor())
     assert dark.iso_gain > bright.iso_gain and dark.shot > bright.shot  # noise rises with gain in low light
+
+
+def test_in_the_dark_the_gain_keeps_the_lit_road_below_clip() -> None:
+    night = np.full((64, 64, 3), 1e-4, np.float32)
+    night[40:] = 0.2  # the road in the headlights' beam under a black sky: the mean alone would ask for max gain
+    gain = metered_gain(night, Sensor())
+    assert BASE_GAIN <= gain < Sensor().max_gain and gain * 0.2 <= 1.0 + 1e-6
+    # by day (a gain below BASE_GAIN) highlights clip as before: the trimmed mean alone decides
+    day = np.full((64, 64, 3), 0.2, np.float32)
+    day[:16] = 5.0  # a bright sky over a quarter of the frame
+    assert metered_gain(day, Sensor()) < BASE_GAIN and metered_gain(day, Sensor()) * 5.0 > 1.0
+
+
+@pytest.mark.parametrize("height", [1.2, 1.55, 3.0])
+@pytest.mark.parametrize("pitch", [-3.0, 0.0, 3.5])
+def test_headlights_stand_on_the_car_under_a_camera_of_any_height_and_pitch(height: float, pitch: float) -> None:
+    # not a fixed drop below the camera (under a 1.55 m camera that put them under the road: a black night)
+    case = Case.model_validate({"camera": {"z": height, "pitch": pitch}, "road": {"type": "straight"}})
+    camera = compile_scene(case).ego.camera(0, (160, 90))
+    heading, beams_world = headlight_positions(camera, height)
+    ground_z = camera.p_world_camera[2] - height
+    np.testing.assert_allclose(beams_world[:, 2] - ground_z, HEADLIGHT_HEIGHT_M, atol=1e-9)
+    assert heading[2] == 0.0 and np.linalg.norm(heading) == pytest.approx(1.0)
+    np.testing.assert_allclose((beams_world - camera.p_world_camera)[:, :2] @ heading[:2], HEADLIGHT_AHEAD_M)
+    assert np.linalg.norm(beams_world[0] - beams_world[1]) == pytest.approx(2 * HEADLIGHT_HALF_SPAN_M)
 
 
 def _shadow_share(case: Case) -> float:
