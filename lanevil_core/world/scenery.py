@@ -331,6 +331,56 @@ def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Gene
     return out
 
 
+PARKED_SETBACK_M = 0.45  # a parked vehicle's side from the edge of the sidewalk (its footprint keeps 0.1 m more)
+PARKING_ROW_M = 2.6  # the depth of the row of parked vehicles beyond the sidewalk: a van's width and a door's room
+PARKED_GAP_M = (0.7, 2.5)  # bumper to bumper between parked vehicles
+DRIVEWAY_SHARE = 0.2  # the gaps that are an entrance or a driveway instead
+DRIVEWAY_GAP_M = (3.5, 9.0)
+JUNCTION_GAP_M = 8.0  # nobody parks this close to a crossing road's corridor
+PARKING_AHEAD_M = (15.0, 100.0)  # parked along the main road from this far behind the ego's start to this far
+# beyond its end, and along a junction's arms this far from the main road: further on they are a few pixels and
+# only cost triangles
+PARKING_ARM_M = 45.0
+
+
+def parking_occupancy(density: float) -> float:
+    """The share of the parking row's slots taken at a scene density: 0 for none, 0.33 at 1, 0.7 at 3."""
+    return float(1.0 - np.exp(-0.4 * density))
+
+
+def parked_cars(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """Rows of parked cars and vans beyond the sidewalk (kerb-parallel, facing the traffic of their side's lanes),
+    in car-paint colours; slots taken at ``parking_occupancy`` of the scene density, with gaps for driveways, none
+    within JUNCTION_GAP_M of a crossing road and only along the stretch the ego can see (``PARKING_AHEAD_M``)."""
+    occupancy = parking_occupancy(case.scene.density)
+    s_lo, s_hi = case.ego.start_s - PARKING_AHEAD_M[0], case.ego.start_s + case.ego.speed * (
+        case.ego.frames - 1) / case.ego.fps + PARKING_AHEAD_M[1]
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        placed: list[tuple[float, Mesh]] = []
+        s = piece.s_start + float(rng.uniform(0.0, 6.0))
+        while s < piece.line.length and occupancy > 0:
+            length, width, build = props.parked_vehicle(own_rng(rng))
+            parks = rng.random() < occupancy
+            gap = float(rng.uniform(*(DRIVEWAY_GAP_M if rng.random() < DRIVEWAY_SHARE else PARKED_GAP_M)))
+            t = side * (corridor_half_width(piece) + PARKED_SETBACK_M + width / 2)
+            spot = Spot(index, s + length / 2, t, facing_yaw(side), length / 2 + 0.1, width / 2 + 0.1)
+            seen = s_lo < spot.s < s_hi if index == 0 else spot.s < piece.s_start + PARKING_ARM_M
+            if parks and seen and _clear_of_junctions(clear, piece, spot) \
+                    and try_place(clear, piece, spot):
+                placed.append((s, transformed(build(), spot.T_world_local)))
+            s += length + gap
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"parked cars {label} piece {index}", "vehicle")
+    return out
+
+
+def _clear_of_junctions(clear: Clearance, piece: RoadPiece, spot: Spot) -> bool:
+    """Whether ``spot``'s ends keep JUNCTION_GAP_M from every other piece's corridor."""
+    ends = np.array([pose_on_road(piece.line, spot.s + ds, spot.t, 0.0)[:2, 3] for ds in (-spot.half_x, spot.half_x)])
+    return not clear.on_road(ends, margin=JUNCTION_GAP_M, skip=spot.index)
+
+
 def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
@@ -361,33 +411,36 @@ def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[
 
 
 def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
 
     def block(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(12.0, 28.0)), float(r.uniform(10.0, 18.0))
         height = float(r.choice([9.6, 12.8, 16.0, 19.2, 25.6]))
         shop = bool(r.random() < 0.5)
-        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop)
+        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop, lit=night)
 
-    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
-    if density > 0:  # a few street trees first; the blocks fill the frontage around them
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
+    if density > 0:  # a few street trees first, parked cars between them; the blocks fill the frontage behind
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
-        meshes += rows_of(network, clear, rng, block, (0.5, 2.5), (1.0 / density, 10.0 / density), "building")
+        meshes += parked_cars(case, network, clear, own_rng(rng))
+        meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
+                          (1.0 / density, 10.0 / density), "building")
         meshes += street_furniture(network, clear, own_rng(rng))
     return meshes
 
 
 def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
     if density <= 0:
         return []
 
     def home(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(8.0, 14.0)), float(r.uniform(7.0, 10.0))
-        return width, depth, lambda: props.house(r, width, depth)
+        return width, depth, lambda: props.house(r, width, depth, lit=night)
 
-    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
+    meshes += parked_cars(case, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
     meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
@@ -403,13 +456,13 @@ def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: 
 
 
 def _rural(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
     if density <= 0:
         return []
 
     def farm(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(9.0, 16.0)), float(r.uniform(7.0, 11.0))
-        return width, depth, lambda: props.house(r, width, depth, storeys=1, name="farmhouse")
+        return width, depth, lambda: props.house(r, width, depth, storeys=1, lit=night, name="farmhouse")
 
     meshes = greenery(network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)
     meshes += rows_of(network, clear, rng, farm, (25.0, 45.0), (90.0 / density, 200.0 / density), "farmhouse")
