@@ -603,6 +603,31 @@ def sign_post(rng: np.random.Generator, name: str = "sign") -> Mesh:
                  kind="pole", gloss=0.3)
 
 
+# Traffic signals: a dark housing of three lamps (red over amber over green), one lit; the lit lamp's radiance is
+# that of a signal's LEDs (thousands of cd/m2: about a sunlit white wall's by day, far above everything at night).
+SIGNAL_ASPECTS = ("red", "amber", "green")
+SIGNAL_LAMPS = ((0.9, 0.03, 0.02), (0.95, 0.45, 0.02), (0.05, 0.85, 0.45))
+SIGNAL_GLOW = 4.0
+SIGNAL_HOUSING = (0.015, 0.015, 0.017)
+SIGNAL_HEAD_Z_M = 2.9  # the head's lowest lamp's centre above the ground
+
+
+def traffic_signal(aspect: str, name: str = "traffic signal") -> Mesh:
+    """A traffic signal on a 3.6 m dark pole, its lamps towards -X (the driver coming along +X), ``aspect`` (one of
+    ``SIGNAL_ASPECTS``) lit, the other lamps dark glass (about 100 faces)."""
+    lit = SIGNAL_ASPECTS.index(aspect)
+    z_lamps = SIGNAL_HEAD_Z_M + 0.3 * np.arange(3)[::-1]
+    parts = [cylinder(0.06, 3.6, (0.0, 0.0, 1.8), SIGNAL_HOUSING, sections=8),
+             box((0.22, 0.34, 1.0), (-0.08, 0.0, SIGNAL_HEAD_Z_M + 0.3), SIGNAL_HOUSING),
+             box((0.02, 0.52, 1.2), (0.04, 0.0, SIGNAL_HEAD_Z_M + 0.3), SIGNAL_HOUSING)]  # backplate
+    for k, (color, z) in enumerate(zip(SIGNAL_LAMPS, z_lamps)):
+        on = k == lit
+        parts.append(box((0.02, 0.2, 0.2), (-0.2, 0.0, z), color if on else np.asarray(color) * 0.08,
+                         emission=np.asarray(color) * SIGNAL_GLOW if on else np.zeros(3)))
+        parts.append(box((0.14, 0.24, 0.03), (-0.26, 0.0, z + 0.12), SIGNAL_HOUSING))  # the visor over it
+    return merge(parts, name=name, kind="pole", gloss=0.3)
+
+
 # New Jersey barrier cross-section (y, z), metres: 0.61 m base, 0.15 m top, 0.81 m tall.
 JERSEY_PROFILE = ((-0.305, 0.0), (0.305, 0.0), (0.305, 0.075), (0.2, 0.33), (0.075, 0.81), (-0.075, 0.81),
                   (-0.2, 0.33), (-0.305, 0.075))

@@ -381,6 +381,55 @@ def _clear_of_junctions(clear: Clearance, piece: RoadPiece, spot: Spot) -> bool:
     return not clear.on_road(ends, margin=JUNCTION_GAP_M, skip=spot.index)
 
 
+SIGNAL_BACK_M = 1.5  # a traffic signal stands this far before the crossing road's corridor, on the sidewalk
+SIGNAL_CLEAR_OF_LAMP_M = 1.5  # and steps back from a street lamp this close
+AMBER_SHARE = 0.15  # the junctions caught with their signals changing
+
+
+def signal_poses(case: Case, network: RoadNetwork) -> list[tuple[int, float, float, float, float]]:
+    """(piece index, s, t, sidewalk height, yaw) of a traffic signal at each approach to the junction: on the
+    approaching traffic's sidewalk (right-hand traffic), SIGNAL_BACK_M before the crossing corridor, its lamps
+    towards that traffic."""
+    if len(network.pieces) < 2:
+        return []
+    main = network.main
+    poses = []
+    for sign in (-1.0, 1.0):  # main-road traffic along +s (sign -1: its sidewalk on the right) and along -s
+        kerb = sidewalk_kerb(main)
+        if kerb is not None:
+            s = case.road.junction_s + sign * (corridor_half_width(network.pieces[1]) + SIGNAL_BACK_M)
+            poses.append((0, s, sign * (kerb[0] + 0.6), kerb[1], 0.0 if sign < 0 else np.pi))
+    for index, arm in enumerate(network.pieces[1:], start=1):  # the arms' traffic comes towards the main road
+        kerb = sidewalk_kerb(arm)
+        if kerb is not None:
+            poses.append((index, corridor_half_width(main) + SIGNAL_BACK_M, kerb[0] + 0.6, kerb[1], np.pi))
+    return poses
+
+
+def traffic_signals(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """A traffic signal at each approach to a town junction (``signal_poses``): the main road's approaches show one
+    aspect, the arms' the other (red against green, or amber while changing)."""
+    main_aspect = "green" if rng.random() < 0.5 else "red"
+    other = "red" if main_aspect == "green" else "green"
+    if rng.random() < AMBER_SHARE:
+        main_aspect = "amber"
+    lamps = [(index, s) for _, index, s, _ in streetlight_poses(network, clear, STREETLIGHT_SPACING_M)]
+    out: list[Mesh] = []
+    for index, s, t, h, yaw in signal_poses(case, network):
+        piece = network.pieces[index]
+        away = -1.0 if index == 0 and yaw == 0.0 else 1.0  # back from the junction along the piece
+        for _ in range(4):
+            if not any(i == index and abs(s - s_lamp) < SIGNAL_CLEAR_OF_LAMP_M for i, s_lamp in lamps):
+                break
+            s += away * SIGNAL_CLEAR_OF_LAMP_M
+        T_world_local = pose_on_road(piece.line, s, t, yaw, h)
+        if clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
+            continue
+        aspect = main_aspect if index == 0 else other
+        out.append(transformed(props.traffic_signal(aspect, name=f"traffic signal {len(out) + 1}"), T_world_local))
+    return out
+
+
 def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
@@ -427,7 +476,7 @@ def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
         meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
                           (1.0 / density, 10.0 / density), "building")
         meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes
+    return meshes + traffic_signals(case, network, clear, own_rng(rng))
 
 
 def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
@@ -444,7 +493,7 @@ def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear:
     meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes
+    return meshes + traffic_signals(case, network, clear, own_rng(rng))
 
 
 def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:

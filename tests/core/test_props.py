@@ -254,3 +254,16 @@ def test_parked_vehicles_are_cheap_and_painted_from_the_palette() -> None:
         body = vehicle.colors[0]
         paints.add(int(np.argmin([np.abs(body / np.asarray(p) - 1.0).max() for p in props.CAR_PAINTS])))
     assert len(paints) >= 4  # white, black, grey, silver and more
+
+
+@pytest.mark.parametrize("aspect", props.SIGNAL_ASPECTS)
+def test_traffic_signal_lights_one_lamp_towards_the_driver(aspect: str) -> None:
+    signal = props.traffic_signal(aspect)
+    assert_renderable(signal)
+    lit = signal.emission.max(1) > 0
+    centre = signal.vertices[signal.faces[lit]].mean((0, 1))
+    assert centre[0] < -0.15 and 2.8 < centre[2] < 3.6  # on the head's face towards -X
+    order = props.SIGNAL_HEAD_Z_M + 0.3 * (2 - props.SIGNAL_ASPECTS.index(aspect))
+    assert abs(centre[2] - order) < 1e-6  # red on top, green at the bottom
+    np.testing.assert_allclose(signal.emission[lit][0], np.asarray(props.SIGNAL_LAMPS[props.SIGNAL_ASPECTS.index(
+        aspect)]) * props.SIGNAL_GLOW, rtol=1e-6)

@@ -167,3 +167,22 @@ def test_parked_cars_line_the_street_beyond_the_sidewalk(kind: SceneKind) -> Non
 def test_parked_cars_only_in_towns() -> None:
     for kind in ("highway", "rural", "tunnel_approach"):
         assert not [m for m in scenery(kind, "crossroad", 3.0)[1] if m.name.startswith("parked")], kind
+
+
+@pytest.mark.parametrize(("road", "approaches"), [("crossroad", 4), ("t_junction", 3), ("straight", 0)])
+def test_a_traffic_signal_at_each_approach_to_a_town_junction(road: str, approaches: int) -> None:
+    for kind in ("urban", "suburban"):
+        network, meshes = scenery(kind, road)
+        signals = [m for m in meshes if m.name.startswith("traffic signal")]
+        assert len(signals) == approaches, (kind, road)
+        for signal in signals:
+            lit = signal.emission.max(1) > 0
+            lamps = np.unique(signal.emission[lit].round(4), axis=0)
+            assert len(lamps) == 1 and lit.sum() == 12  # one lamp (a box) lit, the housing dark
+            s, t, _ = road_frame(network.main, signal.vertices)
+            foot = np.argmin(signal.vertices[:, 2])
+            kerb = network.main.half_width + sum(strip.width for strip in network.main.strips[:2])
+            assert abs(t[foot]) > kerb or any(  # beyond the kerb of the main road or of an arm
+                abs(road_frame(arm, signal.vertices[foot:foot + 1])[1][0]) > kerb for arm in network.pieces[1:])
+    _, rural = scenery("rural", road)
+    assert not [m for m in rural if m.name.startswith("traffic signal")]
