@@ -7,6 +7,7 @@ Dimensions are real (metres); colours are linear albedo.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,15 +80,19 @@ def _side_panels(polygon_xz: PointsLike, half_y: float, color: ColorLike) -> lis
     return panels
 
 
-def _wheels(xs: ColorLike, radius: float, half_track: float, tyre_width: float) -> list[Mesh]:
-    """Dark tyres with grey hubs at the axle positions ``xs``, both sides."""
+def _wheels(xs: ColorLike, radius: float, half_track: float, tyre_width: float, sections: int = 12) -> list[Mesh]:
+    """Dark tyres with grey hubs at the axle positions ``xs``, both sides; ``sections`` round a tyre (a hub has
+    two thirds as many; a tyre of fewer than 8 sections, too coarse for one, has none)."""
     parts = []
     for x in xs:
         for side in (-1.0, 1.0):
             y_out, y_in = side * half_track, side * (half_track - tyre_width)
-            parts.append(cylinder(radius, color=TYRE, segment=[(x, y_in, radius), (x, y_out, radius)], sections=12))
-            parts.append(cylinder(radius * 0.55, color=RIM, segment=[(x, y_out - side * 0.02, radius),
-                                                                     (x, y_out + side * 0.012, radius)], sections=8))
+            parts.append(cylinder(radius, color=TYRE, segment=[(x, y_in, radius), (x, y_out, radius)],
+                                  sections=sections))
+            if sections >= 8:
+                parts.append(cylinder(radius * 0.55, color=RIM, segment=[(x, y_out - side * 0.02, radius),
+                                                                         (x, y_out + side * 0.012, radius)],
+                                      sections=2 * sections // 3))
     return parts
 
 
@@ -98,8 +103,9 @@ def _lamps(x: float, z: float, half_y: float, extents: ColorLike, color: ColorLi
 
 
 def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, length: float = 4.5,
-        width: float = 1.8, height: float = 1.45, name: str = "car") -> Mesh:
-    """A saloon car (about 440 faces): body, glasshouse with dark windows, four wheels, head and tail lights."""
+        width: float = 1.8, height: float = 1.45, wheel_sections: int = 12, name: str = "car") -> Mesh:
+    """A saloon car (about 440 faces; 210 with 6 ``wheel_sections``): body, glasshouse with dark windows, four
+    wheels, head and tail lights."""
     hx, hy = length / 2, width / 2
     body = prism([(-hx, 0.22), (hx - 0.05, 0.22), (hx, 0.5), (hx - 0.2, 0.8), (-hx + 0.1, 0.86), (-hx, 0.6)],
                  -hy, hy, color)
@@ -114,7 +120,7 @@ def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, lengt
                           cabin_hy, GLASS)
     parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, False),
                           cabin_hy, GLASS)
-    parts += _wheels((0.3 * length, -0.3 * length), 0.33, hy + 0.01, 0.22)
+    parts += _wheels((0.3 * length, -0.3 * length), 0.33, hy + 0.01, 0.22, wheel_sections)
     parts += _lamps(hx - 0.1, 0.63, hy - 0.28, (0.18, 0.36, 0.12), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
     parts += _lamps(-hx + 0.02, 0.72, hy - 0.22, (0.1, 0.34, 0.13), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
     parts.append(box((0.1, width - 0.1, 0.16), (hx - 0.02, 0.0, 0.3), TRIM))
@@ -138,8 +144,9 @@ def _window_outline(rear: tuple[float, float], front: tuple[float, float], zb: f
 
 
 def van(color: ColorLike = (0.6, 0.6, 0.6), *, lights_on: bool = False, length: float = 5.2, width: float = 2.0,
-        height: float = 2.3, name: str = "van") -> Mesh:
-    """A panel van (about 410 faces): tall body with a short sloped nose, cab windows, four wheels, lamps."""
+        height: float = 2.3, wheel_sections: int = 12, name: str = "van") -> Mesh:
+    """A panel van (about 410 faces; 190 with 6 ``wheel_sections``): tall body with a short sloped nose, cab
+    windows, four wheels, lamps."""
     hx, hy = length / 2, width / 2
     nose_z, shield_x = 1.15, hx - 0.95
     body = prism([(-hx, 0.3), (hx, 0.3), (hx, 0.95), (hx - 0.25, nose_z), (shield_x, height), (-hx, height)],
@@ -152,7 +159,7 @@ def van(color: ColorLike = (0.6, 0.6, 0.6), *, lights_on: bool = False, length: 
     parts += [_panel([(-hx - 0.01, side * 0.08, 1.35), (-hx - 0.01, side * (hy - 0.12), 1.35),
                       (-hx - 0.01, side * (hy - 0.12), height - 0.2), (-hx - 0.01, side * 0.08, height - 0.2)],
                      (-1.0, 0.0, 0.0), GLASS) for side in (-1.0, 1.0)]
-    parts += _wheels((hx - 0.9, -hx + 1.0), 0.36, hy + 0.01, 0.24)
+    parts += _wheels((hx - 0.9, -hx + 1.0), 0.36, hy + 0.01, 0.24, wheel_sections)
     parts += _lamps(hx - 0.05, 0.82, hy - 0.25, (0.12, 0.36, 0.16), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
     parts += _lamps(-hx + 0.02, 0.9, hy - 0.1, (0.08, 0.14, 0.4), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
     parts.append(box((0.12, width - 0.05, 0.22), (hx, 0.0, 0.42), TRIM))
@@ -178,6 +185,29 @@ def truck(color: ColorLike = (0.05, 0.12, 0.4), *, cargo_color: ColorLike = (0.6
     parts += _lamps(hx - 0.03, 0.95, hy - 0.3, (0.1, 0.4, 0.2), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
     parts += _lamps(-hx + 0.02, 1.2, hy - 0.2, (0.08, 0.25, 0.15), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
     return merge(parts, name=name, kind="vehicle", gloss=0.4)
+
+
+# Car paint (linear albedo) and how common each is on the street: white, black, grey and silver most, then blue,
+# red, beige and green.
+CAR_PAINTS = ((0.7, 0.7, 0.68), (0.018, 0.018, 0.02), (0.1, 0.1, 0.11), (0.36, 0.37, 0.38), (0.02, 0.05, 0.2),
+              (0.42, 0.025, 0.02), (0.33, 0.27, 0.18), (0.03, 0.09, 0.05))
+CAR_PAINT_SHARES = (0.25, 0.2, 0.17, 0.16, 0.09, 0.08, 0.03, 0.02)
+VAN_SHARE = 0.15  # the parked vehicles that are panel vans
+
+
+PARKED_WHEEL_SECTIONS = 6  # parked vehicles stand in rows by the hundred: hexagonal wheels keep them cheap
+
+
+def parked_vehicle(rng: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
+    """A parked car or van in a drawn paint and size, lights off: (length, width, builder of its mesh)."""
+    paint = np.asarray(CAR_PAINTS[int(rng.choice(len(CAR_PAINTS), p=CAR_PAINT_SHARES))])
+    paint = np.clip(paint * rng.uniform(0.85, 1.15), 0.0, 1.0)
+    if rng.random() < VAN_SHARE:
+        length, width = float(rng.uniform(4.8, 5.6)), 2.0
+        return length, width, lambda: van(paint, length=length, width=width, wheel_sections=PARKED_WHEEL_SECTIONS)
+    length, width, height = float(rng.uniform(3.9, 4.9)), float(rng.uniform(1.72, 1.86)), float(rng.uniform(1.4, 1.6))
+    return length, width, lambda: car(paint, length=length, width=width, height=height,
+                                      wheel_sections=PARKED_WHEEL_SECTIONS)
 
 
 def _choose(rng: np.random.Generator | None, given: ColorLike | None, palette: tuple) -> FloatArray:
@@ -406,9 +436,11 @@ def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatAr
 
 
 def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0, height: float = 15.0, *,
-             facade: ColorLike | None = None, shopfront: bool = False, name: str = "building") -> Mesh:
+             facade: ColorLike | None = None, shopfront: bool = False, lit: bool = False,
+             name: str = "building") -> Mesh:
     """An apartment or office block: ``width`` along X, ``depth`` along Y, a grid of dark windows on every
-    facade, a parapet; ``shopfront`` darkens the ground floor of the front (+Y) facade."""
+    facade, a parapet; ``shopfront`` darkens the ground floor of the front (+Y) facade. ``lit`` (night): a share of
+    the windows glows (``light_windows``), and half the shops keep their window lit."""
     facade = _choose(rng, facade, FACADES)
     hy = depth / 2
     parts = [box((width, depth, height + 0.5), (0.0, 0.0, height / 2 - 0.25), facade),
@@ -419,8 +451,16 @@ def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0,
     first = 1 if shopfront else 0
     if shopfront:
         parts.append(box((width - 1.0, 0.1, 2.6), (0.0, hy, 1.6), glass))
+    panes = []
     for axis_len, across, sign, along_x in _facades_seen(width, depth):
-        parts += _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass, rng)
+        grid = _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass, rng)
+        parts += grid
+        panes += grid[1::3]
+    if lit:  # drawn after everything else, so a night block has the day's shape and colours
+        light_windows(panes, rng)
+        if shopfront and rng.random() < SHOP_LIT_SHARE:
+            glow = np.asarray(ROOM_LIGHTS[2], np.float32) * np.float32(rng.uniform(*SHOP_GLOW))
+            parts[2].emission = np.ascontiguousarray(np.broadcast_to(glow, (len(parts[2].faces), 3)))
     return merge(parts, name=name, kind="building", gloss=0.1)
 
 
@@ -429,6 +469,36 @@ def _facades_seen(width: float, depth: float) -> tuple[tuple[float, float, float
     road) and both ends; the back is never seen from the road."""
     hx, hy = width / 2, depth / 2
     return (width, hy, 1.0, True), (depth, hx, 1.0, False), (depth, hx, -1.0, False)
+
+
+# Rooms lit at night, seen through their windows (linear sRGB of the light): tungsten bulbs of 2700 K and 3000 K,
+# a neutral 4000 K LED or fluorescent tube, and the cold blue of a television or a screen, in these shares.
+ROOM_LIGHTS = ((1.0, 0.40, 0.095), (1.0, 0.46, 0.15), (1.0, 0.64, 0.37), (0.42, 0.58, 1.0))
+ROOM_LIGHT_SHARES = (0.4, 0.3, 0.15, 0.15)
+# Curtains drawn across a lit window pass a dimmer light tinted by their cloth: cream, orange, red.
+CURTAIN_TINTS = ((0.95, 0.85, 0.6), (1.0, 0.55, 0.25), (0.9, 0.25, 0.12))
+CURTAINED_SHARE = 0.4
+LIT_SHARE = (0.08, 0.45)  # the share of a building's windows lit at night, drawn per building
+WINDOW_GLOW = (0.05, 0.45)  # radiance of a lit window pane (times its light's colour): a few to tens of cd/m2,
+# against about 1 cd/m2 of a road under street lamps
+SHOP_LIT_SHARE = 0.5  # the shops whose window stays lit at night
+SHOP_GLOW = (0.2, 0.5)
+
+
+def light_windows(panes: list[Mesh], rng: np.random.Generator) -> None:
+    """Make a share (drawn from ``LIT_SHARE``) of the window panes glow: each lit pane gets one of ``ROOM_LIGHTS``
+    at a drawn brightness, dimmed and tinted where a curtain is drawn. ``panes`` are ``_window_grid``'s pane meshes
+    (two triangles per window: window k is faces k and k + n); their ``emission`` is set in place."""
+    share = float(rng.uniform(*LIT_SHARE))
+    for pane in panes:
+        n = len(pane.faces) // 2
+        lit = rng.random(n) < share
+        light = np.asarray(ROOM_LIGHTS)[rng.choice(len(ROOM_LIGHTS), n, p=ROOM_LIGHT_SHARES)]
+        curtain = np.asarray(CURTAIN_TINTS)[rng.integers(len(CURTAIN_TINTS), size=n)] * 0.45
+        curtained = rng.random(n) < CURTAINED_SHARE
+        glow = light * rng.uniform(*WINDOW_GLOW, (n, 1)) * np.where(curtained[:, None], curtain, 1.0)
+        glow[~lit] = 0.0
+        pane.emission = np.concatenate([glow, glow]).astype(np.float32)
 
 
 def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys: int, pitch: float,
@@ -474,8 +544,9 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
 
 
 def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
-          name: str = "house") -> Mesh:
-    """A detached house: walls, a gable roof (ridge along X), windows all round and a door on the +Y front."""
+          lit: bool = False, name: str = "house") -> Mesh:
+    """A detached house: walls, a gable roof (ridge along X), windows all round and a door on the +Y front;
+    ``lit`` (night): a share of the windows glows (``light_windows``)."""
     storeys = int(rng.integers(1, 3)) if storeys is None else storeys
     wall_h = 2.9 * storeys
     hx, hy = width / 2, depth / 2
@@ -486,8 +557,13 @@ def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, 
                    -hx - 0.3, hx + 0.3, _pick(rng, ROOFS), axis="x")]
     glass = np.asarray(GLASS) * 2.0
     pitch = float(rng.uniform(2.8, 3.6))
+    panes = []
     for span, across, sign, along_x in _facades_seen(width, depth):
-        parts += _window_grid(span, across, sign, along_x, storeys, pitch, 0, glass, rng)
+        grid = _window_grid(span, across, sign, along_x, storeys, pitch, 0, glass, rng)
+        parts += grid
+        panes += grid[1::3]
+    if lit:
+        light_windows(panes, rng)
     parts.append(_panel([(hx * 0.5 - 0.5, hy + 0.02, 0.0), (hx * 0.5 + 0.5, hy + 0.02, 0.0),
                          (hx * 0.5 + 0.5, hy + 0.02, 2.1), (hx * 0.5 - 0.5, hy + 0.02, 2.1)],
                         (0.0, 1.0, 0.0), (0.12, 0.06, 0.03)))
@@ -525,6 +601,31 @@ def sign_post(rng: np.random.Generator, name: str = "sign") -> Mesh:
              box((0.012, 0.44, 0.44), (-0.012, 0.0, 2.55), face)]
     return merge([cylinder(0.035, 2.9, (0.03, 0.0, 1.45), (0.45, 0.46, 0.47), sections=6), *plate], name=name,
                  kind="pole", gloss=0.3)
+
+
+# Traffic signals: a dark housing of three lamps (red over amber over green), one lit; the lit lamp's radiance is
+# that of a signal's LEDs (thousands of cd/m2: about a sunlit white wall's by day, far above everything at night).
+SIGNAL_ASPECTS = ("red", "amber", "green")
+SIGNAL_LAMPS = ((0.9, 0.03, 0.02), (0.95, 0.45, 0.02), (0.05, 0.85, 0.45))
+SIGNAL_GLOW = 4.0
+SIGNAL_HOUSING = (0.015, 0.015, 0.017)
+SIGNAL_HEAD_Z_M = 2.9  # the head's lowest lamp's centre above the ground
+
+
+def traffic_signal(aspect: str, name: str = "traffic signal") -> Mesh:
+    """A traffic signal on a 3.6 m dark pole, its lamps towards -X (the driver coming along +X), ``aspect`` (one of
+    ``SIGNAL_ASPECTS``) lit, the other lamps dark glass (about 100 faces)."""
+    lit = SIGNAL_ASPECTS.index(aspect)
+    z_lamps = SIGNAL_HEAD_Z_M + 0.3 * np.arange(3)[::-1]
+    parts = [cylinder(0.06, 3.6, (0.0, 0.0, 1.8), SIGNAL_HOUSING, sections=8),
+             box((0.22, 0.34, 1.0), (-0.08, 0.0, SIGNAL_HEAD_Z_M + 0.3), SIGNAL_HOUSING),
+             box((0.02, 0.52, 1.2), (0.04, 0.0, SIGNAL_HEAD_Z_M + 0.3), SIGNAL_HOUSING)]  # backplate
+    for k, (color, z) in enumerate(zip(SIGNAL_LAMPS, z_lamps)):
+        on = k == lit
+        parts.append(box((0.02, 0.2, 0.2), (-0.2, 0.0, z), color if on else np.asarray(color) * 0.08,
+                         emission=np.asarray(color) * SIGNAL_GLOW if on else np.zeros(3)))
+        parts.append(box((0.14, 0.24, 0.03), (-0.26, 0.0, z + 0.12), SIGNAL_HOUSING))  # the visor over it
+    return merge(parts, name=name, kind="pole", gloss=0.3)
 
 
 # New Jersey barrier cross-section (y, z), metres: 0.61 m base, 0.15 m top, 0.81 m tall.

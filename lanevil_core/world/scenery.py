@@ -331,6 +331,105 @@ def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Gene
     return out
 
 
+PARKED_SETBACK_M = 0.45  # a parked vehicle's side from the edge of the sidewalk (its footprint keeps 0.1 m more)
+PARKING_ROW_M = 2.6  # the depth of the row of parked vehicles beyond the sidewalk: a van's width and a door's room
+PARKED_GAP_M = (0.7, 2.5)  # bumper to bumper between parked vehicles
+DRIVEWAY_SHARE = 0.2  # the gaps that are an entrance or a driveway instead
+DRIVEWAY_GAP_M = (3.5, 9.0)
+JUNCTION_GAP_M = 8.0  # nobody parks this close to a crossing road's corridor
+PARKING_AHEAD_M = (15.0, 100.0)  # parked along the main road from this far behind the ego's start to this far
+# beyond its end, and along a junction's arms this far from the main road: further on they are a few pixels and
+# only cost triangles
+PARKING_ARM_M = 45.0
+
+
+def parking_occupancy(density: float) -> float:
+    """The share of the parking row's slots taken at a scene density: 0 for none, 0.33 at 1, 0.7 at 3."""
+    return float(1.0 - np.exp(-0.4 * density))
+
+
+def parked_cars(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """Rows of parked cars and vans beyond the sidewalk (kerb-parallel, facing the traffic of their side's lanes),
+    in car-paint colours; slots taken at ``parking_occupancy`` of the scene density, with gaps for driveways, none
+    within JUNCTION_GAP_M of a crossing road and only along the stretch the ego can see (``PARKING_AHEAD_M``)."""
+    occupancy = parking_occupancy(case.scene.density)
+    s_lo, s_hi = case.ego.start_s - PARKING_AHEAD_M[0], case.ego.start_s + case.ego.speed * (
+        case.ego.frames - 1) / case.ego.fps + PARKING_AHEAD_M[1]
+    out: list[Mesh] = []
+    for index, piece, side in sides(network):
+        placed: list[tuple[float, Mesh]] = []
+        s = piece.s_start + float(rng.uniform(0.0, 6.0))
+        while s < piece.line.length and occupancy > 0:
+            length, width, build = props.parked_vehicle(own_rng(rng))
+            parks = rng.random() < occupancy
+            gap = float(rng.uniform(*(DRIVEWAY_GAP_M if rng.random() < DRIVEWAY_SHARE else PARKED_GAP_M)))
+            t = side * (corridor_half_width(piece) + PARKED_SETBACK_M + width / 2)
+            spot = Spot(index, s + length / 2, t, facing_yaw(side), length / 2 + 0.1, width / 2 + 0.1)
+            seen = s_lo < spot.s < s_hi if index == 0 else spot.s < piece.s_start + PARKING_ARM_M
+            if parks and seen and _clear_of_junctions(clear, piece, spot) \
+                    and try_place(clear, piece, spot):
+                placed.append((s, transformed(build(), spot.T_world_local)))
+            s += length + gap
+        label = "left" if side > 0 else "right"
+        out += _grouped(placed, f"parked cars {label} piece {index}", "vehicle")
+    return out
+
+
+def _clear_of_junctions(clear: Clearance, piece: RoadPiece, spot: Spot) -> bool:
+    """Whether ``spot``'s ends keep JUNCTION_GAP_M from every other piece's corridor."""
+    ends = np.array([pose_on_road(piece.line, spot.s + ds, spot.t, 0.0)[:2, 3] for ds in (-spot.half_x, spot.half_x)])
+    return not clear.on_road(ends, margin=JUNCTION_GAP_M, skip=spot.index)
+
+
+SIGNAL_BACK_M = 1.5  # a traffic signal stands this far before the crossing road's corridor, on the sidewalk
+SIGNAL_CLEAR_OF_LAMP_M = 1.5  # and steps back from a street lamp this close
+AMBER_SHARE = 0.15  # the junctions caught with their signals changing
+
+
+def signal_poses(case: Case, network: RoadNetwork) -> list[tuple[int, float, float, float, float]]:
+    """(piece index, s, t, sidewalk height, yaw) of a traffic signal at each approach to the junction: on the
+    approaching traffic's sidewalk (right-hand traffic), SIGNAL_BACK_M before the crossing corridor, its lamps
+    towards that traffic."""
+    if len(network.pieces) < 2:
+        return []
+    main = network.main
+    poses = []
+    for sign in (-1.0, 1.0):  # main-road traffic along +s (sign -1: its sidewalk on the right) and along -s
+        kerb = sidewalk_kerb(main)
+        if kerb is not None:
+            s = case.road.junction_s + sign * (corridor_half_width(network.pieces[1]) + SIGNAL_BACK_M)
+            poses.append((0, s, sign * (kerb[0] + 0.6), kerb[1], 0.0 if sign < 0 else np.pi))
+    for index, arm in enumerate(network.pieces[1:], start=1):  # the arms' traffic comes towards the main road
+        kerb = sidewalk_kerb(arm)
+        if kerb is not None:
+            poses.append((index, corridor_half_width(main) + SIGNAL_BACK_M, kerb[0] + 0.6, kerb[1], np.pi))
+    return poses
+
+
+def traffic_signals(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """A traffic signal at each approach to a town junction (``signal_poses``): the main road's approaches show one
+    aspect, the arms' the other (red against green, or amber while changing)."""
+    main_aspect = "green" if rng.random() < 0.5 else "red"
+    other = "red" if main_aspect == "green" else "green"
+    if rng.random() < AMBER_SHARE:
+        main_aspect = "amber"
+    lamps = [(index, s) for _, index, s, _ in streetlight_poses(network, clear, STREETLIGHT_SPACING_M)]
+    out: list[Mesh] = []
+    for index, s, t, h, yaw in signal_poses(case, network):
+        piece = network.pieces[index]
+        away = -1.0 if index == 0 and yaw == 0.0 else 1.0  # back from the junction along the piece
+        for _ in range(4):
+            if not any(i == index and abs(s - s_lamp) < SIGNAL_CLEAR_OF_LAMP_M for i, s_lamp in lamps):
+                break
+            s += away * SIGNAL_CLEAR_OF_LAMP_M
+        T_world_local = pose_on_road(piece.line, s, t, yaw, h)
+        if clear.on_road(T_world_local[None, :2, 3], margin=1.0, skip=index):
+            continue
+        aspect = main_aspect if index == 0 else other
+        out.append(transformed(props.traffic_signal(aspect, name=f"traffic signal {len(out) + 1}"), T_world_local))
+    return out
+
+
 def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
@@ -361,37 +460,40 @@ def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[
 
 
 def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
 
     def block(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(12.0, 28.0)), float(r.uniform(10.0, 18.0))
         height = float(r.choice([9.6, 12.8, 16.0, 19.2, 25.6]))
         shop = bool(r.random() < 0.5)
-        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop)
+        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop, lit=night)
 
-    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
-    if density > 0:  # a few street trees first; the blocks fill the frontage around them
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
+    if density > 0:  # a few street trees first, parked cars between them; the blocks fill the frontage behind
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
-        meshes += rows_of(network, clear, rng, block, (0.5, 2.5), (1.0 / density, 10.0 / density), "building")
+        meshes += parked_cars(case, network, clear, own_rng(rng))
+        meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
+                          (1.0 / density, 10.0 / density), "building")
         meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes
+    return meshes + traffic_signals(case, network, clear, own_rng(rng))
 
 
 def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
     if density <= 0:
         return []
 
     def home(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(8.0, 14.0)), float(r.uniform(7.0, 10.0))
-        return width, depth, lambda: props.house(r, width, depth)
+        return width, depth, lambda: props.house(r, width, depth, lit=night)
 
-    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=is_night(case.sun.altitude))
+    meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
+    meshes += parked_cars(case, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
     meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes
+    return meshes + traffic_signals(case, network, clear, own_rng(rng))
 
 
 def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
@@ -403,13 +505,13 @@ def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: 
 
 
 def _rural(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density = case.scene.density
+    density, night = case.scene.density, is_night(case.sun.altitude)
     if density <= 0:
         return []
 
     def farm(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(9.0, 16.0)), float(r.uniform(7.0, 11.0))
-        return width, depth, lambda: props.house(r, width, depth, storeys=1, name="farmhouse")
+        return width, depth, lambda: props.house(r, width, depth, storeys=1, lit=night, name="farmhouse")
 
     meshes = greenery(network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)
     meshes += rows_of(network, clear, rng, farm, (25.0, 45.0), (90.0 / density, 200.0 / density), "farmhouse")

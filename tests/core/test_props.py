@@ -214,3 +214,56 @@ def test_primitives_reuse_their_geometry_and_hand_out_meshes_of_their_own() -> N
     assert np.array_equal(box([1.0, 2.0, 0.5], center=np.array([0.0, 1.0, 0.25])).vertices.max(0), (0.5, 2.0, 0.5))
     with pytest.raises(ValueError, match="height or a segment"):
         cylinder(0.3)
+
+
+@pytest.mark.parametrize(("build", "half"), [
+    (lambda rng, lit: props.building(rng, 22.0, 12.0, 19.2, shopfront=True, lit=lit), (11.0, 6.0)),
+    (lambda rng, lit: props.house(rng, 11.0, 8.0, storeys=2, lit=lit), (5.5, 4.0))])
+def test_lit_windows_glow_at_night_only(build, half) -> None:
+    day, night = build(RNG(3), False), build(RNG(3), True)
+    assert day.emission is None
+    # the night's building is the day's, face for face, but for its light
+    np.testing.assert_array_equal(day.vertices, night.vertices)
+    np.testing.assert_array_equal(day.colors, night.colors)
+    glowing = night.emission.max(1) > 0
+    centre = night.vertices[night.faces].mean(1)
+    on_facade = (np.abs(np.abs(centre[:, 0]) - half[0]) < 0.1) | (np.abs(np.abs(centre[:, 1]) - half[1]) < 0.1)
+    assert glowing.any() and on_facade[glowing].all()  # panes (and a shop window) glow, not walls or roof
+    lights = night.emission[glowing]
+    assert (lights[:, 0] > lights[:, 2]).mean() > 0.5  # mostly warm lamps, some cold screens
+    np.testing.assert_array_equal(build(RNG(3), True).emission, night.emission)  # deterministic
+
+
+def test_lit_share_varies_from_building_to_building() -> None:
+    shares = []
+    for seed in range(6):
+        night = props.house(RNG(seed), 12.0, 8.0, storeys=2, lit=True)
+        shares.append(int((night.emission.max(1) > 0).sum()))  # same house, same windows: a drawn share lit
+    assert max(shares) > 2 * min(shares)
+
+
+def test_parked_vehicles_are_cheap_and_painted_from_the_palette() -> None:
+    paints = set()
+    for seed in range(40):
+        length, width, build = props.parked_vehicle(RNG(seed))
+        vehicle = build()
+        assert_renderable(vehicle)
+        assert len(vehicle.faces) <= 215 and vehicle.emission is None  # lights off
+        size = extents(vehicle)
+        assert abs(size[0] - length) < 0.1 and abs(size[1] - width) < 0.1 and vehicle.vertices[:, 2].min() > -1e-6
+        body = vehicle.colors[0]
+        paints.add(int(np.argmin([np.abs(body / np.asarray(p) - 1.0).max() for p in props.CAR_PAINTS])))
+    assert len(paints) >= 4  # white, black, grey, silver and more
+
+
+@pytest.mark.parametrize("aspect", props.SIGNAL_ASPECTS)
+def test_traffic_signal_lights_one_lamp_towards_the_driver(aspect: str) -> None:
+    signal = props.traffic_signal(aspect)
+    assert_renderable(signal)
+    lit = signal.emission.max(1) > 0
+    centre = signal.vertices[signal.faces[lit]].mean((0, 1))
+    assert centre[0] < -0.15 and 2.8 < centre[2] < 3.6  # on the head's face towards -X
+    order = props.SIGNAL_HEAD_Z_M + 0.3 * (2 - props.SIGNAL_ASPECTS.index(aspect))
+    assert abs(centre[2] - order) < 1e-6  # red on top, green at the bottom
+    np.testing.assert_allclose(signal.emission[lit][0], np.asarray(props.SIGNAL_LAMPS[props.SIGNAL_ASPECTS.index(
+        aspect)]) * props.SIGNAL_GLOW, rtol=1e-6)

@@ -144,3 +144,45 @@ def test_tunnel_portal_spans_the_road_ahead_of_the_ego() -> None:
     assert lintel.any()
     s_face = s[lintel].min()
     assert case.ego.start_s + 145.0 < s_face < case.ego.start_s + 255.0
+
+
+@pytest.mark.parametrize("kind", ["urban", "suburban"])
+def test_parked_cars_line_the_street_beyond_the_sidewalk(kind: SceneKind) -> None:
+    """Rows of parked vehicles (kind ``vehicle``: test_nothing_stands_on_the_road keeps them off the carriageway
+    and the sidewalk), more at a higher density, none at 0, none in the junction's mouth."""
+    def parked(density: float) -> list[Mesh]:
+        return [m for m in scenery(kind, "crossroad", density)[1] if m.name.startswith("parked cars")]
+
+    counts = [sum(len(m.faces) for m in parked(d)) for d in (0.0, 1.0, 3.0)]
+    assert counts[0] == 0 < counts[1] < counts[2], counts
+    network, _ = scenery(kind, "crossroad", 3.0)
+    points = np.concatenate([m.vertices for m in parked(3.0) if " piece 0 " in m.name])  # along the main road
+    for arm in network.pieces[1:]:
+        s, t, _ = road_frame(arm, points)
+        near_arm = (s > -5.0) & (s < arm.line.length) & (np.abs(t) < corridor_half_width(arm) + 5.0)
+        assert not near_arm.any()  # a gap where the crossing road meets the street
+    assert {m.kind for m in parked(1.0)} == {"vehicle"}
+
+
+def test_parked_cars_only_in_towns() -> None:
+    for kind in ("highway", "rural", "tunnel_approach"):
+        assert not [m for m in scenery(kind, "crossroad", 3.0)[1] if m.name.startswith("parked")], kind
+
+
+@pytest.mark.parametrize(("road", "approaches"), [("crossroad", 4), ("t_junction", 3), ("straight", 0)])
+def test_a_traffic_signal_at_each_approach_to_a_town_junction(road: str, approaches: int) -> None:
+    for kind in ("urban", "suburban"):
+        network, meshes = scenery(kind, road)
+        signals = [m for m in meshes if m.name.startswith("traffic signal")]
+        assert len(signals) == approaches, (kind, road)
+        for signal in signals:
+            lit = signal.emission.max(1) > 0
+            lamps = np.unique(signal.emission[lit].round(4), axis=0)
+            assert len(lamps) == 1 and lit.sum() == 12  # one lamp (a box) lit, the housing dark
+            s, t, _ = road_frame(network.main, signal.vertices)
+            foot = np.argmin(signal.vertices[:, 2])
+            kerb = network.main.half_width + sum(strip.width for strip in network.main.strips[:2])
+            assert abs(t[foot]) > kerb or any(  # beyond the kerb of the main road or of an arm
+                abs(road_frame(arm, signal.vertices[foot:foot + 1])[1][0]) > kerb for arm in network.pieces[1:])
+    _, rural = scenery("rural", road)
+    assert not [m for m in rural if m.name.startswith("traffic signal")]
