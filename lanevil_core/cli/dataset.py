@@ -58,9 +58,9 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run_dataset(args: argparse.Namespace) -> int:
     from ..dataset import PlanError, Settings, generate_dataset
-    from ..dataset.plan import world_flags_error
     from ..dataset.distributed import SchedulerError, check_scheduler_address, run_dask
     from ..dataset.local import LocalPool
+    from ..dataset.plan import world_flags_error
     from ..dataset.run import Executor
 
     if not args.cases.is_dir():

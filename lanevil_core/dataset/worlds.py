@@ -47,7 +47,8 @@ class WorldRanges:
             weathered slabs' 0.21); tint: the red and blue channels moved by up to this share (warm or cool).
         lane_width_m: lane width (m); the lane count stays the variation's own draw.
         bend_radius_m: radius of bends and S-curves (m); grade: slope of uphill and downhill roads.
-        traffic_share: share of variations with traffic; traffic_severities: the ``vehicle`` illusion's levels, one drawn.
+        traffic_share: share of variations with traffic; traffic_severities: the ``vehicle`` illusion's levels,
+            one drawn.
         camera: field of view, mount height and pitch of the cameras (the train world leaves the camera to
             ``--vary-camera``, whose ranges these are; the held-out world draws its own).
         draws_camera: whether the world draws the camera (through ``camera.variation.random_camera``).

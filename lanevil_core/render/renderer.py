@@ -164,10 +164,10 @@ def _surface_table(network: RoadNetwork) -> FloatArray:
 
 def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
     fine, coarse = noise_textures()
-    return RoadLook(_surface_table(scene.network), packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
-                    float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
-                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params,
-                    float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)))
+    return RoadLook(_surface_table(scene.network), packed.stripes, packed.stripe_index,
+                    float(scene.network.lanes_per_direction), float(scene.network.lane_width), packed.layers.texels,
+                    packed.layers.table, packed.layers.first_level, fine, coarse, packed.overhead,
+                    packed.overhead_params, float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)))
 
 
 def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:
