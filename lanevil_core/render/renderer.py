@@ -14,8 +14,8 @@ from ..camera import PinholeCamera
 from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
-from ..typed import MATERIALS, Float32Array, FloatArray, IntArray, UInt8Array
-from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
+from ..typed import Float32Array, FloatArray, IntArray, UInt8Array
+from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR, road_albedo
 from ..world.road_layout import RoadNetwork
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
@@ -155,11 +155,7 @@ def _geometry(packed: PackedScene) -> Geometry:
 
 def _surface_table(network: RoadNetwork) -> FloatArray:
     """The road materials' table, the carriageway's row in the case's own colour when it has one."""
-    if network.surface_color is None:
-        return SURFACE_TABLE
-    albedo = MATERIAL_ALBEDO.copy()
-    albedo[MATERIALS.index(network.main.carriageway)] = network.surface_color
-    return surface_table(albedo)
+    return SURFACE_TABLE if network.surface_color is None else surface_table(road_albedo(network))
 
 
 def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:

@@ -150,6 +150,24 @@ def test_surface_color_round_trips_and_changes_the_road() -> None:
         parse_case(data)
 
 
+def test_surface_color_lightens_the_rendered_road_and_its_gltf() -> None:
+    from lanevil_core.export.case import scene_glb
+    from lanevil_core.pipeline.compile import compile_scene
+    from lanevil_core.render import render_frame
+    from lanevil_core.world.scene import ID_ROAD, ID_SKY
+
+    data = load_case(CLEAN / "00_straight_urban.json").model_dump()
+    plain = compile_scene(parse_case(data))
+    data["road"]["surface_color"] = (0.3, 0.3, 0.3)
+    grey = compile_scene(parse_case(data))
+    dark, light = render_frame(plain, 0, (160, 90)), render_frame(grey, 0, (160, 90))
+    road, sky = dark.object_id == ID_ROAD, dark.object_id == ID_SKY
+    assert np.array_equal(road, light.object_id == ID_ROAD)
+    assert light.rgb[road].mean() > dark.rgb[road].mean() + 30
+    assert abs(float(light.rgb[sky].mean()) - float(dark.rgb[sky].mean())) < 2.0  # the sky stays
+    assert scene_glb(plain) != scene_glb(grey)
+
+
 def test_plan_names_world_folders_and_records_the_draw() -> None:
     sources = discover_cases(CLEAN)
     plan = build_plan(sources, Settings(train_frames=10, seed=1, vary_world=True, heldout=True),
