@@ -60,7 +60,7 @@ def _run_dataset(args: argparse.Namespace) -> int:
     from ..dataset import PlanError, Settings, generate_dataset
     from ..dataset.distributed import SchedulerError, check_scheduler_address, run_dask
     from ..dataset.local import LocalPool
-    from ..dataset.plan import world_flags_error
+    from ..dataset.plan import check_world_flags
     from ..dataset.run import Executor
 
     if not args.cases.is_dir():
@@ -77,7 +77,7 @@ def _run_dataset(args: argparse.Namespace) -> int:
                         sampling=args.sampling, camera=args.camera, vary_camera=args.vary_camera,
                         vary_world=args.vary_world, heldout=args.heldout)
     try:  # checked before workers start: a bad combination is one line
-        world_flags_error(settings)
+        check_world_flags(settings)
     except PlanError as error:
         raise UsageError(str(error)) from None
     if args.scheduler is not None:

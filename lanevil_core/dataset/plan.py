@@ -434,11 +434,11 @@ def split_sources(sources: list[SourceCase], settings: Settings) -> tuple[list[S
                         "seed the train split, sized by --train-frames")
     if not typed and settings.train_frames <= 0:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
-    world_flags_error(settings)
+    check_world_flags(settings)
     return typed, clean
 
 
-def world_flags_error(settings: Settings) -> None:
+def check_world_flags(settings: Settings) -> None:
     """Raise ``PlanError`` for world flags that cannot be honoured: ``--heldout`` without ``--vary-world``, a
     held-out split with train cameras (``--vary-camera``) or one fixed camera (``--camera``), a world draw with no
     train frames."""

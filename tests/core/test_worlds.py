@@ -20,9 +20,9 @@ from lanevil_core.dataset.plan import (
     PlanError,
     Settings,
     build_plan,
+    check_world_flags,
     discover_cases,
     train_variation,
-    world_flags_error,
 )
 from lanevil_core.dataset.worlds import (
     HELDOUT_AXES,
@@ -184,7 +184,7 @@ def test_plan_names_world_folders_and_records_the_draw() -> None:
 ])
 def test_flag_combinations_that_cannot_be_honoured(settings: Settings, message: str) -> None:
     with pytest.raises(PlanError, match=message):
-        world_flags_error(settings)
+        check_world_flags(settings)
 
 
 @pytest.mark.parametrize(("flags", "message"), [
