@@ -13,7 +13,18 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializerFunctionWrapHandler,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    ValidationError,
+    model_serializer,
+    model_validator,
+)
 
 from .files import write_atomic
 from .illusions import IllusionSpec
@@ -119,6 +130,11 @@ class Road(_Model):
         description="false removes every lane marking from the world (the paint-free control: the lane labels "
         "stay, so a detector that still finds the lanes reads the road's layout, not its paint)",
     )
+    surface_color: RGB | None = Field(
+        None,
+        description="albedo of the carriageway's material (linear RGB: a darker or lighter asphalt, a fresh or "
+        "aged concrete); empty = the material's own (asphalt 0.055, slabs 0.21)",
+    )
 
     @model_validator(mode="after")
     def _fill_markings(self) -> Road:
@@ -133,6 +149,15 @@ class Road(_Model):
         if self.junction_s >= self.length - 20:
             raise ValueError("junction_s must lie at least 20 m before the end of the road")
         return self
+
+    @model_serializer(mode="wrap")
+    def _omit_own_surface(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        # A case that keeps its material's own colour is written as before the field existed (same bytes, same
+        # sha256 in dataset manifests).
+        data: dict[str, Any] = handler(self)
+        if self.surface_color is None:
+            data.pop("surface_color", None)
+        return data
 
 
 class Scene(_Model):

@@ -28,6 +28,12 @@ _TABLE: Final[dict[str, tuple[float, float, float, float, float, float]]] = {
 PRESET_NAMES: Final[tuple[str, ...]] = tuple(_TABLE)
 
 
+def sun_intensity(altitude_deg: float, cloudiness: float) -> float:
+    """Luminance of the direct sun (1 = clear noon) for a sun altitude and cloud cover (0-100): overcast skies dim
+    it, night has none."""
+    return 0.0 if altitude_deg <= 0 else round(1.0 - 0.7 * cloudiness / 100.0, 3)
+
+
 def preset_values(name: str) -> dict[str, dict[str, float]]:
     """Return ``{"weather": {...}, "sun": {...}}`` field values for a preset name.
 
@@ -50,8 +56,7 @@ def preset_values(name: str) -> dict[str, dict[str, float]]:
         "sun": {
             "altitude": altitude,
             "azimuth": 0.0,
-            # Overcast skies dim the direct sun; night has none.
-            "intensity": 0.0 if altitude <= 0 else round(1.0 - 0.7 * cloud / 100.0, 3),
+            "intensity": sun_intensity(altitude, cloud),
         },
     }
 

@@ -28,7 +28,7 @@ from lanevil_core.camera import PinholeCamera, ego_camera
 from lanevil_core.case import Case
 from lanevil_core.images import linear_to_srgb as _linear_to_srgb
 from lanevil_core.typed import Float32Array, FloatArray, IntArray
-from lanevil_core.world.paint import MATERIAL_ALBEDO, road_paint
+from lanevil_core.world.paint import road_albedo, road_paint
 from lanevil_core.world.primitives import flat_trimesh
 from lanevil_core.world.road_layout import RoadNetwork
 from lanevil_core.world.road_mesh import RoadSurface, road_surface
@@ -66,7 +66,7 @@ def mesh_parts(meshes: Sequence[Mesh]) -> list[tuple[FloatArray, IntArray, Float
 def road_parts(surface: RoadSurface, network: RoadNetwork, case: Case) -> list[tuple[FloatArray, IntArray,
                                                                                      Float32Array]]:
     """Road surface (coloured by material) and lane paint, as in ``export.scene_glb``."""
-    return [(surface.vertices, surface.faces, MATERIAL_ALBEDO[surface.material]),
+    return [(surface.vertices, surface.faces, road_albedo(network)[surface.material]),
             road_paint(case.road).mesh(network)]
 
 

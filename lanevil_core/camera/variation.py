@@ -6,6 +6,7 @@ so what a caller draws afterwards does not shift."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -59,14 +60,45 @@ def _height(u: float) -> float:
     return _pick((u - CAR_HEIGHT_SHARE) / (1.0 - CAR_HEIGHT_SHARE), (CAR_HEIGHT_M[1], HEIGHT_M[1]), 2)
 
 
-def random_camera(rng: np.random.Generator, size: tuple[int, int] = (1280, 720)) -> dict[str, Any]:
-    """Camera fields (a dict for ``Case.camera``) of an image of ``size`` drawn from the ranges above, always
-    ``DRAWS`` uniform draws."""
+Spans = tuple[tuple[float, float], ...]  # one or more (lo, hi) intervals a value is drawn from
+
+
+@dataclass(frozen=True)
+class MountSpans:
+    """Where a drawn camera's field of view (degrees), mount height (m) and pitch (degrees) may lie instead of
+    the ranges above (a held-out draw: cameras outside what the train split saw)."""
+
+    fov_deg: Spans
+    height_m: Spans
+    pitch_deg: Spans
+
+
+def pick_spans(u: float, spans: Spans, digits: int = 3) -> float:
+    """The value at ``u`` (0-1) along the intervals of ``spans`` laid end to end (each as likely as its length):
+    one uniform draw whatever the number of intervals."""
+    total = sum(hi - lo for lo, hi in spans)
+    at = float(u) * total
+    for lo, hi in spans:
+        if at <= hi - lo:
+            return round(lo + at, digits)
+        at -= hi - lo
+    return round(spans[-1][1], digits)
+
+
+def random_camera(rng: np.random.Generator, size: tuple[int, int] = (1280, 720),
+                  spans: MountSpans | None = None) -> dict[str, Any]:
+    """Camera fields (a dict for ``Case.camera``) of an image of ``size`` drawn from the ranges above (field of
+    view, height and pitch from ``spans`` when given), always ``DRAWS`` uniform draws."""
     u = rng.uniform(0.0, 1.0, DRAWS)
     camera = camera_preset_values(CAMERA_PRESET_NAMES[int(u[0] * len(CAMERA_PRESET_NAMES))])
     camera.update(width=size[0], height=size[1])
-    camera.update(fov=_pick(u[1], HFOV_DEG, 1), z=_height(u[2]), x=_pick(u[3], AHEAD_M, 2),
-                  pitch=_pick(u[4], PITCH_DEG, 2), roll=_pick(u[5], ROLL_DEG, 2), yaw=_pick(u[6], YAW_DEG, 2),
+    if spans is None:
+        fov, height, pitch = _pick(u[1], HFOV_DEG, 1), _height(u[2]), _pick(u[4], PITCH_DEG, 2)
+    else:
+        fov = pick_spans(u[1], spans.fov_deg, 1)
+        height, pitch = pick_spans(u[2], spans.height_m, 2), pick_spans(u[4], spans.pitch_deg, 2)
+    camera.update(fov=fov, z=height, x=_pick(u[3], AHEAD_M, 2),
+                  pitch=pitch, roll=_pick(u[5], ROLL_DEG, 2), yaw=_pick(u[6], YAW_DEG, 2),
                   lens={"k1": _pick(u[7], K1, 4), "k2": _pick(u[8], K2, 4)})
     camera["bonnet"] = ({"reach": _pick(u[10], BONNET_REACH_M, 2), "drop": _pick(u[11], BONNET_DROP_M, 2)}
                         if u[9] < BONNET_SHARE else None)

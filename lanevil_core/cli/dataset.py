@@ -45,6 +45,14 @@ def _dataset_arguments(parser: argparse.ArgumentParser) -> None:
                         help="train variations draw their camera and sensor: HFOV 45-100, height 1.2-3.5 m, pitch "
                         "-2..6, roll +-2, principal point row, bonnet on/off, lens, exposure, noise, blur, colour, "
                         "compression; and concrete roads (30 %%) and worn paint (half)")
+    parser.add_argument("--vary-world", action="store_true",
+                        help="train variations draw their world: scene kind and density, sun (day to night), "
+                        "clouds, fog, wet or dry, asphalt or concrete in drawn shades, lane width, bends, grades, "
+                        "traffic in the lanes (lanevil_core/dataset/worlds.py, docs/learning.md)")
+    parser.add_argument("--heldout", action="store_true",
+                        help="with --vary-world: draw from the held-out ranges (cameras, lane widths, bends, grades "
+                        "and road colours outside the train draw's; the rest alike): a validation split of unseen "
+                        "cameras, roads and materials. Not with --vary-camera or --camera")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -52,6 +60,7 @@ def _run_dataset(args: argparse.Namespace) -> int:
     from ..dataset import PlanError, Settings, generate_dataset
     from ..dataset.distributed import SchedulerError, check_scheduler_address, run_dask
     from ..dataset.local import LocalPool
+    from ..dataset.plan import check_world_flags
     from ..dataset.run import Executor
 
     if not args.cases.is_dir():
@@ -63,6 +72,14 @@ def _run_dataset(args: argparse.Namespace) -> int:
             camera_choice(args.camera)
         except CalibrationError as error:
             raise UsageError(str(error)) from None
+    settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
+                        train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint,
+                        sampling=args.sampling, camera=args.camera, vary_camera=args.vary_camera,
+                        vary_world=args.vary_world, heldout=args.heldout)
+    try:  # checked before workers start: a bad combination is one line
+        check_world_flags(settings)
+    except PlanError as error:
+        raise UsageError(str(error)) from None
     if args.scheduler is not None:
         try:
             address = check_scheduler_address(args.scheduler)
@@ -71,9 +88,6 @@ def _run_dataset(args: argparse.Namespace) -> int:
         executor: Executor = functools.partial(run_dask, address=address, timeout_s=args.scheduler_timeout)
     else:
         executor = LocalPool(args.workers)
-    settings = Settings(size=args.size, image_format=args.image_format, frames_per_case=args.frames_per_case,
-                        train_frames=args.train_frames, seed=args.seed, no_paint=args.no_paint,
-                        sampling=args.sampling, camera=args.camera, vary_camera=args.vary_camera)
     try:
         summary = generate_dataset(args.cases, args.out, settings, executor, show_progress=not args.quiet)
     except (PlanError, SchedulerError) as error:

@@ -21,7 +21,7 @@ import numpy as np
 import PIL
 
 from ..library.benchmark_layout import frame_file
-from .plan import SPLIT_LABELS, DatasetPlan, PlannedCase
+from .plan import SPLIT_LABELS, DatasetPlan, PlannedCase, Settings
 
 MANIFEST_FILE = "manifest.json"
 MANIFEST_VERSION = 1
@@ -125,6 +125,14 @@ def case_entry(case: PlannedCase, plan: DatasetPlan, frame_hashes: dict[int, str
     }
 
 
+def world_setting(settings: Settings) -> dict[str, str]:
+    """``{"world": "train" | "heldout"}`` for a run with ``--vary-world``, else nothing (manifests of runs without
+    it stay as they were)."""
+    if not settings.vary_world:
+        return {}
+    return {"world": "heldout" if settings.heldout else "train"}
+
+
 def build_manifest(plan: DatasetPlan, versions: dict[str, str],
                    frame_hashes: dict[tuple[str, str], dict[int, str]]) -> dict[str, Any]:
     """The whole manifest; ``frame_hashes`` maps (split, folder) -> frame -> sha256 of the written file."""
@@ -141,7 +149,7 @@ def build_manifest(plan: DatasetPlan, versions: dict[str, str],
         "settings": {"size": list(settings.size), "format": settings.image_format,
                      "frames_per_case": settings.frames_per_case, "train_frames": settings.train_frames,
                      "seed": settings.seed, "no_paint": settings.no_paint,
-                     "sampling": settings.sampling},
+                     "sampling": settings.sampling, **world_setting(settings)},
         "splits": splits,
         "cases": [case_entry(case, plan, frame_hashes[case.key]) for case in plan.cases],
     }

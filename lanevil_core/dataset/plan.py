@@ -40,6 +40,7 @@ from ..library.benchmark_layout import (
 from ..pipeline.frames import evenly_spaced
 from ..presets import PRESET_NAMES, preset_values
 from ..typed import LineType
+from .worlds import HELDOUT_WORLD, TRAIN_WORLD, WorldRanges, day_label, draw_world, world_parameters, world_rng
 
 TEST_SPLIT = "test"
 TRAIN_SPLIT = "train"
@@ -89,6 +90,15 @@ class Settings:
     sampling: str = "in_view"  # test frames: "in_view" of each type's level-5 illusion, or "even" over the drive
     camera: str | None = None  # a camera preset or calibration file every case is seen through (None: its own)
     vary_camera: bool = False  # train variations draw their camera and sensor (camera.variation.random_camera)
+    vary_world: bool = False  # train variations draw their world (dataset.worlds.draw_world)
+    heldout: bool = False  # ... from the held-out ranges (dataset.worlds.HELDOUT_WORLD): a held-out validation split
+
+    @property
+    def world(self) -> WorldRanges | None:
+        """The ranges train variations draw their world from (None: no world draw)."""
+        if not self.vary_world:
+            return None
+        return HELDOUT_WORLD if self.heldout else TRAIN_WORLD
 
     @property
     def suffix(self) -> str:
@@ -313,11 +323,14 @@ def _camera_mount(base: Case, rng: np.random.Generator) -> dict[str, Any]:
     return camera
 
 
-def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False) -> tuple[Case, dict[str, Any]]:
+def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False,
+                    world: WorldRanges | None = None) -> tuple[Case, dict[str, Any]]:
     """Variation ``index`` of a clean case and its parameters, drawn from ``default_rng([seed, index])``; with
     ``vary_camera`` its camera and sensor are drawn too (after every other draw, so the rest stays the same), and
     used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's), and last
-    its pavement (concrete slabs for ``CONCRETE_SHARE`` of them) and its paint's wear (``WORN_PAINT_SHARE``)."""
+    its pavement (concrete slabs for ``CONCRETE_SHARE`` of them) and its paint's wear (``WORN_PAINT_SHARE``).
+    With ``world`` (``dataset.worlds``), a world drawn from those ranges on its own stream replaces the scene,
+    weather, sun, pavement, lane width, bends and grades, adds traffic, and (a held-out world) the camera."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -353,17 +366,27 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
                         markings=markings, pavement=pavement)
     data["ego"].update(lane=lane, start_s=start_s)
     data["seed"] = case_seed
+    parameters: dict[str, Any] = {}
+    if world is not None:
+        drawn_world = draw_world(world_rng(seed, index), world, (base.camera.width, base.camera.height))
+        data["road"].update(drawn_world["road"])
+        data.update({key: drawn_world[key] for key in ("scene", "weather", "sun", "illusions", "camera")
+                     if key in drawn_world})
+        camera = data["camera"]
+        preset = ("Heldout" if world.draws_camera else "World") + day_label(drawn_world["sun"]["altitude"])
+        parameters["world"] = world_parameters(drawn_world)
     data["title"] = f"{base.title} ({preset}, variation {index})"
-    parameters = {"preset": preset, "sun_azimuth": azimuth, "sun_altitude": round(altitude, 1), "seed": case_seed,
-                  "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
-                  "lane_width": lane_width, "pavement": pavement, "paint_wear": wear,
+    road = data["road"]
+    parameters = {"preset": preset, "sun_azimuth": data["sun"]["azimuth"], "sun_altitude": data["sun"]["altitude"],
+                  "seed": case_seed, "lane": lane, "start_s": start_s, "lanes_per_direction": lanes_per_direction,
+                  "lane_width": road["lane_width"], "pavement": road["pavement"], "paint_wear": wear,
                   "camera": {k: camera[k] for k in ("fov", "x", "y", "z", "pitch", "yaw", "roll") if k in camera},
-                  "markings": [m["type"] for m in data["road"]["markings"]]}
+                  "markings": [m["type"] for m in road["markings"]], **parameters}
     return parse_case(data, source=f"train variation {index}"), parameters
 
 
 def train_cases(clean: list[SourceCase], train_frames: int, seed: int,
-                vary_camera: bool = False) -> list[PlannedCase]:
+                vary_camera: bool = False, world: WorldRanges | None = None) -> list[PlannedCase]:
     """``train_frames`` frames over variations of the clean cases (bases taken in turn, so every road type,
     scene and line type of the clean library recurs)."""
     if train_frames <= 0:
@@ -373,7 +396,7 @@ def train_cases(clean: list[SourceCase], train_frames: int, seed: int,
     planned = []
     for index in range(math.ceil(train_frames / TRAIN_FRAMES_PER_VARIANT)):
         base = clean[index % len(clean)]
-        case, parameters = train_variation(base.case, seed, index, vary_camera)
+        case, parameters = train_variation(base.case, seed, index, vary_camera, world)
         count = min(TRAIN_FRAMES_PER_VARIANT, train_frames - index * TRAIN_FRAMES_PER_VARIANT)
         folder = PurePosixPath(f"{index:05d}_{base.relative.stem}_{parameters['preset']}")
         planned.append(PlannedCase(
@@ -411,7 +434,23 @@ def split_sources(sources: list[SourceCase], settings: Settings) -> tuple[list[S
                         "seed the train split, sized by --train-frames")
     if not typed and settings.train_frames <= 0:
         raise PlanError("no test cases (cases with an illusion type) found and --train-frames is 0")
+    check_world_flags(settings)
     return typed, clean
+
+
+def check_world_flags(settings: Settings) -> None:
+    """Raise ``PlanError`` for world flags that cannot be honoured: ``--heldout`` without ``--vary-world``, a
+    held-out split with train cameras (``--vary-camera``) or one fixed camera (``--camera``), a world draw with no
+    train frames."""
+    if settings.heldout and not settings.vary_world:
+        raise PlanError("--heldout: only with --vary-world (it picks the held-out ranges of the world draw)")
+    if settings.heldout and settings.vary_camera:
+        raise PlanError("--heldout: not with --vary-camera (a held-out split draws its cameras outside the "
+                        "--vary-camera ranges)")
+    if settings.heldout and settings.camera is not None:
+        raise PlanError("--heldout: not with --camera (a held-out split draws its own cameras)")
+    if settings.vary_world and settings.train_frames <= 0:
+        raise PlanError("--vary-world: needs --train-frames (it varies the train variations)")
 
 
 def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = threads_map) -> DatasetPlan:
@@ -423,13 +462,14 @@ def build_plan(sources: list[SourceCase], settings: Settings, mapper: Mapper = t
                                  chosen.get(str(source.relative.parent))) for source in typed]
     if settings.no_paint:
         planned += [paint_free(case) for case in planned if case.severity == 0]
-    planned += train_cases(clean, settings.train_frames, settings.seed, settings.vary_camera)
+    planned += train_cases(clean, settings.train_frames, settings.seed, settings.vary_camera, settings.world)
     if settings.camera is not None:  # every case through one camera; drawn train cameras stay drawn
         try:  # a preset, or a calibration file read once (``camera.calibration``)
             camera, label = camera_choice(settings.camera)
         except CalibrationError as error:
             raise PlanError(str(error)) from None
-        planned = [case if settings.vary_camera and case.split == TRAIN_SPLIT else seen_through(case, camera, label)
+        drawn = settings.vary_camera or settings.heldout
+        planned = [case if drawn and case.split == TRAIN_SPLIT else seen_through(case, camera, label)
                    for case in planned]
     _check_unique(planned)
     return DatasetPlan(settings, tuple(planned))

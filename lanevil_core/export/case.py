@@ -29,7 +29,7 @@ from ..labels.lanes import CULANE_SIZE, TUSIMPLE_SIZE, culane_lines, tusimple_re
 from ..pipeline.compile import compile_scene
 from ..render import render_frame
 from ..typed import Float32Array, FloatArray, IntArray
-from ..world.paint import MATERIAL_ALBEDO
+from ..world.paint import road_albedo
 from ..world.primitives import flat_trimesh
 from ..world.road_mesh import road_surface
 from ..world.scene import CompiledScene
@@ -125,7 +125,7 @@ def scene_glb(scene: CompiledScene) -> bytes:
     """The compiled 3D scene (road surface, paint, visible objects) as glTF binary bytes, +Y up."""
     gltf_scene = trimesh.Scene()
     road = road_surface(scene.network)
-    gltf_scene.add_geometry(_gltf(road.vertices, road.faces, MATERIAL_ALBEDO[road.material]),
+    gltf_scene.add_geometry(_gltf(road.vertices, road.faces, road_albedo(scene.network)[road.material]),
                             geom_name="road", node_name="road")
     paint = scene.paint.mesh(scene.network)
     if len(paint[1]):

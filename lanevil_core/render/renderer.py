@@ -15,7 +15,8 @@ from ..camera.bonnet import bonnet_mask, paint_bonnet
 from ..camera.cover import cover_camera, cover_maps
 from ..camera.sensor import development
 from ..typed import Float32Array, FloatArray, IntArray, UInt8Array
-from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR
+from ..world.paint import MATERIAL_ALBEDO, PAINT_WEAR, road_albedo
+from ..world.road_layout import RoadNetwork
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
 from .develop import NO_STREAKS, Streaks, develop, motion_blur
@@ -165,12 +166,18 @@ def _geometry(packed: PackedScene) -> Geometry:
                     packed.face_texture)
 
 
+def _surface_table(network: RoadNetwork) -> FloatArray:
+    """The road materials' table, the carriageway's row in the case's own colour when it has one."""
+    return SURFACE_TABLE if network.surface_color is None else surface_table(road_albedo(network))
+
+
 def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
     fine, coarse = noise_textures()
-    return RoadLook(SURFACE_TABLE, packed.stripes, packed.stripe_index, float(scene.network.lanes_per_direction),
-                    float(scene.network.lane_width), packed.layers.texels, packed.layers.table,
-                    packed.layers.first_level, fine, coarse, packed.overhead, packed.overhead_params,
-                    float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)), scene.paint.wear_shift_m)
+    return RoadLook(_surface_table(scene.network), packed.stripes, packed.stripe_index,
+                    float(scene.network.lanes_per_direction), float(scene.network.lane_width), packed.layers.texels,
+                    packed.layers.table, packed.layers.first_level, fine, coarse, packed.overhead,
+                    packed.overhead_params, float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)),
+                    scene.paint.wear_shift_m)
 
 
 def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:

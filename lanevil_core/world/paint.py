@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..typed import Float32Array, FloatArray, IntArray
+from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from .marking_standards import standard_markings
 from .road_layout import RoadNetwork
 
@@ -38,6 +38,19 @@ MATERIAL_ALBEDO = np.array([
     [0.13, 0.10, 0.07],  # dirt
     [0.21, 0.205, 0.19],  # slab: weathered concrete pavement (new 0.35-0.40, aged 0.20-0.30)
 ], np.float32)
+
+
+
+def road_albedo(network: RoadNetwork) -> Float32Array:
+    """(len(MATERIALS), 3) float32 linear albedo of the road materials on ``network``: ``MATERIAL_ALBEDO`` with the
+    carriageway's material in the case's ``road.surface_color`` when it has one (the renderer, the glTF scene and
+    the editor colour the road from this)."""
+    if network.surface_color is None:
+        return MATERIAL_ALBEDO
+    albedo = MATERIAL_ALBEDO.copy()
+    albedo[MATERIALS.index(network.main.carriageway)] = network.surface_color
+    return albedo
+
 
 WHITE_PAINT = (0.70, 0.70, 0.67)
 YELLOW_PAINT = (0.72, 0.46, 0.04)

@@ -77,6 +77,7 @@ class RoadNetwork:
     pieces: list[RoadPiece]
     lane_width: float
     lanes_per_direction: int
+    surface_color: tuple[float, float, float] | None = None  # the carriageway's albedo; None = its material's
 
     @property
     def main(self) -> RoadPiece:
@@ -129,7 +130,7 @@ def build_network(road: Road, scene_kind: SceneKind) -> RoadNetwork:
     strips, carriageway = paved(CROSS_SECTIONS[scene_kind], road.pavement)
     main = RoadPiece(ReferenceLine(pieces, grade_changes=grades), n * w, strips, boundaries,
                      carriageway=carriageway)
-    network = RoadNetwork([main], w, n)
+    network = RoadNetwork([main], w, n, road.surface_color)
     if road.type in ("t_junction", "crossroad"):
         sides = (-1,) if road.type == "t_junction" else (-1, 1)
         for side in sides:

@@ -238,6 +238,7 @@ def test_lit_share_varies_from_building_to_building() -> None:
     shares = []
     for seed in range(6):
         night = props.house(RNG(seed), 12.0, 8.0, storeys=2, lit=True)
+        assert night.emission is not None
         shares.append(int((night.emission.max(1) > 0).sum()))  # same house, same windows: a drawn share lit
     assert max(shares) > 2 * min(shares)
 
@@ -260,10 +261,11 @@ def test_parked_vehicles_are_cheap_and_painted_from_the_palette() -> None:
 def test_traffic_signal_lights_one_lamp_towards_the_driver(aspect: str) -> None:
     signal = props.traffic_signal(aspect)
     assert_renderable(signal)
+    assert signal.emission is not None
     lit = signal.emission.max(1) > 0
     centre = signal.vertices[signal.faces[lit]].mean((0, 1))
     assert centre[0] < -0.15 and 2.8 < centre[2] < 3.6  # on the head's face towards -X
     order = props.SIGNAL_HEAD_Z_M + 0.3 * (2 - props.SIGNAL_ASPECTS.index(aspect))
     assert abs(centre[2] - order) < 1e-6  # red on top, green at the bottom
-    np.testing.assert_allclose(signal.emission[lit][0], np.asarray(props.SIGNAL_LAMPS[props.SIGNAL_ASPECTS.index(
-        aspect)]) * props.SIGNAL_GLOW, rtol=1e-6)
+    expected = np.asarray(props.SIGNAL_LAMPS[props.SIGNAL_ASPECTS.index(aspect)], np.float64) * props.SIGNAL_GLOW
+    np.testing.assert_allclose(np.asarray(signal.emission[lit][0], np.float64), expected, rtol=1e-6)

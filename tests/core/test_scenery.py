@@ -176,6 +176,7 @@ def test_a_traffic_signal_at_each_approach_to_a_town_junction(road: str, approac
         signals = [m for m in meshes if m.name.startswith("traffic signal")]
         assert len(signals) == approaches, (kind, road)
         for signal in signals:
+            assert signal.emission is not None
             lit = signal.emission.max(1) > 0
             lamps = np.unique(signal.emission[lit].round(4), axis=0)
             assert len(lamps) == 1 and lit.sum() == 12  # one lamp (a box) lit, the housing dark
