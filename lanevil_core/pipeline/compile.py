@@ -15,7 +15,7 @@ from ..world.environment import environment_for, in_proportion, is_night
 from ..world.paint import road_paint
 from ..world.road_layout import RoadNetwork, build_network
 from ..world.scene import CompiledScene, Environment, Mesh
-from ..world.scenery import roadside_meshes, street_lamps
+from ..world.scenery import RoadsideInputs, roadside_meshes, street_lamps
 from ..world.user_meshes import load_obstacle, mesh_path
 
 
@@ -32,7 +32,7 @@ def _roadside(case: Case, reuse: CompiledScene | None) -> tuple[RoadNetwork, lis
     if reuse is not None and roadside_key(reuse.case) == roadside_key(case):
         return reuse.network, [mesh for mesh in reuse.meshes if mesh.source < 0]
     network = build_network(case.road, case.scene.kind)
-    return network, roadside_meshes(case, network, np.random.default_rng([case.seed, 0]))
+    return network, roadside_meshes(roadside_inputs(case), network, np.random.default_rng([case.seed, 0]))
 
 
 def _named_meshes(case: Case) -> list[tuple[int, str, str]]:
@@ -74,6 +74,20 @@ def ego_drive(case: Case) -> EgoDrive:
                     road_length=case.road.length)
 
 
+def roadside_inputs(case: Case) -> RoadsideInputs:
+    """What the roadside reads of the case: its scene, night or day, the ego's drive, the junction (every one of
+    them is part of ``roadside_key``)."""
+    drive = ego_drive(case)
+    return RoadsideInputs(kind=case.scene.kind, density=case.scene.density, night=is_night(case.sun.altitude),
+                          start_s=drive.start_s, end_s=drive.end_s, junction_s=case.road.junction_s)
+
+
+def case_environment(case: Case) -> Environment:
+    """The case's sun, sky, wetness and fog before its illusions change them; photographed when its camera has a
+    sensor."""
+    return environment_for(case.weather, case.sun, photographed=case.camera.sensor is not None)
+
+
 def _sun_of(env: Environment) -> tuple[float, ...]:
     """What an illusion may do to the sun: its direction, its strength, night."""
     return (*(float(v) for v in env.sun_dir_world), float(env.sun_intensity), float(env.night))
@@ -89,10 +103,10 @@ def compile_scene(case: Case, reuse: CompiledScene | None = None, *, meshes_dir:
     as they are and only the environment and illusions are compiled anew; the result equals a full compile.
     """
     network, roadside = _roadside(case, reuse)
-    ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=environment_for(case),
+    ctx = CompileContext(seed=case.seed, drive=ego_drive(case), network=network, env=case_environment(case),
                          user_meshes=load_user_meshes(case, meshes_dir), case_sun_altitude=case.sun.altitude)
     ctx.meshes.extend(roadside)
-    ctx.lights.extend(street_lamps(case, network))  # lit at night only
+    ctx.lights.extend(street_lamps(roadside_inputs(case), network))  # lit at night only
     case_sun = ctx.env.sun_intensity
     for index, illusion in enumerate(case.illusions):
         ctx.source = index

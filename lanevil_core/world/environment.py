@@ -1,8 +1,8 @@
-"""Lighting and atmosphere from a case's weather and sun numbers."""
+"""Lighting and atmosphere from weather and sun numbers."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -10,8 +10,26 @@ import numpy.typing as npt
 from ..typed import FloatArray
 from .scene import Environment
 
-if TYPE_CHECKING:  # the case model imports the illusions, which use sun_direction
-    from ..case import Case
+
+class WeatherInputs(Protocol):
+    """The weather numbers the environment reads (a case's ``weather`` is one): CARLA's 0-100 scales, the fog's
+    start in m."""
+
+    cloudiness: float
+    precipitation: float
+    precipitation_deposits: float
+    wetness: float
+    fog_density: float
+    fog_distance: float
+
+
+class SunInputs(Protocol):
+    """The sun the environment reads (a case's ``sun`` is one): azimuth and altitude in degrees, the luminance of
+    its beam (1 = clear noon)."""
+
+    azimuth: float
+    altitude: float
+    intensity: float
 
 
 NIGHT_EXPOSURE = 2.2
@@ -118,9 +136,9 @@ def in_proportion(env: Environment, air_mass: bool = True) -> None:
                             NIGHT_AMBIENT))
 
 
-def environment_for(case: Case) -> Environment:
-    """Sun, sky, wetness and fog of a case (before illusions change them)."""
-    weather, sun = case.weather, case.sun
+def environment_for(weather: WeatherInputs, sun: SunInputs, photographed: bool) -> Environment:
+    """Sun, sky, wetness and fog of a weather and a sun (before illusions change them); ``photographed``: seen
+    through a real camera's sensor (its daylight in proportion, the road's surface detail)."""
     cloud = weather.cloudiness / 100.0
     altitude = sun.altitude
     night = is_night(altitude)
@@ -132,7 +150,6 @@ def environment_for(case: Case) -> Environment:
     zenith = _mix(clear_zenith, grey * 0.8, cloud) * day + NIGHT_ZENITH * (1 - day)
     horizon = _mix(_mix(clear_horizon, [0.95, 0.7, 0.5], low * 0.6 * (1 - cloud)), grey, cloud)
     horizon = horizon * day + NIGHT_HORIZON * (1 - day)
-    photographed = case.camera.sensor is not None
     direct = sun.intensity * day * (_beam_through_clouds(altitude, cloud) if photographed else 1.0 - 0.85 * cloud)
     return Environment(
         sun_dir_world=sun_direction(sun.azimuth, max(altitude, 0.5)),

@@ -9,25 +9,34 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..typed import FloatArray
+from ..typed import FloatArray, SceneKind
 from . import props
-from .environment import is_night
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh, PointLight
 from .structures import WARM_LAMP, streetlight, streetlight_lamp_offset
 
-if TYPE_CHECKING:  # the case model builds on the world (through the illusions), not the other way round
-    from ..case import Case
-
 CLEAR_MARGIN_M = 0.3  # free space kept between a prop's footprint and any road corridor
 GROUP_LENGTH_M = 100.0  # small props (trees, bushes, barriers) are merged into one mesh per side and stretch
 TUNNEL_HEIGHT_M = 6.0
 ROW_RETRY_STEP_M = 3.0
+
+
+@dataclass(frozen=True)
+class RoadsideInputs:
+    """What the roadside reads beside the road network (``pipeline/compile.py`` ``roadside_inputs`` fills it from a
+    case): the scene kind and density, whether it is night (lit windows, street lamps on), the ego's drive along the
+    main road (where parked cars are seen) and where a junction's arms cross the main road."""
+
+    kind: SceneKind
+    density: float
+    night: bool
+    start_s: float  # the ego's first and last positions along the main road (m)
+    end_s: float
+    junction_s: float
 
 
 def corridor_half_width(piece: RoadPiece) -> float:
@@ -289,10 +298,10 @@ def streetlights(network: RoadNetwork, clear: Clearance, spacing: float, emissiv
     return out
 
 
-def street_lamps(case: Case, network: RoadNetwork) -> list[PointLight]:
-    """The lights of the roadside's street lamps when they are lit (a night case of a scene kind with lamps):
+def street_lamps(inputs: RoadsideInputs, network: RoadNetwork) -> list[PointLight]:
+    """The lights of the roadside's street lamps when they are lit (at night, in a scene kind with lamps):
     warm LED heads with a full cut-off beam at each lamp of ``streetlights``."""
-    if case.scene.kind not in STREETLIGHT_KINDS or not is_night(case.sun.altitude):
+    if inputs.kind not in STREETLIGHT_KINDS or not inputs.night:
         return []
     offset = streetlight_lamp_offset()
     return [PointLight(T_world_local[:3, :3] @ offset + T_world_local[:3, 3], np.asarray(WARM_LAMP, np.float32),
@@ -348,13 +357,12 @@ def parking_occupancy(density: float) -> float:
     return float(1.0 - np.exp(-0.4 * density))
 
 
-def parked_cars(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+def parked_cars(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
     """Rows of parked cars and vans beyond the sidewalk (kerb-parallel, facing the traffic of their side's lanes),
     in car-paint colours; slots taken at ``parking_occupancy`` of the scene density, with gaps for driveways, none
     within JUNCTION_GAP_M of a crossing road and only along the stretch the ego can see (``PARKING_AHEAD_M``)."""
-    occupancy = parking_occupancy(case.scene.density)
-    s_lo, s_hi = case.ego.start_s - PARKING_AHEAD_M[0], case.ego.start_s + case.ego.speed * (
-        case.ego.frames - 1) / case.ego.fps + PARKING_AHEAD_M[1]
+    occupancy = parking_occupancy(inputs.density)
+    s_lo, s_hi = inputs.start_s - PARKING_AHEAD_M[0], inputs.end_s + PARKING_AHEAD_M[1]
     out: list[Mesh] = []
     for index, piece, side in sides(network):
         placed: list[tuple[float, Mesh]] = []
@@ -386,7 +394,7 @@ SIGNAL_CLEAR_OF_LAMP_M = 1.5  # and steps back from a street lamp this close
 AMBER_SHARE = 0.15  # the junctions caught with their signals changing
 
 
-def signal_poses(case: Case, network: RoadNetwork) -> list[tuple[int, float, float, float, float]]:
+def signal_poses(inputs: RoadsideInputs, network: RoadNetwork) -> list[tuple[int, float, float, float, float]]:
     """(piece index, s, t, sidewalk height, yaw) of a traffic signal at each approach to the junction: on the
     approaching traffic's sidewalk (right-hand traffic), SIGNAL_BACK_M before the crossing corridor, its lamps
     towards that traffic."""
@@ -397,7 +405,7 @@ def signal_poses(case: Case, network: RoadNetwork) -> list[tuple[int, float, flo
     for sign in (-1.0, 1.0):  # main-road traffic along +s (sign -1: its sidewalk on the right) and along -s
         kerb = sidewalk_kerb(main)
         if kerb is not None:
-            s = case.road.junction_s + sign * (corridor_half_width(network.pieces[1]) + SIGNAL_BACK_M)
+            s = inputs.junction_s + sign * (corridor_half_width(network.pieces[1]) + SIGNAL_BACK_M)
             poses.append((0, s, sign * (kerb[0] + 0.6), kerb[1], 0.0 if sign < 0 else np.pi))
     for index, arm in enumerate(network.pieces[1:], start=1):  # the arms' traffic comes towards the main road
         kerb = sidewalk_kerb(arm)
@@ -406,7 +414,8 @@ def signal_poses(case: Case, network: RoadNetwork) -> list[tuple[int, float, flo
     return poses
 
 
-def traffic_signals(case: Case, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+def traffic_signals(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
+                    rng: np.random.Generator) -> list[Mesh]:
     """A traffic signal at each approach to a town junction (``signal_poses``): the main road's approaches show one
     aspect, the arms' the other (red against green, or amber while changing)."""
     main_aspect = "green" if rng.random() < 0.5 else "red"
@@ -415,7 +424,7 @@ def traffic_signals(case: Case, network: RoadNetwork, clear: Clearance, rng: np.
         main_aspect = "amber"
     lamps = [(index, s) for _, index, s, _ in streetlight_poses(network, clear, STREETLIGHT_SPACING_M)]
     out: list[Mesh] = []
-    for index, s, t, h, yaw in signal_poses(case, network):
+    for index, s, t, h, yaw in signal_poses(inputs, network):
         piece = network.pieces[index]
         away = -1.0 if index == 0 and yaw == 0.0 else 1.0  # back from the junction along the piece
         for _ in range(4):
@@ -430,11 +439,11 @@ def traffic_signals(case: Case, network: RoadNetwork, clear: Clearance, rng: np.
     return out
 
 
-def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
+def tunnel(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
     line = network.main.line
-    s_portal = float(min(case.ego.start_s + rng.uniform(150.0, 250.0), line.length - 30.0))
+    s_portal = float(min(inputs.start_s + rng.uniform(150.0, 250.0), line.length - 30.0))
     opening = corridor_half_width(network.main) + 0.2
     hill_depth, crest, hill_width = 12.0, 16.0, 45.0
     portal = props.tunnel_portal(2 * opening, TUNNEL_HEIGHT_M, hill_height=crest, hill_depth=hill_depth,
@@ -459,8 +468,8 @@ def tunnel(case: Case, network: RoadNetwork, rng: np.random.Generator) -> tuple[
     return meshes, s_portal
 
 
-def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density, night = case.scene.density, is_night(case.sun.altitude)
+def _urban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density, night = inputs.density, inputs.night
 
     def block(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(12.0, 28.0)), float(r.uniform(10.0, 18.0))
@@ -472,15 +481,15 @@ def _urban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
     if density > 0:  # a few street trees first, parked cars between them; the blocks fill the frontage behind
         meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
-        meshes += parked_cars(case, network, clear, own_rng(rng))
+        meshes += parked_cars(inputs, network, clear, own_rng(rng))
         meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
                           (1.0 / density, 10.0 / density), "building")
         meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes + traffic_signals(case, network, clear, own_rng(rng))
+    return meshes + traffic_signals(inputs, network, clear, own_rng(rng))
 
 
-def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density, night = case.scene.density, is_night(case.sun.altitude)
+def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density, night = inputs.density, inputs.night
     if density <= 0:
         return []
 
@@ -489,23 +498,23 @@ def _suburban(case: Case, network: RoadNetwork, rng: np.random.Generator, clear:
         return width, depth, lambda: props.house(r, width, depth, lit=night)
 
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
-    meshes += parked_cars(case, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
+    meshes += parked_cars(inputs, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
     meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes + traffic_signals(case, network, clear, own_rng(rng))
+    return meshes + traffic_signals(inputs, network, clear, own_rng(rng))
 
 
-def _highway(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+def _highway(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
     meshes = barriers(network, clear)
-    if case.scene.density > 0:
-        meshes += greenery(network, clear, rng, 22.0 / case.scene.density, (6.0, 35.0), bush_share=0.35,
+    if inputs.density > 0:
+        meshes += greenery(network, clear, rng, 22.0 / inputs.density, (6.0, 35.0), bush_share=0.35,
                            conifer_share=0.5)
     return meshes
 
 
-def _rural(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    density, night = case.scene.density, is_night(case.sun.altitude)
+def _rural(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
+    density, night = inputs.density, inputs.night
     if density <= 0:
         return []
 
@@ -518,16 +527,17 @@ def _rural(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Cl
     return meshes
 
 
-def _tunnel_approach(case: Case, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
-    meshes, s_portal = tunnel(case, network, rng)
+def _tunnel_approach(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator,
+                     clear: Clearance) -> list[Mesh]:
+    meshes, s_portal = tunnel(inputs, network, rng)
     clear.closed_s.append((s_portal - 11.0, network.main.line.length))  # the hill claims the ground
-    if case.scene.density > 0:
-        meshes += greenery(network, clear, rng, 12.0 / case.scene.density, (0.5, 20.0), bush_share=0.5,
+    if inputs.density > 0:
+        meshes += greenery(network, clear, rng, 12.0 / inputs.density, (0.5, 20.0), bush_share=0.5,
                            conifer_share=0.6)
     return meshes
 
 
-SCENES: dict[str, Callable[[Case, RoadNetwork, np.random.Generator, Clearance], list[Mesh]]] = {
+SCENES: dict[str, Callable[[RoadsideInputs, RoadNetwork, np.random.Generator, Clearance], list[Mesh]]] = {
     "urban": _urban,
     "suburban": _suburban,
     "highway": _highway,
@@ -536,6 +546,6 @@ SCENES: dict[str, Callable[[Case, RoadNetwork, np.random.Generator, Clearance], 
 }
 
 
-def roadside_meshes(case: Case, network: RoadNetwork, rng: np.random.Generator) -> list[Mesh]:
-    """World-frame meshes of everything beside the road for the case's scene kind and density."""
-    return SCENES[case.scene.kind](case, network, rng, Clearance(network))
+def roadside_meshes(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator) -> list[Mesh]:
+    """World-frame meshes of everything beside the road for the scene kind and density of ``inputs``."""
+    return SCENES[inputs.kind](inputs, network, rng, Clearance(network))

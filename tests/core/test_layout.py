@@ -3,8 +3,8 @@ of docs/architecture.md.
 
 A package here is a subpackage of ``lanevil_core`` (``world``, ``camera``, ``illusions``, ...) or one of its
 top-level modules (``case``, ``images``, ...). Every import counts, at module level or inside a function; imports
-under ``if TYPE_CHECKING:`` (names used in annotations only, as ``world`` names ``Case`` and ``camera``'s
-``EgoPath``) are left out. A package may import only the packages on the lines above its own in the
+under ``if TYPE_CHECKING:`` (names used in annotations only, as ``world``'s compiled scene names ``Case`` and
+``camera``'s ``EgoPath``) are left out. A package may import only the packages on the lines above its own in the
 architecture's layer list; ``ALLOWED`` names the exceptions and why.
 """
 
@@ -185,6 +185,38 @@ def test_illusions_do_not_know_the_case_model() -> None:
             if isinstance(node, ast.ImportFrom):
                 parts = _imported_parts(node, ("illusions",))
                 assert ("case",) not in parts, f"{path.name}:{node.lineno} imports the case model"
+
+
+def case_uses(root: Path, keep: set[str]) -> list[str]:
+    """``file:line`` of every import of ``Case`` (even under ``if TYPE_CHECKING:``) and every parameter named ``case``
+    in the modules below ``root``, except the files ``keep`` (paths relative to ``root``)."""
+    uses = []
+    for path in sorted(root.rglob("*.py")):
+        where = path.relative_to(root).as_posix()
+        if where in keep:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and any(alias.name == "Case" for alias in node.names):
+                uses.append(f"{where}:{node.lineno} imports Case")
+            elif isinstance(node, ast.arg) and node.arg == "case":
+                uses.append(f"{where}:{node.lineno} takes a case")
+    return uses
+
+
+def test_the_world_builds_from_its_own_inputs() -> None:
+    """The world's functions take what they read (``RoadsideInputs``, a weather and a sun), which
+    ``pipeline/compile.py`` takes from the case; only the compiled scene names ``Case`` (``CompiledScene.case``)."""
+    uses = case_uses(PACKAGE / "world", keep={"scene.py"})
+    assert uses == [], f"pass the world what it reads of the case instead: {uses}"
+
+
+def test_the_case_check_sees_type_checking_imports_and_parameters(tmp_path: Path) -> None:
+    (tmp_path / "scenery.py").write_text(
+        "from typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from ..case import Case, Road\n"
+        "def f(network, case):\n    return network\n")
+    (tmp_path / "scene.py").write_text("from ..case import Case\n")
+    assert case_uses(tmp_path, keep={"scene.py"}) == ["scenery.py:3 imports Case", "scenery.py:4 takes a case"]
 
 
 @pytest.mark.parametrize("package", CASE_FREE)

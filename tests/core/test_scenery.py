@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Case
+from lanevil_core.pipeline.compile import roadside_inputs
 from lanevil_core.typed import SCENE_KINDS, SceneKind
 from lanevil_core.world.road_layout import RoadNetwork, RoadPiece, build_network
 from lanevil_core.world.scene import Mesh
@@ -53,7 +54,7 @@ def scenery(kind: SceneKind, road: str = "straight", density: float = 1.0,
             seed: int = 0) -> tuple[RoadNetwork, list[Mesh]]:
     case = Case.model_validate({"scene": {"kind": kind, "density": density}, "road": {"type": road}})
     network = build_network(case.road, kind)
-    return network, roadside_meshes(case, network, np.random.default_rng(seed))
+    return network, roadside_meshes(roadside_inputs(case), network, np.random.default_rng(seed))
 
 
 @pytest.mark.parametrize("road", ["straight", "bend", "crossroad"])
@@ -137,7 +138,7 @@ def test_highway_barriers_line_both_edges_beyond_the_shoulder() -> None:
 def test_tunnel_portal_spans_the_road_ahead_of_the_ego() -> None:
     case = Case.model_validate({"scene": {"kind": "tunnel_approach"}})
     network = build_network(case.road, "tunnel_approach")
-    meshes = roadside_meshes(case, network, np.random.default_rng(0))
+    meshes = roadside_meshes(roadside_inputs(case), network, np.random.default_rng(0))
     portal = next(m for m in meshes if m.name == "tunnel portal")
     s, t, h = road_frame(network.main, portal.vertices[portal.faces].mean(1))
     lintel = (np.abs(t) < network.main.half_width) & (h > 5.0)

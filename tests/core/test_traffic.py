@@ -17,8 +17,7 @@ from lanevil_core.camera import ego_camera
 from lanevil_core.case import Case, case_meshes_dir, parse_case
 from lanevil_core.illusions import REGISTRY, CompileContext, MeshFileError
 from lanevil_core.illusions.traffic import EGO_CLEAR_M, Footprints, Slot, load_obstacle, srgb_to_linear
-from lanevil_core.pipeline.compile import ego_drive, load_user_meshes
-from lanevil_core.world.environment import environment_for
+from lanevil_core.pipeline.compile import case_environment, ego_drive, load_user_meshes
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
 
@@ -29,7 +28,7 @@ def compiled(spec: dict, meshes_dir: Path | None = None, **case: object) -> tupl
     """Compile one illusion on its own (no roadside) into a fresh context."""
     model = Case.model_validate({"illusions": [spec], **case})
     network = build_network(model.road, model.scene.kind)
-    ctx = CompileContext(seed=model.seed, drive=ego_drive(model), network=network, env=environment_for(model),
+    ctx = CompileContext(seed=model.seed, drive=ego_drive(model), network=network, env=case_environment(model),
                          source=0, user_meshes=load_user_meshes(model, meshes_dir))
     model.illusions[0].compile(ctx)
     return model, ctx
