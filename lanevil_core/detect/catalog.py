@@ -19,7 +19,14 @@ from typing import Any, Literal
 from ..metrics.formats import LaneFileError
 from .learned import SHIPPED_MODELS
 from .model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE
-from .registry import ONNX_PREFIX, PluginSpec, detector_names, plugin_real_trained, plugin_spec
+from .registry import (
+    ONNX_PREFIX,
+    PluginSpec,
+    bundled_specs,
+    detector_names,
+    plugin_real_trained,
+    plugin_spec,
+)
 from .split import DETECTORS, LEARNED_METHODS
 
 DetectorKind = Literal["learned", "classical", "http", "onnx", "plugin"]
@@ -128,12 +135,15 @@ def _plugin_info(spec: PluginSpec) -> DetectorInfo:
     """A plug-in's entry; an ONNX model or Python plug-in is opened to tell whether it can run and whether it is
     marked real-trained (an HTTP server is only reached when it detects)."""
     version = _plugin_version(spec)
+    bundled = bundled_specs().get(spec.name) == spec  # shipped: its folder in the package, not this disk's path
+    source = f"{ONNX_PREFIX}detect/models/{spec.name}" if bundled else spec.source
+    model = model_summary(spec.name) if bundled else None
     try:
         real_trained = spec.real_trained if spec.kind == "http" else plugin_real_trained(spec)
     except LaneFileError as error:
         return DetectorInfo(spec.name, spec.kind, False, version, str(error).removeprefix("detector: "),
-                            source=spec.source, real_trained=spec.real_trained)
-    return DetectorInfo(spec.name, spec.kind, True, version, source=spec.source, real_trained=real_trained)
+                            model=model, source=source, real_trained=spec.real_trained)
+    return DetectorInfo(spec.name, spec.kind, True, version, model=model, source=source, real_trained=real_trained)
 
 
 def detector_info(name: str) -> DetectorInfo:

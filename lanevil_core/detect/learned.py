@@ -32,6 +32,10 @@ from .line_anchors import decode_anchors, line_anchors
 from .model_spec import FAMILIES, ONNX_FILE, ModelSpec, ModelSpecError
 
 SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
+# Models shipped beside the six families' own, each a `lanevil train` folder run as its family, by name:
+# seg-transfer is `seg` fine-tuned with --randomise --photometric, chosen on held-out synthetic worlds
+# (docs/learning.md, "Selection on held-out synthetic worlds"); `make models-transfer` makes it again.
+BUNDLED_MODELS: tuple[str, ...] = ("seg-transfer",)
 
 
 def shipped_model_dir(family: str) -> Path:

@@ -11,7 +11,9 @@ Built-ins are ``detect.split.METHODS`` (six learned families, two classical base
                                           "input_size": [1280, 720], "timeout_s": 10, "retries": 1,
                                           "concurrency": 1}}}
 
-- the installed Python plug-ins of the entry-point group ``lanevil.detectors`` (``detect.plugin``).
+- the installed Python plug-ins of the entry-point group ``lanevil.detectors`` (``detect.plugin``);
+- and, unless one of those takes the name, the model folders shipped beside the families' own
+  (``learned.BUNDLED_MODELS``: ``seg-transfer``).
 
 A SOURCE is ``http://HOST:PORT/PATH`` (or https: ``detect.http_detector``) or ``onnx:PATH`` (an ONNX model with a
 sidecar: ``detect.onnx_detector``; or a model folder of ``lanevil train`` / ``lanevil adapt``, run as its family).
@@ -160,12 +162,24 @@ def configured_specs() -> dict[str, PluginSpec]:
     return specs
 
 
+def bundled_specs() -> dict[str, PluginSpec]:
+    """The model folders shipped beside the six families' (``learned.BUNDLED_MODELS``) that are present, by name:
+    each an ``onnx:`` model folder, run as its family."""
+    from .learned import BUNDLED_MODELS, SHIPPED_MODELS
+    from .model_spec import ONNX_FILE
+
+    return {name: PluginSpec(name, "onnx", f"{ONNX_PREFIX}{SHIPPED_MODELS / name}") for name in BUNDLED_MODELS
+            if (SHIPPED_MODELS / name / ONNX_FILE).is_file()}
+
+
 def plugin_specs() -> dict[str, PluginSpec]:
-    """Every plug-in by name: the configured ones, then the installed entry points (a configured name wins; entry
-    points with a taken or malformed name are left out)."""
+    """Every plug-in by name: the configured ones, then the bundled models and the installed entry points (a
+    configured name wins; entry points with a taken or malformed name are left out)."""
     from .plugin import entry_points
 
     specs = configured_specs()
+    for name, spec in bundled_specs().items():
+        specs.setdefault(name, spec)
     for name, point in sorted(entry_points().items()):
         if name not in specs and name not in METHODS and name not in RESERVED_NAMES and NAME_PATTERN.fullmatch(name):
             specs[name] = PluginSpec(name, "plugin", point.value)

@@ -10,6 +10,7 @@ import pytest
 
 from lanevil_core.cli import main
 from lanevil_core.detect.catalog import available_detector, detector_info, detector_infos
+from lanevil_core.detect.learned import BUNDLED_MODELS
 from lanevil_core.detect.polylines import checked_polylines, polyline_lanes, scaled_polylines
 from lanevil_core.detect.registry import (
     ENV_DETECTORS,
@@ -76,8 +77,8 @@ def test_an_http_detector_resized_to_its_input_size(monkeypatch, tmp_path, lane_
 
 def test_named_detectors_from_the_environment_join_every_list(monkeypatch, lane_server) -> None:
     monkeypatch.setenv(ENV_DETECTORS, f" mine={lane_server.url()} ; other=onnx:missing.onnx;")
-    assert detector_names() == (*METHODS, "mine", "other")
-    assert drive_detector_names() == ("gt", *METHODS, "mine", "other")
+    assert detector_names() == (*METHODS, "mine", "other", *BUNDLED_MODELS)
+    assert drive_detector_names() == ("gt", *METHODS, "mine", "other", *BUNDLED_MODELS)
     infos = {info.name: info for info in detector_infos()}
     assert infos["mine"].kind == "http" and infos["mine"].available
     assert infos["other"].kind == "onnx" and not infos["other"].available
@@ -97,6 +98,18 @@ def test_a_malformed_environment_is_one_clear_error(monkeypatch, value, message)
     monkeypatch.setenv(ENV_DETECTORS, value)
     with pytest.raises(LaneFileError, match=message):
         detector_names()
+
+
+def test_the_bundled_model_is_a_named_detector_a_configured_one_may_take_over(monkeypatch, stripes) -> None:
+    assert BUNDLED_MODELS == ("seg-transfer",) and detector_names()[-1] == "seg-transfer"
+    info = detector_info("seg-transfer")
+    assert info.available and info.kind == "onnx" and not info.real_trained
+    assert info.source == "onnx:detect/models/seg-transfer"  # not the path of the installation's disk
+    assert info.model is not None and info.model["input_size"] == [320, 180]
+    lanes = detector_for("seg-transfer")(stripes([60, 100]), ROWS)  # runs as its family, seg
+    assert isinstance(lanes, list)
+    monkeypatch.setenv(ENV_DETECTORS, "seg-transfer=onnx:missing.onnx")
+    assert detector_names().count("seg-transfer") == 1 and not detector_info("seg-transfer").available
 
 
 def test_a_malformed_config_file_names_the_field(monkeypatch, tmp_path) -> None:
@@ -229,12 +242,12 @@ def test_lanevil_detectors_lists_built_ins_and_plugins(monkeypatch, lane_server,
     monkeypatch.setenv(ENV_DETECTORS, f"mine={lane_server.url()};gone=onnx:missing.onnx")
     assert main(["detectors"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert [line.split()[0] for line in lines] == [*METHODS, "mine", "gone"]
-    assert lines[-2].split()[1:3] == ["http", "available"] and lane_server.url() in lines[-2]
-    assert "not available: gone: no ONNX model at missing.onnx" in lines[-1]
+    assert [line.split()[0] for line in lines] == [*METHODS, "mine", "gone", *BUNDLED_MODELS]
+    assert lines[-3].split()[1:3] == ["http", "available"] and lane_server.url() in lines[-3]
+    assert "not available: gone: no ONNX model at missing.onnx" in lines[-2]
     assert main(["detectors", "--json"]) == 0
     entries = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert entries[-2] == {"name": "mine", "kind": "http", "available": True, "reason": None, "model": None,
+    assert entries[-3] == {"name": "mine", "kind": "http", "available": True, "reason": None, "model": None,
                            "source": lane_server.url(), "real_trained": False}
     monkeypatch.setenv(ENV_DETECTORS, "mine")
     assert main(["detectors"]) == 2

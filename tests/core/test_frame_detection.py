@@ -12,6 +12,7 @@ import pytest
 from lanevil_core.detect import catalog as detector_catalog
 from lanevil_core.detect.catalog import available_detector, detector_info, detector_infos, detector_version
 from lanevil_core.detect.frame_detection import detect_frame, score_frame_lanes
+from lanevil_core.detect.learned import BUNDLED_MODELS
 from lanevil_core.detect.split import METHODS
 from lanevil_core.labels.lanes import h_samples_for, tusimple_record
 from lanevil_core.labels.overlay import DETECTION_COLOR, LANE_COLORS, draw_detections, draw_lanes
@@ -22,7 +23,7 @@ from lanevil_core.render import render_frame
 
 def test_catalog_lists_every_method_once() -> None:
     infos = detector_infos()
-    assert [info.name for info in infos] == list(METHODS)
+    assert [info.name for info in infos] == [*METHODS, *BUNDLED_MODELS]
     kinds = {info.name: info.kind for info in infos}
     assert kinds["hough"] == kinds["birdseye"] == "classical" and kinds["ufld"] == "learned"
     ufld = detector_info("ufld")

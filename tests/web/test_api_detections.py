@@ -9,6 +9,7 @@ import pytest
 from PIL import Image
 
 from lanevil_core.detect import catalog as detector_catalog
+from lanevil_core.detect.learned import BUNDLED_MODELS
 from lanevil_core.detect.split import METHODS
 from lanevil_core.labels.lanes import h_samples_for
 from lanevil_core.labels.overlay import DETECTION_COLOR
@@ -30,7 +31,8 @@ def no_shipped_models(monkeypatch, tmp_path) -> None:
 
 def test_detectors_lists_every_method_with_kind_and_model(client) -> None:
     body = client.get("/api/detectors").json()
-    assert [entry["name"] for entry in body["data"]] == list(METHODS) and body["count"] == len(METHODS)
+    names = [*METHODS, *BUNDLED_MODELS]
+    assert [entry["name"] for entry in body["data"]] == names and body["count"] == len(names)
     by_name = {entry["name"]: entry for entry in body["data"]}
     ufld = by_name["ufld"]
     assert ufld["kind"] == "learned" and ufld["available"] and ufld["reason"] is None
