@@ -17,12 +17,10 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    SerializerFunctionWrapHandler,
     StrictBool,
     StrictFloat,
     StrictInt,
     ValidationError,
-    model_serializer,
     model_validator,
 )
 
@@ -116,6 +114,7 @@ class Road(_Model):
     )
     marking_standard: MarkingStandardName = Field(
         "custom",
+        exclude_if=lambda value: value == "custom",
         description="the country's and road class's marking manual whose dash, gap and line widths every marking "
         "takes (us_mutcd: 10 ft / 30 ft; de_autobahn: 6 m / 12 m; de_urban: 3 m / 6 m; cn_fast: 6 m / 9 m; "
         "cn_slow: 2 m / 4 m); custom: each marking's own width, dash and gap",
@@ -130,8 +129,11 @@ class Road(_Model):
         description="false removes every lane marking from the world (the paint-free control: the lane labels "
         "stay, so a detector that still finds the lanes reads the road's layout, not its paint)",
     )
+    # a case that keeps its material's own colour, or paints each marking to its own numbers, is written as before
+    # these fields existed (same bytes, same sha256 in dataset manifests)
     surface_color: RGB | None = Field(
         None,
+        exclude_if=lambda value: value is None,
         description="albedo of the carriageway's material (linear RGB: a darker or lighter asphalt, a fresh or "
         "aged concrete); empty = the material's own (asphalt 0.055, slabs 0.21)",
     )
@@ -149,15 +151,6 @@ class Road(_Model):
         if self.junction_s >= self.length - 20:
             raise ValueError("junction_s must lie at least 20 m before the end of the road")
         return self
-
-    @model_serializer(mode="wrap")
-    def _omit_own_surface(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        # A case that keeps its material's own colour is written as before the field existed (same bytes, same
-        # sha256 in dataset manifests).
-        data: dict[str, Any] = handler(self)
-        if self.surface_color is None:
-            data.pop("surface_color", None)
-        return data
 
 
 class Scene(_Model):
