@@ -151,12 +151,14 @@ class Road(_Model):
         return self
 
     @model_serializer(mode="wrap")
-    def _omit_own_surface(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        # A case that keeps its material's own colour is written as before the field existed (same bytes, same
-        # sha256 in dataset manifests).
+    def _omit_defaults_of_new_fields(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        # A case that keeps its material's own colour and its markings' own numbers is written as before those
+        # fields existed (same bytes as the stock case files, same sha256 in dataset manifests).
         data: dict[str, Any] = handler(self)
         if self.surface_color is None:
             data.pop("surface_color", None)
+        if self.marking_standard == "custom":
+            data.pop("marking_standard", None)
         return data
 
 
