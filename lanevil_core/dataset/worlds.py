@@ -152,7 +152,7 @@ HELDOUT_WORLD = WorldRanges(
 
 WORLDS: dict[str, WorldRanges] = {"train": TRAIN_WORLD, "heldout": HELDOUT_WORLD}
 # Axes on which the held-out draw takes the train draw's ranges (time of day, weather, roadside and traffic vary
-# alike in both); every other axis of the tables is disjoint (tests/core/dataset/test_worlds.py checks it).
+# alike in both); every other axis of the tables is disjoint (tests/core/test_worlds.py checks it).
 SHARED_AXES: tuple[str, ...] = (
     "scene_kinds", "density", "sun_altitude_deg", "sun_azimuth_deg", "cloudiness", "fog_density", "wet_share",
     "wetness", "puddles", "rain", "tint", "traffic_share", "traffic_severities", "concrete_share", "draws_camera",
