@@ -40,7 +40,16 @@ from ..library.benchmark_layout import (
 from ..pipeline.frames import evenly_spaced
 from ..presets import PRESET_NAMES, preset_values
 from ..typed import LineType
-from .worlds import HELDOUT_WORLD, TRAIN_WORLD, WorldRanges, day_label, draw_world, world_parameters, world_rng
+from .worlds import (
+    HELDOUT_WORLD,
+    TRAIN_WORLD,
+    WorldRanges,
+    day_label,
+    draw_world,
+    world_markings,
+    world_parameters,
+    world_rng,
+)
 
 TEST_SPLIT = "test"
 TRAIN_SPLIT = "train"
@@ -330,7 +339,8 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     used for ``VARIED_CAMERA_SHARE`` of the variations (the rest keep the base's camera, the paper's), and last
     its pavement (concrete slabs for ``CONCRETE_SHARE`` of them) and its paint's wear (``WORN_PAINT_SHARE``).
     With ``world`` (``dataset.worlds``), a world drawn from those ranges on its own stream replaces the scene,
-    weather, sun, pavement, lane width, bends and grades, adds traffic, and (a held-out world) the camera."""
+    weather, sun, pavement, lane width, bends and grades, the marking standard and the paint's wear, turns the
+    broken lane lines into Botts' dots (some variations), adds traffic, and (a held-out world) the camera."""
     rng = np.random.default_rng([seed, index])
     preset = PRESET_NAMES[int(rng.integers(len(PRESET_NAMES)))]
     values = preset_values(preset)
@@ -369,7 +379,8 @@ def train_variation(base: Case, seed: int, index: int, vary_camera: bool = False
     parameters: dict[str, Any] = {}
     if world is not None:
         drawn_world = draw_world(world_rng(seed, index), world, (base.camera.width, base.camera.height))
-        data["road"].update(drawn_world["road"])
+        data["road"].update(drawn_world["road"], markings=world_markings(markings, drawn_world["markings"]))
+        wear = drawn_world["markings"]["wear"]
         data.update({key: drawn_world[key] for key in ("scene", "weather", "sun", "illusions", "camera")
                      if key in drawn_world})
         camera = data["camera"]

@@ -2,15 +2,18 @@
 
 ``lanevil dataset --vary-world`` draws, per train variation, the scene kind and density (and with it the kerbs,
 barriers and walls of that kind's cross-section), the sun (day, low sun, dusk, night), clouds, fog, a wet or dry
-road, the carriageway's material and colour, the lane width, the bends' radius and the slopes' grade, and traffic
+road, the carriageway's material and colour, the lane width, the bends' radius and the slopes' grade, traffic
 in the lanes (a ``vehicle`` illusion: its vehicles stand in every lane, the ego's beyond its drive, and hide the
-lines they stand on from the labels too). ``--vary-world --heldout`` draws from ``HELDOUT_WORLD`` instead: the same
-ranges on the axes in ``SHARED_AXES``, ranges disjoint from the train draw's on every other axis (cameras, lane
-widths, bends, grades, road colours), so a validation split made with it measures how a detector does on cameras,
-roads and materials it never saw. Both tables are below, side by side; ``docs/learning.md`` prints them.
+lines they stand on from the labels too), and the markings' manual (``road.marking_standard``: dash, gap, widths),
+Botts' dots in place of the broken lane lines and the paint's wear. ``--vary-world --heldout`` draws from
+``HELDOUT_WORLD`` instead: the same ranges on the axes in ``SHARED_AXES``, ranges disjoint from the train draw's on
+every other axis (cameras, lane widths, bends, grades, road colours, marking standards, paint wear), so a validation
+split made with it measures how a detector does on cameras, roads, materials and markings it never saw. Both tables
+are below, side by side; ``docs/learning.md`` prints them.
 
 Every draw uses its own stream, ``default_rng([seed, index, WORLD_STREAM])``, and always the same number of draws,
-so the variation's other draws (markings, ego lane and start, ``--vary-camera``'s camera) stay what they were.
+so the variation's other draws (markings, ego lane and start, ``--vary-camera``'s camera) stay what they were; the
+markings' draws come last on it (after the held-out camera's), so the world drawn before them stays as it was too.
 """
 
 from __future__ import annotations
@@ -22,12 +25,13 @@ import numpy as np
 
 from ..camera.variation import HEIGHT_M, HFOV_DEG, PITCH_DEG, MountSpans, Spans, pick_spans, random_camera
 from ..presets import sun_intensity
-from ..typed import SCENE_KINDS, SceneKind
+from ..typed import SCENE_KINDS, MarkingStandardName, SceneKind
 from ..world.environment import is_night
 
 WORLD_STREAM = 1  # third seed word of the world draws (the variation's own draws use [seed, index])
 VEHICLE = "vehicle"
 DAY_LABELS: tuple[tuple[float, str], ...] = ((5.0, "Dusk"), (20.0, "LowSun"), (90.0, "Day"))  # below this: name
+DASHED_LANE_LINE, BOTTS_DOTS = "white_dashed", "botts_dots"  # a broken lane line: painted dashes, or dots
 
 
 @dataclass(frozen=True)
@@ -52,6 +56,13 @@ class WorldRanges:
         camera: field of view, mount height and pitch of the cameras (the train world leaves the camera to
             ``--vary-camera``, whose ranges these are; the held-out world draws its own).
         draws_camera: whether the world draws the camera (through ``camera.variation.random_camera``).
+        marking_standards: the marking manuals (``road.marking_standard``; ``custom``: the markings' own dash 3 m,
+            gap 9 m, width 0.15 m), one drawn uniformly.
+        botts_share: share of variations whose broken lane lines (white dashes or dots in the variation's own
+            draw; not the edges, not the centre line) are Botts' dots, in groups standing in for the standard's
+            dashes; the rest are dashes (the labels stay: the same boundaries).
+        worn_share: share of variations with worn paint (the rest fresh); paint_wear: its wear (``Marking.wear``),
+            the same on every line of the variation.
     """
 
     scene_kinds: tuple[SceneKind, ...]
@@ -75,6 +86,10 @@ class WorldRanges:
     grade: Spans
     camera: MountSpans
     draws_camera: bool
+    marking_standards: tuple[MarkingStandardName, ...]
+    botts_share: float
+    worn_share: float
+    paint_wear: Spans
 
 
 TRAIN_WORLD = WorldRanges(
@@ -99,6 +114,10 @@ TRAIN_WORLD = WorldRanges(
     grade=((0.02, 0.07),),
     camera=MountSpans(fov_deg=(HFOV_DEG,), height_m=(HEIGHT_M,), pitch_deg=(PITCH_DEG,)),
     draws_camera=False,
+    marking_standards=("custom", "us_mutcd", "de_autobahn", "de_urban", "cn_fast", "jp_expressway"),  # gaps 6-12 m
+    botts_share=0.5,  # as often as the plain split's dots (its lane lines: dashes or dots alike)
+    worn_share=0.6,
+    paint_wear=((0.05, 0.6),),
 )
 
 HELDOUT_WORLD = WorldRanges(
@@ -125,17 +144,23 @@ HELDOUT_WORLD = WorldRanges(
                       height_m=((0.9, 1.15), (3.6, 4.2)),  # a low sports car, a tall truck cab
                       pitch_deg=((-4.0, -2.5), (6.5, 8.0))),  # tilted up, tilted down
     draws_camera=True,
+    marking_standards=("cn_slow", "jp_general"),  # the short-gap manuals: 2 m / 4 m and 5 m / 5 m
+    botts_share=TRAIN_WORLD.botts_share,
+    worn_share=TRAIN_WORLD.worn_share,
+    paint_wear=((0.75, 0.85),),  # beyond every train split's wear (--vary-camera's too): old, flaking paint
 )
 
 WORLDS: dict[str, WorldRanges] = {"train": TRAIN_WORLD, "heldout": HELDOUT_WORLD}
 # Axes on which the held-out draw takes the train draw's ranges (time of day, weather, roadside and traffic vary
-# alike in both); every other axis of the tables is disjoint (tests/core/dataset/test_worlds.py checks it).
+# alike in both); every other axis of the tables is disjoint (tests/core/test_worlds.py checks it).
 SHARED_AXES: tuple[str, ...] = (
     "scene_kinds", "density", "sun_altitude_deg", "sun_azimuth_deg", "cloudiness", "fog_density", "wet_share",
     "wetness", "puddles", "rain", "tint", "traffic_share", "traffic_severities", "concrete_share", "draws_camera",
+    "botts_share", "worn_share",
 )
 HELDOUT_AXES: tuple[str, ...] = tuple(f.name for f in fields(WorldRanges) if f.name not in SHARED_AXES)
 DRAWS = 20
+MARKING_DRAWS = 4  # drawn after DRAWS and the camera
 
 
 def day_label(altitude_deg: float) -> str:
@@ -159,10 +184,18 @@ def _surface(u: np.ndarray, ranges: WorldRanges) -> tuple[str, tuple[float, floa
     return ("concrete" if concrete else "asphalt"), color
 
 
+def _marking_draw(u: np.ndarray, ranges: WorldRanges) -> tuple[MarkingStandardName, dict[str, Any]]:
+    """(marking standard, ``{"botts_dots": bool, "wear": float}``) from ``MARKING_DRAWS`` uniform draws."""
+    standard = ranges.marking_standards[int(u[0] * len(ranges.marking_standards))]
+    wear = pick_spans(u[3], ranges.paint_wear, 2) if u[2] < ranges.worn_share else 0.0
+    return standard, {"botts_dots": bool(u[1] < ranges.botts_share), "wear": wear}
+
+
 def draw_world(rng: np.random.Generator, ranges: WorldRanges, size: tuple[int, int]) -> dict[str, Any]:
     """Case fields of one world drawn from ``ranges`` (always ``DRAWS`` uniform draws, plus ``random_camera``'s
-    when the world draws the camera): ``scene``, ``weather``, ``sun``, ``road`` (fields to update), ``illusions``
-    and, for a world that draws it, ``camera`` for an image of ``size``."""
+    when the world draws the camera, then ``MARKING_DRAWS``): ``scene``, ``weather``, ``sun``, ``road`` (fields to
+    update), ``illusions``, ``markings`` (what ``world_markings`` does to the variation's markings) and, for a world
+    that draws it, ``camera`` for an image of ``size``."""
     u = rng.uniform(0.0, 1.0, DRAWS)
     altitude = pick_spans(u[2], ranges.sun_altitude_deg, 1)
     cloud = pick_spans(u[4], ranges.cloudiness, 1)
@@ -194,13 +227,33 @@ def draw_world(rng: np.random.Generator, ranges: WorldRanges, size: tuple[int, i
     }
     if ranges.draws_camera:
         world["camera"] = random_camera(rng, size, ranges.camera)
+    road["marking_standard"], world["markings"] = _marking_draw(rng.uniform(0.0, 1.0, MARKING_DRAWS), ranges)
     return world
 
 
+def world_markings(markings: list[dict[str, Any]], drawn: dict[str, Any]) -> list[dict[str, Any]]:
+    """The variation's markings (dicts, left to right: edge, lane lines, centre line, lane lines, edge) under a
+    world's marking draw: every line's wear, and its broken lane lines as Botts' dots (``botts_dots``) or as
+    dashes. Every other type stays (an unpainted boundary stays unpainted), so the labels are those of the same
+    lines."""
+    centre = (len(markings) - 1) // 2
+
+    def line_type(index: int, marking: dict[str, Any]) -> str:
+        broken = index not in (0, centre, len(markings) - 1) and marking["type"] in (DASHED_LANE_LINE, BOTTS_DOTS)
+        if not broken:
+            return str(marking["type"])
+        return BOTTS_DOTS if drawn["botts_dots"] else DASHED_LANE_LINE
+
+    return [{**marking, "type": line_type(index, marking), "wear": drawn["wear"]}
+            for index, marking in enumerate(markings)]
+
+
 def world_parameters(world: dict[str, Any]) -> dict[str, Any]:
-    """What a variation's manifest entry says of its world draw."""
+    """What a variation's manifest entry says of its world draw (its paint wear and marking types are the entry's
+    own ``paint_wear`` and ``markings``)."""
     traffic = [illusion["severity"] for illusion in world["illusions"] if illusion["type"] == VEHICLE]
     return {"scene": world["scene"]["kind"], "density": world["scene"]["density"],
             "wetness": world["weather"]["wetness"], "cloudiness": world["weather"]["cloudiness"],
             "surface_color": list(world["road"]["surface_color"]), "traffic": traffic[0] if traffic else 0,
-            "day": day_label(world["sun"]["altitude"])}
+            "day": day_label(world["sun"]["altitude"]), "marking_standard": world["road"]["marking_standard"],
+            "botts_dots": world["markings"]["botts_dots"]}

@@ -1,22 +1,24 @@
 """``--vary-world`` and ``--heldout``: deterministic world draws, held-out ranges disjoint from the train draw's,
-a tiny varied split whose labels pass the label checks, and flag combinations refused with one line."""
+the markings' draw (standard, Botts' dots, wear), a tiny varied split whose labels pass the label checks, and flag
+combinations refused with one line."""
 
 from __future__ import annotations
 
 import json
 import shutil
-from dataclasses import fields
+from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lanevil_core.camera.variation import MountSpans, pick_spans
-from lanevil_core.case import Case, case_json, load_case, parse_case
+from lanevil_core.case import GAP_M, Case, Marking, case_json, load_case, parse_case
 from lanevil_core.cli import main
 from lanevil_core.dataset.plan import (
     CAMERA_PITCH_RANGE_DEG,
     CAMERA_Z_RANGE_M,
+    PAINT_WEAR_RANGE,
     PlanError,
     Settings,
     build_plan,
@@ -31,10 +33,13 @@ from lanevil_core.dataset.worlds import (
     TRAIN_WORLD,
     WorldRanges,
     draw_world,
+    world_markings,
     world_rng,
 )
 from lanevil_core.labels.lanes import h_samples_for
 from lanevil_core.metrics.formats import read_tusimple
+from lanevil_core.typed import MarkingStandardName
+from lanevil_core.world.marking_standards import MARKING_STANDARDS
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 CLEAN = SCENES / "00_clean"
@@ -55,7 +60,8 @@ def _overlaps(a: tuple[float, float], b: tuple[float, float]) -> bool:
 def test_every_axis_is_shared_or_held_out() -> None:
     names = {f.name for f in fields(WorldRanges)}
     assert set(SHARED_AXES) | set(HELDOUT_AXES) == names and not set(SHARED_AXES) & set(HELDOUT_AXES)
-    assert {"camera", "lane_width_m", "asphalt_albedo", "concrete_albedo"} <= set(HELDOUT_AXES)
+    assert {"camera", "lane_width_m", "asphalt_albedo", "concrete_albedo", "marking_standards",
+            "paint_wear"} <= set(HELDOUT_AXES)
 
 
 @pytest.mark.parametrize("axis", SHARED_AXES)
@@ -71,6 +77,9 @@ def test_held_out_ranges_are_disjoint_from_the_train_ranges(axis: str) -> None:
             for a in getattr(held, f.name):
                 assert not any(_overlaps(a, b) for b in getattr(train, f.name)), (f.name, a)
         return
+    if all(isinstance(name, str) for name in held):  # named choices (marking standards): no name in both
+        assert held and not set(held) & set(train), (axis, set(held) & set(train))
+        return
     for a in _intervals(held):
         assert not any(_overlaps(a, b) for b in _intervals(train)), (axis, a)
 
@@ -81,6 +90,29 @@ def test_held_out_cameras_lie_outside_every_train_camera() -> None:
     assert all(any(lo <= v <= hi for lo, hi in train.height_m) for v in (*CAMERA_Z_RANGE_M, 3.0))
     assert all(any(lo <= v <= hi for lo, hi in train.pitch_deg) for v in (*CAMERA_PITCH_RANGE_DEG, 0.0))
     assert any(lo <= 90.0 <= hi for lo, hi in train.fov_deg)
+
+
+def test_held_out_markings_lie_outside_every_train_split() -> None:
+    # the held-out manuals' gaps are shorter than any train manual's (custom: the markings' own 9 m gap) ...
+    def gap(name: MarkingStandardName) -> float:
+        return GAP_M if name == "custom" else MARKING_STANDARDS[name].gap_m
+
+    assert max(gap(name) for name in HELDOUT_WORLD.marking_standards) < min(
+        gap(name) for name in TRAIN_WORLD.marking_standards)
+    assert Marking().gap == GAP_M
+    # ... and the held-out wear lies beyond the world draw's and --vary-camera's (the plain split's paint is fresh)
+    worst = max(hi for _, hi in TRAIN_WORLD.paint_wear)
+    assert all(lo > max(worst, PAINT_WEAR_RANGE[1]) for lo, _ in HELDOUT_WORLD.paint_wear)
+
+
+def test_the_markings_draw_comes_last_on_the_world_stream() -> None:
+    other = replace(TRAIN_WORLD, marking_standards=("cn_slow",), botts_share=1.0, worn_share=1.0,
+                    paint_wear=((0.9, 1.0),))
+    for index in range(5):
+        first, second = (draw_world(world_rng(2, index), ranges, (640, 360)) for ranges in (TRAIN_WORLD, other))
+        assert second["road"].pop("marking_standard") == "cn_slow" and second["markings"]["botts_dots"]
+        del first["road"]["marking_standard"], first["markings"], second["markings"]
+        assert first == second
 
 
 def test_pick_spans_covers_every_interval_with_one_draw() -> None:
@@ -114,6 +146,21 @@ def test_drawn_worlds_lie_in_their_ranges(ranges: WorldRanges) -> None:
         grey = case.road.surface_color[1]
         assert inside(grey, ranges.concrete_albedo if case.road.pavement == "concrete" else ranges.asphalt_albedo)
         assert case.scene.kind in ranges.scene_kinds
+    own = [train_variation(base, 0, index)[0].road.markings for index in range(60)]
+    for case, markings in zip(cases, own, strict=True):
+        assert case.road.marking_standard in ranges.marking_standards
+        wear = {marking.wear for marking in case.road.markings}  # one wear on every line
+        assert len(wear) == 1 and (wear == {0.0} or inside(min(wear), ranges.paint_wear))
+        last = len(markings) - 1
+        for index, (marking, before) in enumerate(zip(case.road.markings, markings, strict=True)):
+            if marking.type != before.type:  # only broken lane lines change; edges, centre, solid lines stay
+                assert {before.type, marking.type} == {"white_dashed", "botts_dots"}
+                assert index not in (0, last // 2, last)
+    assert len({case.road.marking_standard for case in cases}) == len(ranges.marking_standards)
+    assert any(marking.wear > 0 for case in cases for marking in case.road.markings)
+    assert any(case.road.markings[0].wear == 0 for case in cases)
+    assert any([m.type for m in case.road.markings] != [m.type for m in markings]
+               for case, markings in zip(cases, own, strict=True))  # some dashes became dots, or dots dashes
     camera_heights = {case.camera.z for case in cases}
     if ranges.draws_camera:
         assert all(inside(case.camera.fov, ranges.camera.fov_deg) and inside(case.camera.z, ranges.camera.height_m)
@@ -135,9 +182,38 @@ def test_without_world_flags_variations_and_case_files_are_unchanged() -> None:
     assert case.road.surface_color is None and "surface_color" not in case_json(case)
     assert "world" not in parameters and not case.illusions
     assert case_json(base) == (CLEAN / "00_straight_urban.json").read_text()
-    # the world's own stream: the variation's other draws (markings, ego lane and start) stay
-    varied, _ = train_variation(base, 2, 1, world=TRAIN_WORLD)
-    assert (varied.road.markings, varied.ego, varied.seed) == (case.road.markings, case.ego, case.seed)
+    assert case.road.marking_standard == "custom"
+    # the world's own stream: the variation's other draws (markings, ego lane and start) stay; the world draws
+    # only the standard, the wear and whether broken lane lines are dots
+    for index in range(8):
+        case, _ = train_variation(base, 2, index)
+        varied, _ = train_variation(base, 2, index, world=TRAIN_WORLD)
+        drawn = draw_world(world_rng(2, index), TRAIN_WORLD, (base.camera.width, base.camera.height))["markings"]
+        plain = [marking.model_dump() for marking in case.road.markings]
+        assert [Marking(**m) for m in world_markings(plain, drawn)] == varied.road.markings
+        assert (varied.ego, varied.seed) == (case.ego, case.seed)
+
+
+def test_botts_dots_keep_the_labels_of_the_broken_lines() -> None:
+    from lanevil_core.camera.pinhole import ego_camera
+    from lanevil_core.labels.lanes import lane_labels
+    from lanevil_core.pipeline.compile import compile_scene
+
+    base = load_case(CLEAN / "03_uphill_highway.json")
+    dashed = [marking.model_dump() for marking in base.road.markings]
+    assert sum(m["type"] == "white_dashed" for m in dashed) >= 2
+    dotted = world_markings(dashed, {"botts_dots": True, "wear": 0.5})
+    assert sum(m["type"] == "botts_dots" for m in dotted) == sum(m["type"] == "white_dashed" for m in dashed)
+    assert world_markings(dotted, {"botts_dots": False, "wear": 0.0}) == dashed
+    lanes = []
+    for markings in (dashed, dotted):
+        data = base.model_dump()
+        data["road"].update(markings=markings, marking_standard="us_mutcd")
+        scene = compile_scene(parse_case(data))
+        camera = ego_camera(scene.case, scene.network, 30, (320, 180))
+        labels = lane_labels(scene, camera, np.arange(90.0, 180.0, 10.0))
+        lanes.append([(label.boundary.index, np.nan_to_num(label.x_image, nan=-1.0).tolist()) for label in labels])
+    assert len(lanes[0]) >= 3 and lanes[0] == lanes[1]
 
 
 def test_surface_color_round_trips_and_changes_the_road() -> None:
@@ -222,5 +298,7 @@ def test_a_tiny_varied_split_writes_labels_that_pass_the_checks(flags: list[str]
         assert (out / "train" / record.raw_file).is_file()
         case = load_case(out / "train" / record.extra["case"] / "case.json")
         assert case.road.surface_color is not None
+        world = HELDOUT_WORLD if "--heldout" in flags else TRAIN_WORLD
+        assert case.road.marking_standard in world.marking_standards
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["settings"]["world"] == ("heldout" if "--heldout" in flags else "train")
