@@ -25,6 +25,7 @@ from app.state import AppState
 from app.store import CaseRecord
 from lanevil_core.case import parse_case
 from lanevil_core.detect import catalog as detector_catalog
+from lanevil_core.detect.learned import BUNDLED_MODELS
 from lanevil_core.detect.split import METHODS
 from lanevil_core.illusions.shadow import roadside_t
 from lanevil_core.library.benchmark_layout import illusion_folder
@@ -235,7 +236,8 @@ def test_frame_slider_and_overlay_toggle(tab: EditorTab) -> None:
 
 def test_detector_dropdown_draws_its_lanes_and_scores_the_frame(tab: EditorTab, state: AppState, monkeypatch,
                                                                  tmp_path) -> None:
-    assert list(tab.display.detector.options) == ["none", *METHODS] and tab.display.detector.value == "none"
+    assert list(tab.display.detector.options) == ["none", *METHODS, *BUNDLED_MODELS]
+    assert tab.display.detector.value == "none"
     plain = settle(tab)
     assert tab.display.detection.content == "" and tab.last_result.request.detector is None
     shown: dict[str, np.ndarray] = {}
@@ -272,7 +274,7 @@ def served_detector(monkeypatch, lane_server):
 
 def test_a_plugin_detector_is_a_choice_and_a_server_down_is_said(served_detector, tab: EditorTab, monkeypatch,
                                                                   down_url: str) -> None:
-    assert list(tab.display.detector.options) == ["none", *METHODS, "mine"]
+    assert list(tab.display.detector.options) == ["none", *METHODS, "mine", *BUNDLED_MODELS]
     tab.display.detector.value = "mine"
     settle(tab)
     assert "**mine**" in tab.display.detection.content and served_detector.sizes
