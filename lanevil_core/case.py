@@ -254,6 +254,10 @@ class Sensor(_Model):
     saturation: StrictFloat = Field(1.45, ge=0.0, le=3.0, description="colour matrix saturation (1 = none)")
     contrast: StrictFloat = Field(1.15, ge=0.5, le=2.0, description="slope of the filmic curve's toe and middle")
     vignetting: StrictFloat = Field(0.35, ge=0.0, le=1.0, description="light lost in the image corners (0-1)")
+    softness: StrictFloat = Field(0.0, ge=0.0, le=5.0, exclude_if=lambda value: value == 0.0,  # files as before
+                                  description="what the lens, demosaicing and noise "
+                                  "reduction take of the finest detail: a Gaussian blur of this sigma (px at 1280 "
+                                  "wide) before the ISP sharpens; 0 = none")
     sharpen: StrictFloat = Field(0.6, ge=0.0, le=3.0, description="ISP unsharp-mask amount")
     noise: StrictFloat = Field(1.0, ge=0.0, le=10.0, description="sensor noise scale (1 = a typical small sensor)")
     shutter: StrictFloat = Field(0.004, ge=0.0, le=0.1, description="exposure time for motion blur (s); 0 = none")

@@ -42,6 +42,7 @@ SURFACE_TABLE = surface_table(MATERIAL_ALBEDO)
 MIRROR_BLUR_PX_AT_1280 = 10
 MIRROR_LAMP_SPILL = 0.02  # irradiance of the street lamps on the objects a wet road mirrors at night
 HEADLIGHT_COLOR = (1.0, 0.95, 0.85)  # halogen-white low beams
+SOFTNESS_WIDTH = 1280  # image width at which a sensor's softness sigma is given
 HEADLIGHT_HEIGHT_M = 0.7  # the low beams' height above the road (ECE R48: 0.5-1.2 m)
 HEADLIGHT_AHEAD_M = 1.5  # how far ahead of the camera the lamps stand
 HEADLIGHT_HALF_SPAN_M = 0.75  # half the distance between the two lamps
@@ -311,6 +312,8 @@ def _photograph(scene: CompiledScene, camera: PinholeCamera, threads: int, frame
         glare(hdr, dev.gain)
         develop(hdr, dev.gain, dev.channel_gain, sensor.vignetting, (k.cx, k.cy), dev.shot, dev.read,
                 sensor.saturation, _noise_seed(scene.ego.seed, frame), dev.lut, rgb, threads, object_id, streaks)
+        if sensor.softness > 0.0:  # the sigma is the camera's at 1280 wide: the same blur of the scene at any size
+            rgb = np.asarray(cv2.GaussianBlur(rgb, (0, 0), sensor.softness * k.width / SOFTNESS_WIDTH), np.uint8)
         if sensor.sharpen > 0.0:
             soft = cv2.GaussianBlur(rgb, (0, 0), 1.0)
             rgb = np.asarray(cv2.addWeighted(rgb, 1.0 + sensor.sharpen, soft, -sensor.sharpen, 0.0), np.uint8)

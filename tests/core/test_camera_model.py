@@ -129,6 +129,21 @@ def test_headlights_stand_on_the_car_under_a_camera_of_any_height_and_pitch(heig
     assert np.linalg.norm(beams_world[0] - beams_world[1]) == pytest.approx(2 * HEADLIGHT_HALF_SPAN_M)
 
 
+def test_softness_takes_the_finest_detail_as_a_camera_does() -> None:
+    def frame(softness: float) -> np.ndarray:
+        case = Case.model_validate({"camera": {"width": 640, "height": 360, "sensor": {"softness": softness,
+                                                                                       "sharpen": 0.0}}})
+        return render_frame(compile_scene(case), 0).rgb.astype(np.float64).mean(2)
+
+    def fine_detail(grey: np.ndarray) -> float:  # variance of the discrete Laplacian
+        return float(np.var(grey[1:-1, 2:] + grey[1:-1, :-2] + grey[2:, 1:-1] + grey[:-2, 1:-1] - 4 * grey[1:-1, 1:-1]))
+
+    sharp, soft = frame(0.0), frame(1.6)
+    assert fine_detail(soft) < 0.5 * fine_detail(sharp)
+    assert abs(soft.mean() - sharp.mean()) < 1.0  # a blur moves no light
+    assert np.array_equal(frame(1.6), soft)  # deterministic
+
+
 def _shadow_share(case: Case) -> float:
     """Light on flat ground in shadow over light in the sun (luminance), as the renderer gets them."""
     env = compile_scene(case).env
