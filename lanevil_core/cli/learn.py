@@ -123,11 +123,12 @@ def _run_train(args: argparse.Namespace) -> int:
 
 
 def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
+    from ..detect.learned import BUNDLED_MODELS
     from ..detect.model_spec import FAMILIES
 
     parser.add_argument("--weights", required=True,
-                        help=f"the model to adapt: a model folder of `lanevil train` or a shipped family "
-                             f"({', '.join(FAMILIES)})")
+                        help=f"the model to adapt: a model folder of `lanevil train`, a shipped family "
+                             f"({', '.join(FAMILIES)}) or a shipped model ({', '.join(BUNDLED_MODELS)})")
     parser.add_argument("--frames", type=Path, required=True, action="append",
                         help="folder of your own unlabelled frames (png/jpg, searched recursively); repeatable")
     parser.add_argument("--out", type=Path, required=True, help="model folder to write")
@@ -135,6 +136,8 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
                         help="AdaBN (normalisation statistics re-estimated), self-training on confident "
                              "pseudo-labels, or both in that order (default)")
     parser.add_argument("--epochs", type=count(1), default=3, help="self-training epochs (default 3)")
+    parser.add_argument("--rounds", type=count(1), default=1,
+                        help="self-training rounds, each on the last round's model's readings (default 1)")
     parser.add_argument("--lr", type=float, default=2e-4, help="self-training learning rate (default 2e-4)")
     parser.add_argument("--max-frames", type=count(1), default=2000, help="frames read at most (default 2000)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
@@ -148,19 +151,20 @@ def _run_adapt(args: argparse.Namespace) -> int:
         import torch  # noqa: F401
     except ImportError:
         raise UsageError("lanevil adapt needs PyTorch: pip install -e '.[learn]'") from None
-    from ..detect.learned import shipped_model_dir
+    from ..detect.learned import BUNDLED_MODELS, shipped_model_dir
     from ..detect.model_spec import FAMILIES, ModelSpecError
     from ..learn.adapt import AdaptError, AdaptSettings, adapt
 
-    model = shipped_model_dir(args.weights) if args.weights in FAMILIES else Path(args.weights)
+    shipped = args.weights in FAMILIES or args.weights in BUNDLED_MODELS
+    model = shipped_model_dir(args.weights) if shipped else Path(args.weights)
     if not model.is_dir():
         raise UsageError(f"--weights {args.weights}: no such model folder")
     for folder in args.frames:
         if not folder.is_dir():
             raise UsageError(f"--frames {folder}: no such folder")
     settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
-                             epochs=args.epochs, lr=args.lr, max_frames=args.max_frames, device=args.device,
-                             seed=args.seed, threads=args.threads)
+                             epochs=args.epochs, rounds=args.rounds, lr=args.lr, max_frames=args.max_frames,
+                             device=args.device, seed=args.seed, threads=args.threads)
     try:
         summary = adapt(settings, show_progress=not args.quiet)
     except (AdaptError, ModelSpecError) as error:

@@ -38,11 +38,11 @@ SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 BUNDLED_MODELS: tuple[str, ...] = ("seg-transfer",)
 
 
-def shipped_model_dir(family: str) -> Path:
-    """The folder of the model shipped for ``family`` (one of ``FAMILIES``)."""
-    if family not in FAMILIES:
-        raise ModelSpecError(f"no shipped model for {family!r} (choose from {', '.join(FAMILIES)})")
-    return SHIPPED_MODELS / family
+def shipped_model_dir(name: str) -> Path:
+    """The folder of the model shipped for ``name``: one of ``FAMILIES`` or ``BUNDLED_MODELS``."""
+    if name not in FAMILIES and name not in BUNDLED_MODELS:
+        raise ModelSpecError(f"no shipped model {name!r} (choose from {', '.join((*FAMILIES, *BUNDLED_MODELS))})")
+    return SHIPPED_MODELS / name
 
 
 def network_input(rgb: UInt8Array, input_size: tuple[int, int]) -> Float32Array:

@@ -10,6 +10,8 @@ Two methods, used in this order (``--method``):
   under ``agreement`` of the image width over the rows both cover) and a frame only with at least ``min_lanes``
   such lanes. The model is then fine-tuned on those frames and labels with strong photometric augmentation
   (``learn.randomise.photometric``) at a small learning rate, which keeps it near what it learned from renders.
+  With ``rounds`` above 1 the frames are read again by the fine-tuned model and it is fine-tuned on its new
+  readings, round after round (each round's lanes must again agree with their mirror).
 
 The result is a model folder like ``lanevil train``'s (``config.json``, ``weights.pt``, ``model.onnx``,
 ``training.json`` with what was adapted on), usable wherever a detector is chosen (``--weights``).
@@ -58,6 +60,7 @@ class AdaptSettings:
     out: Path
     method: str = "adabn+self-train"
     epochs: int = 3
+    rounds: int = 1  # self-training rounds: each reads the frames again with the model the last round left
     batch: int = 16
     lr: float = 2e-4
     agreement: float = 0.015  # mean |x - x_mirrored| as a share of the width for a lane to be kept
@@ -186,7 +189,8 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     if "adabn" in settings.method:
         summary["adabn_layers"] = adapt_batch_norm(model, images, device)
     if "self-train" in settings.method:
-        summary["self_training"] = _self_train(model, images, settings, device, show_progress)
+        rounds = [_self_train(model, images, settings, device, show_progress) for _ in range(settings.rounds)]
+        summary["self_training"] = rounds[-1] if len(rounds) == 1 else {**rounds[-1], "rounds": rounds}
     model = model.cpu().eval()
     out = settings.out
     out.mkdir(parents=True, exist_ok=True)

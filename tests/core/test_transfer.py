@@ -178,6 +178,13 @@ def test_adapt_writes_a_model_usable_as_weights(tiny_dataset, tmp_path, capsys):
     assert isinstance(detector(np.ascontiguousarray(rgb), list(range(100, 144, 4))), list)
     assert main(["detect", str(tiny_dataset / "train"), "--method", "ufld", "--weights", str(out),
                  "--out", str(tmp_path / "pred.json")]) == 0
+    again = tmp_path / "two_rounds"
+    code = main(["adapt", "--weights", str(tmp_path / "model"), "--frames", str(frames), "--out", str(again),
+                 "--method", "self-train", "--rounds", "2", "--epochs", "1", "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    rounds = json.loads((again / "training.json").read_text())["self_training"]
+    assert "adabn_layers" not in json.loads((again / "training.json").read_text())
+    assert "rounds" in rounds and len(rounds["rounds"]) == 2
 
 
 def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, monkeypatch, capsys):  # noqa: F811
@@ -196,8 +203,13 @@ def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, m
 
 def test_adapt_errors_exit_2(tmp_path, capsys):
     (tmp_path / "empty").mkdir()
-    assert main(["adapt", "--weights", "ufld", "--frames", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 2
-    assert "no png or jpg" in capsys.readouterr().err
+    for shipped in ("ufld", "seg-transfer"):  # a family's and a bundled model's name both name a shipped folder
+        assert main(["adapt", "--weights", shipped, "--frames", str(tmp_path / "empty"),
+                     "--out", str(tmp_path / "o")]) == 2
+        assert "no png or jpg" in capsys.readouterr().err
+    assert main(["adapt", "--weights", "ufld", "--frames", str(tmp_path), "--out", str(tmp_path / "o"),
+                 "--rounds", "0"]) == 2
+    assert "--rounds" in capsys.readouterr().err
     assert main(["adapt", "--weights", str(tmp_path / "nowhere"), "--frames", str(tmp_path),
                  "--out", str(tmp_path / "o")]) == 2
     assert "no such model folder" in capsys.readouterr().err
