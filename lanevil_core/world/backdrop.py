@@ -31,9 +31,13 @@ VALLEY_SHARE = 0.45  # hills fall to this share of their height where the main r
 VALLEY_HALF_WIDTH = np.radians(14.0)
 CAMERA_HEIGHT_M = 1.5  # the eye the elevation limit is kept for
 VIEW_HALF_ANGLE = np.radians(80.0)  # the widest camera's half field of view, and some
-FOREST = ((0.035, 0.06, 0.025), (0.045, 0.07, 0.03), (0.03, 0.05, 0.028), (0.05, 0.065, 0.03))
+FOREST = ((0.05, 0.085, 0.035), (0.065, 0.1, 0.04), (0.045, 0.075, 0.04), (0.07, 0.09, 0.04))
 FIELDS = ((0.11, 0.13, 0.05), (0.16, 0.14, 0.07), (0.08, 0.11, 0.04), (0.13, 0.12, 0.06))
 UNDERSTOREY = 0.45  # the shade under a forest edge's canopy, as a share of its leaves' colour
+CANOPY_SHADES = (UNDERSTOREY, 1.0, 1.05)  # understorey, crowns, their tops
+CROWN_DOME = 0.6  # a crown's dome: its height over its radius
+EMERGENT_SHARE = 0.1  # the crowns that rise well above their neighbours
+TAPER_M = 12.0  # a line of vegetation thins out over this length at its ends
 DRIVE_AHEAD_M = 600.0  # tree lines stand along the main road from behind the ego's start to this far beyond its end
 DRIVE_BEHIND_M = 40.0
 
@@ -52,7 +56,7 @@ class Vegetation:
     name: str
 
 
-TREE_LINE = Vegetation((45.0, 140.0), (9.0, 17.0), (2.5, 5.5), 0.55, (60.0, 260.0), "tree line")
+TREE_LINE = Vegetation((50.0, 140.0), (8.0, 14.0), (3.0, 5.5), 0.55, (60.0, 260.0), "tree line")
 FAR_WOOD = Vegetation((150.0, 230.0), (12.0, 20.0), (3.0, 6.0), 0.7, (120.0, 400.0), "wood")
 HEDGEROW = Vegetation((32.0, 60.0), (1.6, 3.2), (1.0, 2.2), 0.5, (40.0, 160.0), "hedgerow")
 SUBURB_BEHIND = Vegetation((26.0, 42.0), (7.0, 13.0), (2.5, 4.5), 0.6, (30.0, 110.0), "houses behind")
@@ -82,6 +86,12 @@ def road_points(network: RoadNetwork) -> FloatArray:
     return np.concatenate(rows)
 
 
+def patches(noise: FloatArray, palette: tuple[tuple[float, float, float], ...]) -> FloatArray:
+    """(n, 3) colours of ``palette`` in patches: smooth ``noise`` (n,) (about [-1, 1]) cut into as many bands."""
+    k = np.clip(((noise + 1.0) / 2.0 * len(palette)).astype(int), 0, len(palette) - 1)
+    return np.asarray(palette)[k]
+
+
 def view_sector(inputs: RoadsideInputs, network: RoadNetwork) -> tuple[float, float]:
     """(first, last) bearing (radians, increasing) the ego's camera can see along its drive: the main road's
     headings from its start to DRIVE_AHEAD_M beyond its end, VIEW_HALF_ANGLE to either side."""
@@ -92,31 +102,39 @@ def view_sector(inputs: RoadsideInputs, network: RoadNetwork) -> tuple[float, fl
 
 
 def hill_ring(network: RoadNetwork, sector: tuple[float, float], rng: np.random.Generator, scale: float,
-              max_deg: float, step_deg: float, colors: tuple[tuple[float, float, float], ...], name: str) -> Mesh:
+              max_deg: float, step_deg: float, colors: tuple[tuple[float, float, float], ...], name: str,
+              shoulder: bool = True) -> Mesh:
     """An arc of hills over the bearings of ``sector`` around the road network, ``scale`` times the nearest
-    ring's radius, its crest at most ``max_deg`` above the horizontal seen from any road point 1.5 m up: one
-    quad every ``step_deg`` from a foot sunk below the land up to the crest, facing the road."""
+    ring's radius, its crest at most ``max_deg`` above the horizontal seen from any road point 1.5 m up: every
+    ``step_deg`` a quad from a foot sunk below the land up to a ``shoulder`` and one up to the crest (or one
+    straight up to the crest), facing the road."""
     p_road = road_points(network)
     centre = 0.5 * (p_road[:, :2].min(0) + p_road[:, :2].max(0))
     radius = scale * max(HILL_MIN_RADIUS_M, float(np.linalg.norm(p_road[:, :2] - centre, axis=1).max())
                          + HILL_MARGIN_M)
     theta = np.arange(sector[0], sector[1] + 1e-9, np.radians(step_deg))
     around = np.stack([np.cos(theta), np.sin(theta)], 1)
-    shape = 0.62 + 0.38 * periodic_noise(rng, theta)  # the crest's share of the allowed height
+    shape = np.clip(0.5 + 0.5 * periodic_noise(rng, theta), 0.12, 1.0)  # the crest's share of the allowed height
     heading = float(network.main.line.heading[0])
     for ahead in (heading, heading + np.pi):  # the road runs up a valley: lower hills where it heads
         off = np.angle(np.exp(1j * (theta - ahead)))
         shape *= 1.0 - (1.0 - VALLEY_SHARE) * np.exp(-0.5 * (off / VALLEY_HALF_WIDTH) ** 2)
     level = _land_level(p_road, centre, theta)
     foot = np.column_stack([centre + around * radius, level - 0.02 * radius])  # below the horizon from the road
-    crest_xy = centre + around * radius * 1.08
+    crest_xy = centre + around * radius * 1.1
     nearest = np.sqrt(((crest_xy[:, None] - p_road[None, :, :2]) ** 2).sum(-1)).min(1)
-    top = p_road[:, 2].min() + CAMERA_HEIGHT_M + shape * np.tan(np.radians(max_deg)) * nearest
-    vertices = np.concatenate([foot, np.column_stack([crest_xy, np.maximum(top, level + 4.0)])])
-    faces = _ribbon_faces(len(theta), 2, closed=False)
-    palette = np.asarray(colors)
-    mesh_colors = palette[rng.integers(0, len(palette), len(faces))] * rng.uniform(0.8, 1.2, (len(faces), 1))
-    towards = np.column_stack([np.tile(-around, (2, 1)), np.zeros(len(vertices))])[faces[:, 0]]
+    top = np.maximum(p_road[:, 2].min() + CAMERA_HEIGHT_M + shape * np.tan(np.radians(max_deg)) * nearest,
+                     level + 4.0)
+    rows = [foot]
+    if shoulder:  # a shoulder part way up, its own height: slopes facing several ways, lit unevenly
+        share = 0.45 + 0.25 * periodic_noise(rng, theta, octaves=3, base=6)
+        rows.append(np.column_stack([centre + around * radius * 1.05, level + share * (top - level)]))
+    rows.append(np.column_stack([crest_xy, top]))
+    vertices = np.concatenate(rows)
+    faces = _ribbon_faces(len(theta), len(rows), closed=False)
+    tone = patches(periodic_noise(rng, theta, octaves=3, base=10), colors)[:-1]
+    mesh_colors = np.tile(tone, (2 * (len(rows) - 1), 1)) * rng.uniform(0.94, 1.06, (len(faces), 1))
+    towards = np.column_stack([np.tile(-around, (len(rows), 1)), np.zeros(len(vertices))])[faces[:, 0]]
     return Mesh(vertices, facing(vertices, faces, towards), mesh_colors.astype(np.float32), name=name,
                 kind="terrain", casts_shadow=False)
 
@@ -149,47 +167,66 @@ def _ribbon_faces(n: int, rows: int, closed: bool) -> np.ndarray:
 
 def crown_tops(s: FloatArray, rng: np.random.Generator, height: tuple[float, float],
                crown: tuple[float, float]) -> FloatArray:
-    """(n,) the top of a row of crowns over stations ``s`` (n,): round crowns of random radius and height side
-    by side and overlapping, so the row reads as trees merging into a mass."""
+    """(2, n) the top of a row of crowns over stations ``s`` (n,), and how far the crown standing there bulges
+    out (m, its radius at its middle, none at its rims): domed crowns of random radius and height overlapping
+    side by side, so the row reads as trees merging into a mass."""
     top = np.zeros_like(s)
+    bulge = np.zeros_like(s)
     c = float(s[0]) - crown[1]
+    groves = smooth_tone(s, rng, 70.0, 0.2)  # stands of taller and lower trees
     while c < s[-1] + crown[1]:
         r = float(rng.uniform(*crown))
-        h = float(rng.uniform(*height))
-        inside = np.abs(s - c) < r
-        top[inside] = np.maximum(top[inside], h - r + r * np.sqrt(1.0 - ((s[inside] - c) / r) ** 2))
-        c += r * float(rng.uniform(0.8, 1.5))
-    return np.maximum(top, 0.4 * height[0])
+        h = float(rng.uniform(*height)) * float(np.interp(c, s, groves))
+        if rng.random() < EMERGENT_SHARE:  # a tree standing out of the mass
+            h *= 1.2
+        inside = np.flatnonzero(np.abs(s - c) < r)
+        round_ = r * np.sqrt(1.0 - ((s[inside] - c) / r) ** 2)
+        dome = h + CROWN_DOME * (round_ - r)
+        wins = dome > top[inside]
+        top[inside[wins]], bulge[inside[wins]] = dome[wins], round_[wins]
+        c += r * float(rng.uniform(0.5, 1.1))
+    return np.stack([np.maximum(top, 0.6 * height[0]), bulge])
 
 
-def canopy(base: FloatArray, back: FloatArray, top: FloatArray, rng: np.random.Generator, name: str) -> Mesh:
-    """A forest edge or a hedge over the ground line ``base`` (n, 3) (world): its face leaning away along the
-    horizontal ``back`` (n, 2) (unit) to the crowns' ``top`` (n,) m above the ground, a shaded understorey below;
-    leaves varied face by face."""
+def smooth_tone(x: FloatArray, rng: np.random.Generator, wavelength: float, spread: float) -> FloatArray:
+    """(n,) a tone 1 +- ``spread`` varying smoothly over ``x`` (n,) at about ``wavelength``: patches of lighter
+    and darker vegetation instead of face-by-face stripes."""
+    tone = np.zeros_like(x)
+    for k in range(3):
+        tone += np.sin(x * (2 ** k) * 2 * np.pi / wavelength + rng.uniform(0, 2 * np.pi)) / 2 ** k
+    return 1.0 + spread * tone / 1.75
+
+
+def canopy(base: FloatArray, back: FloatArray, crowns: FloatArray, rng: np.random.Generator, name: str) -> Mesh:
+    """A forest edge or a hedge over the ground line ``base`` (n, 3) (world), its ``crowns`` (``crown_tops``,
+    (2, n)): a shaded understorey, each crown bulging towards the road (against the horizontal ``back`` (n, 2),
+    unit) so it is lit as a dome, their tops leaning away; leaves in patches of tone, lighter up in the sun."""
     n = len(base)
-    jitter = rng.uniform(-0.06, 0.06, n) * top
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(base[:, :2], axis=0), axis=1))])
+    top, bulge = crowns * np.clip(np.minimum(along, along[-1] - along) / TAPER_M, 0.3, 1.0) ** 0.5
     green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
-    leaves = (np.asarray(FOREST)[rng.integers(0, len(FOREST), 2 * (n - 1))] * 0.5 + 0.5 * green) \
-        * rng.uniform(0.75, 1.3, (2 * (n - 1), 1))
-    return banded(base, back, (0.3 * top, 0.15 * top + jitter), (top, 0.45 * top + jitter),
-                  leaves * UNDERSTOREY, leaves[::-1], name, "tree")
+    levels = [(0.3 * top, 0.15 * top), (0.68 * top, 0.25 * top - 0.8 * bulge), (top, 0.25 * top)]
+    levels = [(h, lean + rng.uniform(-0.02, 0.02, n) * top) for h, lean in levels]
+    tone = smooth_tone(along, rng, 40.0, 0.25)
+    faces_tone = np.tile(0.5 * (tone[:-1] + tone[1:]), 2)[:, None] * rng.uniform(0.92, 1.08, (2 * (n - 1), 1))
+    colors = [green * faces_tone * shade for shade in CANOPY_SHADES]
+    return layered(base, back, levels, colors, name, "tree")
 
 
-def banded(base: FloatArray, back: FloatArray, middle: tuple[FloatArray, FloatArray],
-           top: tuple[FloatArray, FloatArray], low: FloatArray, high: FloatArray, name: str, kind: str) -> Mesh:
-    """Two bands of quads over the ground line ``base`` (n, 3): from just below the ground up to ``middle``
-    (heights (n,), set back (n,) along ``back`` (n, 2)), then to ``top`` (the same); each band's (2 (n - 1), 3)
-    colours ``low`` and ``high``, the quads facing against ``back``."""
+def layered(base: FloatArray, back: FloatArray, levels: list[tuple[FloatArray, FloatArray]],
+            colors: list[FloatArray], name: str, kind: str) -> Mesh:
+    """Bands of quads over the ground line ``base`` (n, 3): from just below the ground up through ``levels``
+    ((height, setback along the horizontal ``back`` (n, 2)), each (n,)); each band's (2 (n - 1), 3) colours in
+    ``colors``; the quads face against ``back``."""
     n = len(base)
     lean = np.column_stack([back, np.zeros(n)])
     up = np.array([0.0, 0.0, 1.0])
-    rows = [base - 0.6 * up, base + lean * middle[1][:, None] + np.outer(middle[0], up),
-            base + lean * top[1][:, None] + np.outer(top[0], up)]
+    rows = [base - 0.6 * up] + [base + lean * setback[:, None] + np.outer(height, up) for height, setback in levels]
     faces = _ribbon_faces(n, len(rows), closed=False)
     vertices = np.concatenate(rows)
     towards = -np.tile(lean, (len(rows), 1))[faces[:, 0]]
-    colors = np.concatenate([low, high])
-    return Mesh(vertices, facing(vertices, faces, towards), colors.astype(np.float32), name=name, kind=kind)
+    return Mesh(vertices, facing(vertices, faces, towards), np.concatenate(colors).astype(np.float32), name=name,
+                kind=kind)
 
 
 def facing(vertices: FloatArray, faces: np.ndarray, towards: FloatArray) -> np.ndarray:
@@ -275,8 +312,8 @@ def vegetation_lines(inputs: RoadsideInputs, network: RoadNetwork, clear: Cleara
                 base = piece.line.to_world(s, t, ground_h(piece))
                 keep = clear_of_roads(clear, index, base[:, :2], s, t, margin=4.0)
                 _, _, left = piece.line.frame(s)
-                top = crown_tops(s, rng, veg.height, veg.crown)
-                parts += [canopy(base[run], side * left[run, :2], top[run], own_rng(rng), veg.name)
+                crowns = crown_tops(s, rng, veg.height, veg.crown)
+                parts += [canopy(base[run], side * left[run, :2], crowns[:, run], own_rng(rng), veg.name)
                           for run in runs(keep)]
             if parts:
                 label = "left" if side > 0 else "right"
@@ -302,8 +339,8 @@ def field_hedges(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
             keep = clear_of_roads(clear, 0, base[:, :2], s, t, margin=4.0)
             _, tangent, _ = piece.line.frame(s)
             back = tangent[:, :2] / np.linalg.norm(tangent[:, :2], axis=1, keepdims=True)
-            top = crown_tops(np.abs(t), rng, HEDGEROW.height, HEDGEROW.crown)
-            parts += [canopy(base[run], back[run], top[run], own_rng(rng), "field hedge") for run in runs(keep)]
+            crowns = crown_tops(np.abs(t), rng, HEDGEROW.height, HEDGEROW.crown)
+            parts += [canopy(base[run], back[run], crowns[:, run], own_rng(rng), "field hedge") for run in runs(keep)]
             s_hedge += spacing * float(rng.uniform(0.5, 1.5))
     return [merge(parts, name="field hedges", kind="tree")] if parts else []
 
@@ -325,9 +362,10 @@ def back_rows(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rn
             base = piece.line.to_world(s, t, ground_h(piece))
             keep = clear_of_roads(clear, 0, base[:, :2], s, t, margin=3.0)
             _, _, left = piece.line.frame(s)
-            parts += [banded(base[run], side * left[run, :2], (middle[0][run], middle[1][run]),
-                             (top[0][run], top[1][run]), low[run][:-1].repeat(2, 0), high[run][:-1].repeat(2, 0),
-                             "houses behind", "building") for run in runs(keep)]
+            parts += [layered(base[run], side * left[run, :2], [(middle[0][run], middle[1][run]),
+                                                                 (top[0][run], top[1][run])],
+                              [np.tile(low[run][:-1], (2, 1)), np.tile(high[run][:-1], (2, 1))], "houses behind",
+                              "building") for run in runs(keep)]
         if parts:
             out.append(merge(parts, name=f"houses behind {'left' if side > 0 else 'right'}", kind="building"))
     return out
@@ -350,7 +388,7 @@ def _gables_and_crowns(a: float, b: float, rng: np.random.Generator) -> tuple[Fl
         else:  # garden trees: a few crowns
             length = float(rng.uniform(6.0, 18.0))
             stations = np.arange(s, s + length, 2.5)
-            crowns = crown_tops(stations, rng, SUBURB_BEHIND.height, SUBURB_BEHIND.crown)
+            crowns = crown_tops(stations, rng, SUBURB_BEHIND.height, SUBURB_BEHIND.crown)[0]
             green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
             columns += [(float(x), 0.3 * h, 0.5, h, 0.45 * h, tuple(green * UNDERSTOREY * rng.uniform(0.8, 1.2)),
                          tuple(green * rng.uniform(0.75, 1.3))) for x, h in zip(stations, crowns)]
@@ -390,9 +428,11 @@ def wooded_ridge(network: RoadNetwork, s_portal: float, crest: float, inner: flo
         rows.append(np.column_stack([np.full(y.shape, x), y, z, np.ones(y.shape)]))
     p_world = (np.concatenate(rows) @ T_world_portal.T)[:, :3]
     faces = _ribbon_faces(len(y), len(rows), closed=False)
-    colors = np.asarray(FOREST)[rng.integers(0, len(FOREST), len(faces))] * rng.uniform(0.8, 1.25, (len(faces), 1))
-    clearing = (np.arange(len(faces)) < 2 * (len(y) - 1)) & (rng.random(len(faces)) < 0.35)
-    colors[clearing] = np.asarray(FIELDS)[rng.integers(0, len(FIELDS), int(clearing.sum()))]
+    bands = len(RIDGE_ROWS) - 1
+    lower = patches(periodic_noise(rng, angle, octaves=3, base=8), FOREST + FIELDS[:2])[:-1]  # meadows low down
+    upper = patches(periodic_noise(rng, angle, octaves=3, base=6), FOREST)[:-1]
+    colors = np.concatenate([np.tile(lower if k == 0 else upper, (2, 1)) for k in range(bands)]) \
+        * rng.uniform(0.94, 1.06, (len(faces), 1))
     towards = np.tile(-T_world_portal[:3, 0], (len(faces), 1))
     ridge = Mesh(p_world, facing(p_world, faces, towards), colors.astype(np.float32), name="wooded ridge",
                  kind="terrain", casts_shadow=False)
@@ -408,8 +448,8 @@ def _ridge_edge(T_world_portal: FloatArray, y: FloatArray, beside: float, rng: n
                                  np.ones(y_edge.shape)])
         base = (local @ T_world_portal.T)[:, :3]
         back = np.tile(T_world_portal[:2, 0], (len(y_edge), 1))
-        top = crown_tops(np.abs(y_edge), rng, FAR_WOOD.height, FAR_WOOD.crown)
-        parts.append(canopy(base, back, top, own_rng(rng), "ridge forest edge"))
+        crowns = crown_tops(np.abs(y_edge), rng, FAR_WOOD.height, FAR_WOOD.crown)
+        parts.append(canopy(base, back, crowns, own_rng(rng), "ridge forest edge"))
     return [merge(parts, name="ridge forest edge", kind="tree")]
 
 
@@ -420,7 +460,7 @@ def distant_hills(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.G
     hide most of them, gets the near ones only, in coarser steps."""
     sector = view_sector(inputs, network)
     near = hill_ring(network, sector, own_rng(rng), 1.0, 0.7 * MAX_HILL_ELEVATION_DEG, 0.5 if far else 1.5,
-                     FOREST + FIELDS[:1], "near hills")
+                     FOREST + FIELDS[:1], "near hills", shoulder=far)
     if not far:
         return [near]
     return [near, hill_ring(network, sector, own_rng(rng), FAR_RING, MAX_HILL_ELEVATION_DEG, 1.0, FOREST + FIELDS,
