@@ -486,6 +486,15 @@ BACKDROPS: dict[str, Callable[[RoadsideInputs, RoadNetwork, Clearance, np.random
 }
 
 
+BACKDROP_NAMES = ("near hills", "far hills", TREE_LINE.name, FAR_WOOD.name, HEDGEROW.name, "field hedges",
+                  SUBURB_BEHIND.name, "wooded ridge", "ridge forest edge")  # how the backdrop's meshes are named
+
+
+def is_backdrop(mesh: Mesh) -> bool:
+    """Whether ``mesh`` is part of the backdrop (by its name: ``BACKDROP_NAMES``)."""
+    return mesh.name.startswith(BACKDROP_NAMES)
+
+
 def backdrop_meshes(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
                     rng: np.random.Generator) -> list[Mesh]:
     """World-frame meshes of the backdrop of ``inputs``' scene kind and density, beyond the roadside that
