@@ -35,7 +35,7 @@ def main() -> None:
     parser.add_argument("--sizes", nargs="+", default=["1280x720"])
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
-    sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes]
+    sizes = [(int(size.split("x")[0]), int(size.split("x")[1])) for size in args.sizes]
     times: dict[tuple[str, str], list[float]] = {}
     faces = {"without": 0, "with": 0}
     for path in sorted((ROOT / "scenes" / "00_clean").glob("*.json")):
@@ -55,14 +55,13 @@ def main() -> None:
                         render_frame(scenes[name], frame, size)
                         times.setdefault((f"{size[0]}x{size[1]}", name), []).append(
                             (time.perf_counter() - start) * 1e3)
-    table = {}
+    table: dict[str, dict[str, float]] = {}
     for size in args.sizes:
         before, after = (statistics.median(times[(size, name)]) for name in ("without", "with"))
         table[size] = {"frames": len(times[(size, "with")]), "without_ms": round(before, 1),
                        "with_ms": round(after, 1), "ratio": round(after / before, 3)}
-    table["triangles"] = faces
     if args.json:
-        print(json.dumps(table, indent=2))
+        print(json.dumps({**table, "triangles": faces}, indent=2))
         return
     for size in args.sizes:
         row = table[size]
