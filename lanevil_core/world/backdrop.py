@@ -17,7 +17,7 @@ import numpy as np
 
 from ..typed import FloatArray
 from . import props
-from .primitives import merge, pose_on_road
+from .primitives import merge, pose_on_road, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
 from .scenery import Clearance, RoadsideInputs, corridor_half_width, ground_h, own_rng
@@ -61,6 +61,7 @@ FAR_WOOD = Vegetation((150.0, 230.0), (12.0, 20.0), (3.0, 6.0), 0.7, (120.0, 400
 HEDGEROW = Vegetation((32.0, 60.0), (1.6, 3.2), (1.0, 2.2), 0.5, (40.0, 160.0), "hedgerow")
 SUBURB_BEHIND = Vegetation((26.0, 42.0), (7.0, 13.0), (2.5, 4.5), 0.6, (30.0, 110.0), "houses behind")
 SUBURB_AHEAD_M = 250.0  # the houses behind the first row stand along the main road this far beyond the ego's end
+HOUSE_SHARE = 0.6  # of what stands behind a suburb's first row, the houses (the rest garden trees)
 
 
 def periodic_noise(rng: np.random.Generator, theta: FloatArray, octaves: int = 5, base: int = 3) -> FloatArray:
@@ -347,8 +348,8 @@ def field_hedges(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
 
 def back_rows(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
     """The houses and garden trees massing behind a suburb's first row of houses, along the main road ahead of
-    the ego (``SUBURB_BEHIND``): stretches of gables (walls under roofs sloping towards the road) and crowns
-    side by side, one band of quads each, one mesh per side."""
+    the ego: stretches (``SUBURB_BEHIND``) of houses (``house_shell``) and crowns (``crown_lump``) side by side,
+    one mesh per side."""
     piece = network.main
     reach = corridor_half_width(piece)
     s0, s1 = max(0.0, inputs.start_s - DRIVE_BEHIND_M), min(piece.line.length, inputs.end_s + SUBURB_AHEAD_M)
@@ -356,50 +357,56 @@ def back_rows(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rn
     for side in (-1, 1):
         parts = []
         for a, b in stretches(s0, s1, rng, SUBURB_BEHIND, inputs.density):
-            s, middle, top, low, high = _gables_and_crowns(a, b, own_rng(rng))
-            setback = reach + float(rng.uniform(*SUBURB_BEHIND.setback)) + 2.0 * np.sin(s / 37.0)
-            t = side * setback
-            base = piece.line.to_world(s, t, ground_h(piece))
-            keep = clear_of_roads(clear, 0, base[:, :2], s, t, margin=3.0)
-            _, _, left = piece.line.frame(s)
-            parts += [layered(base[run], side * left[run, :2], [(middle[0][run], middle[1][run]),
-                                                                 (top[0][run], top[1][run])],
-                              [np.tile(low[run][:-1], (2, 1)), np.tile(high[run][:-1], (2, 1))], "houses behind",
-                              "building") for run in runs(keep)]
+            s = a
+            while s < b:
+                own = own_rng(rng)
+                house = rng.random() < HOUSE_SHARE
+                width = float(rng.uniform(8.0, 13.0)) if house else float(rng.uniform(4.0, 8.0))
+                t = side * (reach + float(rng.uniform(*SUBURB_BEHIND.setback)))
+                centre = piece.line.to_world(np.array([s + width / 2]), np.array([t]))[:, :2]
+                if s + width < piece.line.length and clear_of_roads(clear, 0, centre, np.array([s + width / 2]),
+                                                                    np.array([t]), margin=width / 2 + 2.0)[0]:
+                    # turned to face the road: on the right, local +X runs back along it, from the far end
+                    T_world_local = pose_on_road(piece.line, s if side > 0 else s + width, t,
+                                                 0.0 if side > 0 else np.pi, ground_h(piece))
+                    parts.append(transformed(house_shell(own, width) if house else crown_lump(own, width),
+                                             T_world_local))
+                s += width + float(rng.uniform(1.0, 6.0))
         if parts:
-            out.append(merge(parts, name=f"houses behind {'left' if side > 0 else 'right'}", kind="building"))
+            out.append(merge(parts, name=f"{SUBURB_BEHIND.name} {'left' if side > 0 else 'right'}", kind="building"))
     return out
 
 
-def _gables_and_crowns(a: float, b: float, rng: np.random.Generator) -> tuple[FloatArray, ...]:
-    """Stations (n,) from ``a`` to ``b`` along a row of houses and trees, the (height, setback) of its middle and
-    top rows ((2, n) each) and the colours (n, 3) of the low and the high band after each station."""
-    columns: list[tuple[float, float, float, float, float, tuple, tuple]] = []  # s, mid h, mid back, top h, ...
-    s = a
-    while s < b:
-        if rng.random() < 0.55:  # a house: wall to the eaves, roof up to the ridge set back by half its depth
-            width, eaves = float(rng.uniform(8.0, 13.0)), float(rng.uniform(3.0, 6.0))
-            ridge = eaves + float(rng.uniform(2.5, 4.5))
-            wall = tuple(props.FACADES[int(rng.integers(len(props.FACADES)))])
-            roof = tuple(np.asarray(props.ROOFS[int(rng.integers(len(props.ROOFS)))]) * float(rng.uniform(0.8, 1.3)))
-            columns += [(s, eaves, 0.0, eaves, 0.0, wall, roof), (s + width / 2, eaves, 0.0, ridge, 4.0, wall, roof),
-                        (s + width, eaves, 0.0, eaves, 0.0, wall, roof)]
-            s += width + float(rng.uniform(0.5, 3.0))
-        else:  # garden trees: a few crowns
-            length = float(rng.uniform(6.0, 18.0))
-            stations = np.arange(s, s + length, 2.5)
-            crowns = crown_tops(stations, rng, SUBURB_BEHIND.height, SUBURB_BEHIND.crown)[0]
-            green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
-            columns += [(float(x), 0.3 * h, 0.5, h, 0.45 * h, tuple(green * UNDERSTOREY * rng.uniform(0.8, 1.2)),
-                         tuple(green * rng.uniform(0.75, 1.3))) for x, h in zip(stations, crowns)]
-            s += length
-    s_col = np.array([c[0] for c in columns])
-    keep = s_col <= b
-    s_col = s_col[keep]
-    pick = [c for c, k in zip(columns, keep) if k]
-    middle = np.array([(c[1], c[2]) for c in pick]).T
-    top = np.array([(c[3], c[4]) for c in pick]).T
-    return s_col, middle, top, np.array([c[5] for c in pick]), np.array([c[6] for c in pick])
+def house_shell(rng: np.random.Generator, width: float) -> Mesh:
+    """What the road sees of a house behind the first row (local frame: the front along +X from the origin, the
+    house running back along +Y): its front wall, the front slope of its gable roof and its two gable ends."""
+    depth, eaves = float(rng.uniform(7.0, 10.0)), float(rng.uniform(3.0, 6.0))
+    ridge = eaves + float(rng.uniform(0.3, 0.5)) * depth
+    wall = np.asarray(props.FACADES[int(rng.integers(len(props.FACADES)))])
+    roof = np.asarray(props.ROOFS[int(rng.integers(len(props.ROOFS)))]) * float(rng.uniform(0.8, 1.3))
+    gable = [(0.0, -0.5), (depth, -0.5), (depth, eaves), (depth / 2, ridge), (0.0, eaves)]
+    vertices = [(x, y, z) for x in (0.0, width) for y, z in gable]  # 0-4 one end, 5-9 the other
+    faces = [(0, 5, 9), (0, 9, 4), (4, 9, 8), (4, 8, 3)]  # the front wall, the roof's front slope
+    faces += [(k + 0, k + 1, k + 2) for k in (0, 5)] + [(k + 0, k + 2, k + 4) for k in (0, 5)] \
+        + [(k + 4, k + 2, k + 3) for k in (0, 5)]  # the gable ends
+    colors = [wall, wall, roof, roof] + [wall] * 6
+    return Mesh(np.array(vertices), np.array(faces), np.array(colors, np.float32), name="house behind",
+                kind="building")
+
+
+def crown_lump(rng: np.random.Generator, width: float) -> Mesh:
+    """A garden tree seen from afar over the houses in front (local frame, along +X from the origin): a lumpy
+    octahedron from 2 m up (its trunk hidden) to its crown's top."""
+    r = width / 2
+    h = float(rng.uniform(*SUBURB_BEHIND.height))
+    mid = float(rng.uniform(0.5, 0.65)) * h
+    ring = [(r + r * np.cos(a) * float(rng.uniform(0.8, 1.1)), r * np.sin(a) * float(rng.uniform(0.8, 1.1)), mid)
+            for a in np.arange(4) * np.pi / 2 + float(rng.uniform(0.0, 0.8))]
+    vertices = np.array([*ring, (r, 0.0, h), (r, 0.0, 2.0)])
+    faces = [(k, (k + 1) % 4, 4) for k in range(4)] + [((k + 1) % 4, k, 5) for k in range(4)]
+    green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
+    colors = (green * rng.uniform(0.75, 1.25, (8, 1))).astype(np.float32)
+    return Mesh(vertices, np.array(faces), colors, name="garden tree behind", kind="tree")
 
 
 RIDGE_HALF_LENGTH_M = 900.0  # the ridge a tunnel enters runs this far to both sides of the road
