@@ -25,7 +25,6 @@ from .scenery import Clearance, RoadsideInputs, corridor_half_width, ground_h, o
 MAX_HILL_ELEVATION_DEG = 3.0  # the distant hills' crest seen from any point of the road, 1.5 m above it
 HILL_MARGIN_M = 350.0  # the nearest ring of hills stands this far beyond the farthest road point from its centre
 HILL_MIN_RADIUS_M = 650.0
-HILL_SEGMENTS = 720  # around each ring: a 0.5 degree step, a few pixels of silhouette at 1280 wide
 FAR_RING = 1.7  # the second ring's radius over the first's
 VALLEY_SHARE = 0.45  # hills fall to this share of their height where the main road heads (it runs up a valley)
 VALLEY_HALF_WIDTH = np.radians(14.0)
@@ -479,17 +478,31 @@ def _lines(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: 
     return [mesh for veg in kinds for mesh in vegetation_lines(inputs, network, clear, own_rng(rng), veg)]
 
 
+def _suburban(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    return distant_hills(inputs, network, own_rng(rng), far=False) + back_rows(inputs, network, clear, own_rng(rng))
+
+
+def _highway(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    return distant_hills(inputs, network, own_rng(rng)) + _lines(inputs, network, clear, rng, TREE_LINE, FAR_WOOD)
+
+
+def _rural(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    return distant_hills(inputs, network, own_rng(rng)) \
+        + _lines(inputs, network, clear, rng, HEDGEROW, TREE_LINE, FAR_WOOD) \
+        + field_hedges(inputs, network, clear, own_rng(rng))
+
+
+def _tunnel_approach(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
+                     rng: np.random.Generator) -> list[Mesh]:
+    return distant_hills(inputs, network, own_rng(rng)) + _lines(inputs, network, clear, rng, TREE_LINE)
+
+
 BACKDROPS: dict[str, Callable[[RoadsideInputs, RoadNetwork, Clearance, np.random.Generator], list[Mesh]]] = {
     "urban": lambda inputs, network, clear, rng: [],  # the blocks fill the frontage: nothing shows behind them
-    "suburban": lambda inputs, network, clear, rng: distant_hills(inputs, network, own_rng(rng), far=False)
-    + back_rows(inputs, network, clear, own_rng(rng)),
-    "highway": lambda inputs, network, clear, rng: distant_hills(inputs, network, own_rng(rng))
-    + _lines(inputs, network, clear, rng, TREE_LINE, FAR_WOOD),
-    "rural": lambda inputs, network, clear, rng: distant_hills(inputs, network, own_rng(rng))
-    + _lines(inputs, network, clear, rng, HEDGEROW, TREE_LINE, FAR_WOOD)
-    + field_hedges(inputs, network, clear, own_rng(rng)),
-    "tunnel_approach": lambda inputs, network, clear, rng: distant_hills(inputs, network, own_rng(rng))
-    + _lines(inputs, network, clear, rng, TREE_LINE),
+    "suburban": _suburban,
+    "highway": _highway,
+    "rural": _rural,
+    "tunnel_approach": _tunnel_approach,  # and the ridge the tunnel enters (``wooded_ridge``, with the tunnel)
 }
 
 
