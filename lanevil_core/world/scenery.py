@@ -439,13 +439,26 @@ def traffic_signals(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearan
     return out
 
 
+@dataclass(frozen=True)
+class TunnelHill:
+    """The hill around a tunnel's portal (m): how far it reaches back over the mouth, its crest's height over
+    the road, its width beside the tube."""
+
+    depth: float = 12.0
+    crest: float = 16.0
+    width: float = 45.0
+
+
+TUNNEL_HILL = TunnelHill()
+
+
 def tunnel(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator) -> tuple[list[Mesh], float]:
     """The tunnel mouth 150-250 m ahead of the ego start, and the hill and dark tube it leads into, following
     the road to a dark end wall at the road's end. Returns the meshes and the portal's s."""
     line = network.main.line
     s_portal = float(min(inputs.start_s + rng.uniform(150.0, 250.0), line.length - 30.0))
     opening = corridor_half_width(network.main) + 0.2
-    hill_depth, crest, hill_width = 12.0, 16.0, 45.0
+    hill_depth, crest, hill_width = TUNNEL_HILL.depth, TUNNEL_HILL.crest, TUNNEL_HILL.width
     portal = props.tunnel_portal(2 * opening, TUNNEL_HEIGHT_M, hill_height=crest, hill_depth=hill_depth,
                                  hill_width=hill_width)
     meshes = [transformed(portal, pose_on_road(line, s_portal, 0.0))]
@@ -529,12 +542,15 @@ def _rural(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
 
 def _tunnel_approach(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator,
                      clear: Clearance) -> list[Mesh]:
+    from .backdrop import wooded_ridge  # the backdrop builds on this module (its clearance): imported when used
+
     meshes, s_portal = tunnel(inputs, network, rng)
     clear.closed_s.append((s_portal - 11.0, network.main.line.length))  # the hill claims the ground
     if inputs.density > 0:
         meshes += greenery(network, clear, rng, 12.0 / inputs.density, (0.5, 20.0), bush_share=0.5,
                            conifer_share=0.6)
-    return meshes
+    return meshes + wooded_ridge(network, s_portal, TUNNEL_HILL.crest, corridor_half_width(network.main) + 0.6,
+                                 TUNNEL_HILL.width, own_rng(rng))
 
 
 SCENES: dict[str, Callable[[RoadsideInputs, RoadNetwork, np.random.Generator, Clearance], list[Mesh]]] = {
@@ -547,5 +563,10 @@ SCENES: dict[str, Callable[[RoadsideInputs, RoadNetwork, np.random.Generator, Cl
 
 
 def roadside_meshes(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator) -> list[Mesh]:
-    """World-frame meshes of everything beside the road for the scene kind and density of ``inputs``."""
-    return SCENES[inputs.kind](inputs, network, rng, Clearance(network))
+    """World-frame meshes of everything beside the road for the scene kind and density of ``inputs``, and the
+    backdrop beyond it (``backdrop.py``: hills, tree lines, hedgerows, roofs behind roofs), drawn after it."""
+    from .backdrop import backdrop_meshes  # the backdrop builds on this module (its clearance): imported when used
+
+    clear = Clearance(network)
+    meshes = SCENES[inputs.kind](inputs, network, rng, clear)
+    return meshes + backdrop_meshes(inputs, network, clear, own_rng(rng))
