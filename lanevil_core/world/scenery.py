@@ -23,6 +23,8 @@ CLEAR_MARGIN_M = 0.3  # free space kept between a prop's footprint and any road 
 GROUP_LENGTH_M = 100.0  # small props (trees, bushes, barriers) are merged into one mesh per side and stretch
 TUNNEL_HEIGHT_M = 6.0
 ROW_RETRY_STEP_M = 3.0
+NEAR_PLANT_M = 18.0  # trees and bushes farther than this from the main road's centre line, only ever seen from
+# afar, are built with less detail (``props.FAR_DETAIL``)
 
 
 @dataclass(frozen=True)
@@ -184,15 +186,24 @@ def own_rng(rng: np.random.Generator) -> np.random.Generator:
     return np.random.default_rng(int(rng.integers(2**63)))
 
 
-def plant(rng: np.random.Generator, bush_share: float, conifer_share: float) -> tuple[float, Callable[[], Mesh]]:
-    """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh."""
+def plant(rng: np.random.Generator, bush_share: float,
+          conifer_share: float) -> tuple[float, Callable[[bool], Mesh]]:
+    """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh (given whether it
+    stands near the main road, ``NEAR_PLANT_M``)."""
     own = own_rng(rng)
     if rng.random() < bush_share:
         radius = float(rng.uniform(0.6, 1.3))
-        return 1.2 * radius, lambda: props.bush(own, radius=radius)
+        return 1.2 * radius, lambda near: props.bush(own, radius=radius, near=near)
     conifer = bool(rng.random() < conifer_share)
     height = float(rng.uniform(5.0, 11.0))
-    return (0.23 if conifer else 0.43) * height, lambda: props.tree(own, conifer=conifer, height=height)
+    return (0.23 if conifer else 0.43) * height, lambda near: props.tree(own, conifer=conifer, height=height,
+                                                                         near=near)
+
+
+def near_main_road(clear: Clearance, spot: Spot) -> bool:
+    """Whether ``spot`` (posed) stands within ``NEAR_PLANT_M`` of the main road, where the ego drives."""
+    s, t = clear.road_frame(0, spot.T_world_local[None, :2, 3])
+    return bool(-NEAR_PLANT_M < s[0] < clear.pieces[0].line.length + NEAR_PLANT_M and abs(t[0]) < NEAR_PLANT_M)
 
 
 def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, spacing: float,
@@ -206,7 +217,7 @@ def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, s
             t = side * (corridor_half_width(piece) + float(rng.uniform(*setback)) + half)
             spot = Spot(index, float(s), t, float(rng.uniform(0, 2 * np.pi)), half, half)
             if try_place(clear, piece, spot):
-                placed.append((float(s), transformed(build(), spot.T_world_local)))
+                placed.append((float(s), transformed(build(near_main_road(clear, spot)), spot.T_world_local)))
         label = "left" if side > 0 else "right"
         out += _grouped(placed, f"trees {label} piece {index}", "tree")
     return out
