@@ -508,8 +508,10 @@ def bush(rng: np.random.Generator, *, radius: float | None = None, near: bool = 
     height = radius * float(rng.uniform(0.8, 1.2))
     centre = np.array([0.0, 0.0, 0.45 * height])
     half = np.array([radius, radius, 0.55 * height])
-    return merge(_crown(rng, centre, half, np.zeros((0, 3)), _tree_green(rng, LEAVES), int(rng.integers(3, 5)),
-                        LEAF_SPRIGS if near else 0), name=name, kind="bush")
+    shrub = merge(_crown(rng, centre, half, np.zeros((0, 3)), _tree_green(rng, LEAVES), int(rng.integers(3, 5)),
+                         LEAF_SPRIGS if near else 0), name=name, kind="bush")
+    shrub.vertices[:, 2] -= shrub.vertices[:, 2].min() + 0.05  # resting on the ground, not floating
+    return shrub
 
 
 def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatArray:
