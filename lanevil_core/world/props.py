@@ -354,7 +354,7 @@ BROADLEAVES = (
     Broadleaf(crown=0.13, crown_height=0.82, bark=(0.13, 0.11, 0.085), branches=(3, 4), clusters=(7, 8),
               leaves=((0.05, 0.09, 0.03), (0.06, 0.1, 0.035)), tall=1.3),  # Lombardy poplar
 )
-LEAF_SPRIGS = 3  # small tetrahedra sticking out of every leaf cluster: the twigs' leaves breaking its outline
+LEAF_SPRIGS = 4  # small tetrahedra sticking out of every leaf cluster: the twigs' leaves breaking its outline
 FAR_DETAIL = 0.7  # the share of its clusters a tree only seen from afar keeps (and none of their sprigs)
 CROWN_CLUSTERS = 9  # a crown of this many clusters has them at their drawn size
 TREE_TINT = 0.15  # each tree's leaves are its species' green times 1 +- this, and a little warmer or cooler
@@ -397,7 +397,7 @@ def _crown(rng: np.random.Generator, centre: FloatArray, half: FloatArray, ancho
     n_free = max(count - len(anchors) - 1, 0)
     direction = rng.normal(size=(n_free, 3))
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    direction[:, 2] = np.abs(direction[:, 2]) * 0.4 + direction[:, 2] * 0.6  # more of them high, where light is
+    direction[:, 2] = np.abs(direction[:, 2]) * 0.2 + direction[:, 2] * 0.8  # a few more high, where light is
     depth = rng.uniform(0.45, 0.85, (n_free, 1))
     core = centre + half * (0.0, 0.0, 0.15)  # a heart cluster: the crown is one mass, not a ring of puffs
     centres = np.vstack([core, anchors, centre + direction * depth * half])[:count]
@@ -485,7 +485,7 @@ def _leaf_cluster(rng: np.random.Generator, size: float, centre: FloatArray, squ
     where = centre + where / np.linalg.norm(where, axis=1, keepdims=True) * 0.75 * scale
     turn = np.linalg.qr(rng.normal(size=(sprigs, 3, 3)))[0]  # a random orientation per sprig ...
     turn[:, :, 0] *= np.sign(np.linalg.det(turn))[:, None]  # ... a rotation, not a mirror: faces stay outward
-    tips = (TETRAHEDRON @ turn.transpose(0, 2, 1)) * (size * rng.uniform(0.4, 0.6, (sprigs, 1, 1))) + where[:, None]
+    tips = (TETRAHEDRON @ turn.transpose(0, 2, 1)) * (size * rng.uniform(0.3, 0.45, (sprigs, 1, 1))) + where[:, None]
     vertices = np.vstack([core, tips.reshape(-1, 3)])
     tetra = (np.arange(sprigs)[:, None, None] * 4 + len(unit) + TETRAHEDRON_FACES).reshape(-1, 3)
     all_faces = np.vstack([faces, tetra]).astype(np.int32)
@@ -508,8 +508,9 @@ def bush(rng: np.random.Generator, *, radius: float | None = None, near: bool = 
     height = radius * float(rng.uniform(0.8, 1.2))
     centre = np.array([0.0, 0.0, 0.45 * height])
     half = np.array([radius, radius, 0.55 * height])
-    shrub = merge(_crown(rng, centre, half, np.zeros((0, 3)), _tree_green(rng, LEAVES), int(rng.integers(3, 5)),
-                         LEAF_SPRIGS if near else 0), name=name, kind="bush")
+    green = _tree_green(rng, LEAVES) * 0.85  # low in the shade of the grass and its neighbours
+    clusters = _crown(rng, centre, half, np.zeros((0, 3)), green, int(rng.integers(3, 5)), LEAF_SPRIGS if near else 0)
+    shrub = merge(clusters, name=name, kind="bush")
     shrub.vertices[:, 2] -= shrub.vertices[:, 2].min() + 0.05  # resting on the ground, not floating
     return shrub
 
@@ -517,8 +518,8 @@ def bush(rng: np.random.Generator, *, radius: float | None = None, near: bool = 
 def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatArray:
     """(m, 3) foliage colours around ``green``: shade and hue varied face by face (sunlit leaves yellower,
     inner ones darker and bluer) so flat shading reads as leaves."""
-    shade = rng.uniform(0.7, 1.25, (m, 1))
-    warm = rng.uniform(-1.0, 1.0, (m, 1)) * np.array([0.12, 0.0, -0.12])
+    shade = rng.uniform(0.65, 1.2, (m, 1))
+    warm = rng.uniform(-1.0, 1.0, (m, 1)) * np.array([0.08, 0.0, -0.08])
     return np.clip(green * shade * (1.0 + warm), 0.0, 1.0)
 
 
