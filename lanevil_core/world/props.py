@@ -9,11 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import trimesh
 
-from ..typed import FloatArray
+from ..typed import FloatArray, IntArray
 from .primitives import ColorLike, PointsLike, beam, box, cylinder, loft, merge, prism, quad, to_mesh, translation
 from .scene import Mesh
 
@@ -40,7 +41,7 @@ HAIRS = ((0.02, 0.015, 0.01), (0.12, 0.06, 0.02), (0.35, 0.25, 0.1), (0.3, 0.3, 
 FACADES = ((0.45, 0.4, 0.33), (0.3, 0.3, 0.3), (0.35, 0.12, 0.07), (0.55, 0.53, 0.5), (0.4, 0.3, 0.2),
            (0.2, 0.22, 0.25))
 ROOFS = ((0.2, 0.05, 0.03), (0.06, 0.06, 0.07), (0.15, 0.1, 0.07))
-LEAVES = ((0.05, 0.1, 0.035), (0.07, 0.12, 0.04), (0.04, 0.075, 0.035), (0.09, 0.12, 0.035), (0.06, 0.09, 0.045))
+LEAVES = ((0.045, 0.1, 0.035), (0.055, 0.115, 0.04), (0.035, 0.075, 0.035), (0.07, 0.115, 0.035), (0.05, 0.09, 0.045))
 
 
 def _pick(rng: np.random.Generator, palette: tuple[tuple[float, float, float], ...]) -> FloatArray:
@@ -314,124 +315,211 @@ def _rider(hip_c: FloatArray, bracket: FloatArray, grips: FloatArray, shirt: Flo
     return parts
 
 
-def tree(rng: np.random.Generator, *, conifer: bool | None = None, height: float | None = None,
+def tree(rng: np.random.Generator, *, conifer: bool | None = None, height: float | None = None, near: bool = True,
          name: str = "tree") -> Mesh:
-    """A tree 4-12 m tall of one of several species: a spruce (a tapering trunk under a dozen drooping, ragged
-    whorls of branches), or a broadleaf (``BROADLEAVES``: a round crown, a pale slender birch, a columnar
-    poplar), whose trunk forks into branches each ending in a lumpy leaf cluster."""
+    """A tree 4-14 m tall of one of several species: a spruce (a tapering trunk under ragged, drooping tiers of
+    branches), or a broadleaf (``BROADLEAVES``: a round crown, a pale slender birch, a columnar poplar), whose
+    trunk forks into main branches reaching into a crown of irregular leaf clusters (``_crown``). A tree that is
+    not ``near`` (only ever seen from afar) has fewer clusters and no sprigs on them (``FAR_DETAIL``)."""
     conifer = bool(rng.random() < 0.35) if conifer is None else conifer
     height = float(rng.uniform(5.0, 11.0)) if height is None else height
     if conifer:
         return merge(_spruce(rng, height), name=name, kind="tree")
     species = BROADLEAVES[int(rng.choice(len(BROADLEAVES), p=BROADLEAF_SHARES))]
-    return merge(_broadleaf(rng, height, species), name=name, kind="tree")
+    return merge(_broadleaf(rng, height * species.tall, species, near), name=name, kind="tree")
 
 
 @dataclass(frozen=True)
 class Broadleaf:
     """What sets a broadleaf species apart: its crown's radius and its height as shares of the tree's height,
-    its bark, its branches and leaf clusters, and the palette of its leaves."""
+    its bark, its main branches and leaf clusters, the palette of its leaves, its trunk's girth and how much
+    taller than the drawn height it grows."""
 
     crown: float
     crown_height: float
     bark: tuple[float, float, float]
     branches: tuple[int, int]
+    clusters: tuple[int, int]
     leaves: tuple[tuple[float, float, float], ...]
     trunk: float = 1.0
+    tall: float = 1.0
 
 
 BROADLEAF_SHARES = (0.7, 0.15, 0.15)  # most roadside broadleaves have round crowns; birches and poplars are fewer
 BROADLEAVES = (
-    Broadleaf(crown=0.32, crown_height=0.62, bark=BARK, branches=(4, 7), leaves=LEAVES),  # oak, maple, lime
-    Broadleaf(crown=0.22, crown_height=0.6, bark=(0.42, 0.4, 0.36), branches=(3, 5),
-              leaves=((0.09, 0.13, 0.035), (0.1, 0.14, 0.045)), trunk=0.6),  # birch
-    Broadleaf(crown=0.14, crown_height=0.8, bark=(0.12, 0.1, 0.08), branches=(4, 6),
-              leaves=((0.05, 0.09, 0.03), (0.06, 0.1, 0.035))),  # poplar
+    Broadleaf(crown=0.36, crown_height=0.66, bark=BARK, branches=(4, 5), clusters=(8, 10),
+              leaves=LEAVES),  # oak, maple, lime
+    Broadleaf(crown=0.25, crown_height=0.62, bark=(0.5, 0.48, 0.44), branches=(3, 4), clusters=(7, 9),
+              leaves=((0.1, 0.14, 0.035), (0.11, 0.15, 0.05), (0.085, 0.13, 0.04)), trunk=0.6),  # birch
+    Broadleaf(crown=0.13, crown_height=0.82, bark=(0.13, 0.11, 0.085), branches=(3, 4), clusters=(7, 8),
+              leaves=((0.05, 0.09, 0.03), (0.06, 0.1, 0.035)), tall=1.3),  # Lombardy poplar
 )
+LEAF_SPRIGS = 4  # small tetrahedra sticking out of every leaf cluster: the twigs' leaves breaking its outline
+FAR_DETAIL = 0.7  # the share of its clusters a tree only seen from afar keeps (and none of their sprigs)
+CROWN_CLUSTERS = 9  # a crown of this many clusters has them at their drawn size
+TREE_TINT = 0.15  # each tree's leaves are its species' green times 1 +- this, and a little warmer or cooler
+SELF_SHADE = 0.5  # a cluster deep inside or under the crown is this much darker than one on its sunny top
 
 
-def _broadleaf(rng: np.random.Generator, height: float, species: Broadleaf) -> list[Mesh]:
-    """Trunk, branches forking from its top and a lumpy cluster of leaves at each branch's end (local frame, foot
-    at the origin)."""
+def _broadleaf(rng: np.random.Generator, height: float, species: Broadleaf, near: bool = True) -> list[Mesh]:
+    """Trunk, main branches forking from it into the crown, and the crown's leaf clusters (local frame, foot at
+    the origin)."""
     radius = species.crown * height * float(rng.uniform(0.85, 1.1))
     crown_h = species.crown_height * height
-    centre_z = height - crown_h / 2
-    fork = height - crown_h * 0.8
-    trunk_r = (0.06 + 0.018 * height) * species.trunk
-    parts = [cylinder(trunk_r, fork + 0.3, (0.0, 0.0, fork / 2 - 0.15), species.bark, sections=7)]
+    centre = np.array([0.0, 0.0, height - crown_h / 2])
+    fork = height - crown_h * 0.9
+    trunk_r = (0.06 + 0.02 * height) * species.trunk
+    lean = rng.uniform(-0.04, 0.04, 2) * height  # trunks are seldom plumb
+    top = np.array([lean[0], lean[1], fork])
+    parts = [_limb((0.0, 0.0, -0.2), top, trunk_r, trunk_r * 0.8, 5, species.bark)]
+    half = np.array([radius, radius, crown_h / 2])
     count = int(rng.integers(species.branches[0], species.branches[1] + 1))
-    detail = 1  # the first clusters are smooth (subdivided once), the rest coarse: about 250 faces a tree
-    green = _pick(rng, species.leaves)
-    for k in range(count):
+    ends = []
+    for k in range(count):  # main branches: up and out to the crown's middle shell
         angle = 2 * np.pi * (k + float(rng.uniform(-0.3, 0.3))) / count
-        reach = radius * float(rng.uniform(0.35, 0.5))  # the crown stays within the footprint scenery gives a tree
-        lift = float(rng.uniform(-0.25, 0.45)) * crown_h / 2
-        end = np.array([reach * np.cos(angle), reach * np.sin(angle), centre_z + lift])
-        parts.append(beam((0.0, 0.0, fork - 0.2), end, trunk_r * 0.9, color=species.bark))
-        size = radius * float(rng.uniform(0.45, 0.55))
-        parts.append(_leaf_cluster(rng, size, end, (1.0, 1.0, crown_h / (2 * radius) * 0.8), green,
-                                   detail if k < 1 else 0))
-    top = np.array([0.0, 0.0, height - radius * 0.75])  # the leader closes the crown's middle and top
-    parts.append(_leaf_cluster(rng, radius * 0.62, top, (1.0, 1.0, crown_h / (2 * radius) * 0.9), green, detail))
+        out, up = float(rng.uniform(0.45, 0.7)), float(rng.uniform(-0.2, 0.5))
+        end = centre + half * (out * np.cos(angle), out * np.sin(angle), up)
+        ends.append(end)
+        parts.append(_limb(top, end, trunk_r * 0.6, trunk_r * 0.2, 3, species.bark))
+    parts.append(_limb(top, centre + half * (0.0, 0.0, 0.55), trunk_r * 0.6, trunk_r * 0.2, 3, species.bark))
+    clusters = int(rng.integers(species.clusters[0], species.clusters[1] + 1))
+    parts += _crown(rng, centre, half, np.array(ends), _tree_green(rng, species.leaves),
+                    clusters if near else int(np.ceil(clusters * FAR_DETAIL)), LEAF_SPRIGS if near else 0)
     return parts
+
+
+def _crown(rng: np.random.Generator, centre: FloatArray, half: FloatArray, anchors: FloatArray, green: FloatArray,
+           count: int, sprigs: int = 0) -> list[Mesh]:
+    """``count`` irregular leaf clusters filling the ellipsoid crown of semi-axes ``half`` (3,) about ``centre``
+    (3,): one at its heart, then one at each of the branches' ends ``anchors`` (k, 3), the rest towards its shell
+    (a ragged silhouette); each darker the deeper inside or lower in the crown it sits (the leaves above and
+    around shade it), each with ``sprigs`` sprigs (``_leaf_cluster``)."""
+    n_free = max(count - len(anchors) - 1, 0)
+    direction = rng.normal(size=(n_free, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    direction[:, 2] = np.abs(direction[:, 2]) * 0.2 + direction[:, 2] * 0.8  # a few more high, where light is
+    depth = rng.uniform(0.45, 0.85, (n_free, 1))
+    core = centre + half * (0.0, 0.0, 0.15)  # a heart cluster: the crown is one mass, not a ring of puffs
+    centres = np.vstack([core, anchors, centre + direction * depth * half])[:count]
+    rel = (centres - centre) / half  # where each sits in the crown: (0, 0, 0) its heart, |rel| 1 its shell
+    out = np.linalg.norm(rel, axis=1)
+    fill = (CROWN_CLUSTERS / count) ** (1.0 / 3.0)  # fewer clusters, each larger: the crown stays full
+    sizes = np.min(half) * rng.uniform(0.42, 0.6, count) * fill * (1.25 - 0.35 * out)
+    sizes = np.minimum(sizes, np.min(half) * (1.2 - 0.6 * np.clip(out, 0, 1)) + 0.1)
+    sizes[0] = np.min(half) * 0.7 * fill
+    light = 1.0 - SELF_SHADE * np.clip(0.55 - 0.35 * out - 0.35 * rel[:, 2], 0.0, 1.0)
+    squash = (1.0, 1.0, 0.85 * float(np.clip(half[2] / half[0], 1.0, 2.0)))  # upright clusters in a tall crown
+    return [_leaf_cluster(rng, float(size), c, squash, green * float(lit), sprigs)
+            for size, c, lit in zip(sizes, centres, light)]
+
+
+def _tree_green(rng: np.random.Generator, palette: tuple[tuple[float, float, float], ...]) -> FloatArray:
+    """One tree's leaf green: a palette colour, brighter or darker and warmer or cooler than its neighbours'."""
+    warm = float(rng.uniform(-1.0, 1.0)) * np.array([0.1, 0.0, -0.1])
+    return _pick(rng, palette) * float(rng.uniform(1.0 - TREE_TINT, 1.0 + TREE_TINT)) * (1.0 + warm)
+
+
+def _limb(p0: ColorLike, p1: ColorLike, r0: float, r1: float, sides: int, color: ColorLike) -> Mesh:
+    """A tapering trunk or branch from ``p0`` (radius ``r0``) to ``p1`` (radius ``r1``): a loft of two
+    ``sides``-gons (``4 * sides - 4`` faces)."""
+    p0, p1 = np.asarray(p0, np.float64), np.asarray(p1, np.float64)
+    axis = (p1 - p0) / max(float(np.linalg.norm(p1 - p0)), 1e-9)
+    u = np.cross(axis, (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0))
+    u /= np.linalg.norm(u)
+    v = np.cross(axis, u)
+    angle = 2 * np.pi * np.arange(sides) / sides
+    ring = np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v
+    return loft([p0 + r0 * ring, p1 + r1 * ring], color)
+
+
+SPRUCE_TIERS = 7
+SPRUCE_TIPS = 6  # branch tips round a tier: its rim zigzags out to them and back in between
 
 
 def _spruce(rng: np.random.Generator, height: float) -> list[Mesh]:
-    """A spruce or fir: a tapering trunk and whorls of drooping branches, each whorl a ragged cone whose rim dips
-    below its top, narrowing up the tree to a spire."""
-    trunk_h = 0.15 * height
+    """A spruce or fir: a tapering trunk and tiers of drooping branches, each tier a ragged star-shaped cone whose
+    tips reach out and dip below its top, narrowing up the tree to a spire; lower and inner tiers darker."""
+    trunk_h = 0.12 * height
     base_r = 0.21 * height * float(rng.uniform(0.9, 1.1))
-    parts = [cylinder(0.08 + 0.012 * height, height * 0.9, (0.0, 0.0, height * 0.45), BARK, sections=6)]
-    green = _pick(rng, LEAVES) * 0.75
-    tiers = 7
-    for i in range(tiers):
-        share = i / tiers
-        z_rim = trunk_h + share * (height - trunk_h) * 0.92
-        r = base_r * (1.0 - share) ** 0.9 + 0.15
-        sections = 8
-        angles = 2 * np.pi * (np.arange(sections) + float(rng.uniform(0, 1))) / sections
-        reach = r * rng.uniform(0.8, 1.15, sections)
-        rim = np.stack([reach * np.cos(angles), reach * np.sin(angles),
-                        z_rim - rng.uniform(0.0, 0.25, sections) * r], 1)
-        apex = np.array([0.0, 0.0, z_rim + 0.9 * r + 0.3])
-        vertices = np.vstack([rim, apex, (0.0, 0.0, z_rim - 0.1 * r)])
-        ring, nxt = np.arange(sections), (np.arange(sections) + 1) % sections
-        faces = np.concatenate([np.stack([ring, nxt, np.full(sections, sections)], 1),
-                                np.stack([nxt, ring, np.full(sections, sections + 1)], 1)])
-        tm = trimesh.Trimesh(vertices, faces, process=False)
-        parts.append(to_mesh(tm, _leaf_colors(green, rng, len(faces))))
+    parts = [_limb((0.0, 0.0, -0.2), (0.0, 0.0, height * 0.93), 0.08 + 0.014 * height, 0.04, 6, BARK)]
+    green = _tree_green(rng, LEAVES) * 0.72
+    n = 2 * SPRUCE_TIPS
+    ring, nxt = np.arange(n), (np.arange(n) + 1) % n
+    faces = np.concatenate([np.stack([ring, nxt, np.full(n, n)], 1), np.stack([nxt, ring, np.full(n, n + 1)], 1)])
+    for i in range(SPRUCE_TIERS):
+        share = i / SPRUCE_TIERS
+        z_rim = trunk_h + share * (height - trunk_h) * 0.9
+        r = base_r * (1.0 - share) ** 0.95 + 0.12
+        angles = 2 * np.pi * (np.arange(n) + float(rng.uniform(0, 2)) + rng.uniform(-0.25, 0.25, n)) / n
+        reach = r * np.where(ring % 2 == 0, rng.uniform(0.85, 1.15, n), rng.uniform(0.45, 0.65, n))
+        droop = np.where(ring % 2 == 0, rng.uniform(0.12, 0.35, n), rng.uniform(0.0, 0.1, n)) * r
+        rim = np.stack([reach * np.cos(angles), reach * np.sin(angles), z_rim - droop], 1)
+        apex = np.array([0.0, 0.0, z_rim + 0.75 * r + 0.3])
+        vertices = np.vstack([rim, apex, (0.0, 0.0, z_rim - 0.05 * r)])
+        shade = 1.0 - 0.35 * (1.0 - share) + 0.15 * share  # the lower tiers stand in the upper ones' shade
+        colors = _leaf_colors(green * shade, rng, len(faces))
+        colors[n:] *= 1.0 - SELF_SHADE  # the tier's underside
+        parts.append(to_mesh(trimesh.Trimesh(vertices, faces, process=False), colors))
     return parts
 
 
+@lru_cache(maxsize=2)
+def _unit_icosphere(subdivisions: int) -> tuple[FloatArray, IntArray]:
+    """(vertices, faces) of the unit icosphere (read-only): every leaf cluster is a jittered copy."""
+    tm = trimesh.creation.icosphere(subdivisions=subdivisions)
+    vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int32)
+    vertices.setflags(write=False)
+    faces.setflags(write=False)
+    return vertices, faces
+
+
 def _leaf_cluster(rng: np.random.Generator, size: float, centre: FloatArray, squash: tuple[float, float, float],
-                  green: FloatArray, subdivisions: int = 1) -> Mesh:
-    """A clump of leaves: a lumpy, squashed icosphere whose faces vary in shade (the lit and shaded leaves)."""
-    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=size)
-    tm.vertices = tm.vertices * (1.0 + 0.28 * rng.uniform(-1.0, 1.0, (len(tm.vertices), 1)))
-    tm.apply_scale(squash)
-    tm.apply_translation(centre)
-    return to_mesh(tm, _leaf_colors(green, rng, len(tm.faces)))
+                  green: FloatArray, sprigs: int = LEAF_SPRIGS, subdivisions: int = 0) -> Mesh:
+    """A clump of leaves: a jagged, squashed icosahedron (20 faces; subdivided, 80) whose corners reach in and out,
+    with ``sprigs`` small tetrahedra turned every way sticking out of it (a ragged outline, facets catching
+    the light at every angle); faces varied in shade, those facing down darker (the clump shades its underside)."""
+    unit, faces = _unit_icosphere(subdivisions)
+    scale = size * np.asarray(squash)
+    core = unit * (1.0 + 0.3 * rng.uniform(-1.0, 1.0, (len(unit), 1))) * 0.8 * scale + centre
+    where = rng.normal(size=(sprigs, 3))
+    where = centre + where / np.linalg.norm(where, axis=1, keepdims=True) * 0.75 * scale
+    turn = np.linalg.qr(rng.normal(size=(sprigs, 3, 3)))[0]  # a random orientation per sprig ...
+    turn[:, :, 0] *= np.sign(np.linalg.det(turn))[:, None]  # ... a rotation, not a mirror: faces stay outward
+    tips = (TETRAHEDRON @ turn.transpose(0, 2, 1)) * (size * rng.uniform(0.3, 0.45, (sprigs, 1, 1))) + where[:, None]
+    vertices = np.vstack([core, tips.reshape(-1, 3)])
+    tetra = (np.arange(sprigs)[:, None, None] * 4 + len(unit) + TETRAHEDRON_FACES).reshape(-1, 3)
+    all_faces = np.vstack([faces, tetra]).astype(np.int32)
+    p = vertices[all_faces]
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    down = normal[:, 2] / np.maximum(np.linalg.norm(normal, axis=1), 1e-12)
+    colors = _leaf_colors(green, rng, len(all_faces))
+    colors *= (1.0 - 0.5 * SELF_SHADE * np.clip(-down, 0.0, 1.0))[:, None]
+    return Mesh(vertices, all_faces, colors.astype(np.float32))
 
 
-def bush(rng: np.random.Generator, *, radius: float | None = None, name: str = "bush") -> Mesh:
-    """A low shrub: two or three lumpy, squashed leaf clusters side by side on the ground."""
+TETRAHEDRON = np.array([(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)]) / np.sqrt(3.0)
+TETRAHEDRON_FACES = np.array([(0, 1, 2), (0, 3, 1), (0, 2, 3), (1, 3, 2)], np.int32)
+
+
+def bush(rng: np.random.Generator, *, radius: float | None = None, near: bool = True, name: str = "bush") -> Mesh:
+    """A low shrub: three or four jagged leaf clusters heaped on the ground, the inner and lower ones darker (with
+    sprigs when ``near``)."""
     radius = float(rng.uniform(0.6, 1.3)) if radius is None else radius
-    green = _pick(rng, LEAVES)
-    parts = []
-    for k in range(int(rng.integers(2, 4))):
-        size = radius * float(rng.uniform(0.55, 0.8))
-        angle = float(rng.uniform(0, 2 * np.pi))
-        offset = 0.0 if k == 0 else radius * 0.45
-        centre = np.array([offset * np.cos(angle), offset * np.sin(angle), 0.4 * size])
-        parts.append(_leaf_cluster(rng, size, centre, (1.0, 1.0, 0.7), green, 1 if k == 0 else 0))
-    return merge(parts, name=name, kind="bush")
+    height = radius * float(rng.uniform(0.8, 1.2))
+    centre = np.array([0.0, 0.0, 0.45 * height])
+    half = np.array([radius, radius, 0.55 * height])
+    green = _tree_green(rng, LEAVES) * 0.85  # low in the shade of the grass and its neighbours
+    clusters = _crown(rng, centre, half, np.zeros((0, 3)), green, int(rng.integers(3, 5)), LEAF_SPRIGS if near else 0)
+    shrub = merge(clusters, name=name, kind="bush")
+    shrub.vertices[:, 2] -= shrub.vertices[:, 2].min() + 0.05  # resting on the ground, not floating
+    return shrub
 
 
 def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatArray:
     """(m, 3) foliage colours around ``green``: shade and hue varied face by face (sunlit leaves yellower,
     inner ones darker and bluer) so flat shading reads as leaves."""
-    shade = rng.uniform(0.7, 1.25, (m, 1))
-    warm = rng.uniform(-1.0, 1.0, (m, 1)) * np.array([0.12, 0.0, -0.12])
+    shade = rng.uniform(0.65, 1.2, (m, 1))
+    warm = rng.uniform(-1.0, 1.0, (m, 1)) * np.array([0.08, 0.0, -0.08])
     return np.clip(green * shade * (1.0 + warm), 0.0, 1.0)
 
 

@@ -17,12 +17,15 @@ from . import props
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh, PointLight
-from .structures import WARM_LAMP, streetlight, streetlight_lamp_offset
+from .structures import WARM_LAMP, ground_height, pole_stations, power_lines, streetlight, streetlight_lamp_offset
 
 CLEAR_MARGIN_M = 0.3  # free space kept between a prop's footprint and any road corridor
 GROUP_LENGTH_M = 100.0  # small props (trees, bushes, barriers) are merged into one mesh per side and stretch
 TUNNEL_HEIGHT_M = 6.0
 ROW_RETRY_STEP_M = 3.0
+NEAR_PLANT_M = 18.0  # trees and bushes farther than this from the main road's centre line, or from the stretch
+NEAR_AHEAD_M = 60.0  # the ego drives (this far beyond its end), are only ever seen from afar: built with less
+# detail (``props.FAR_DETAIL``)
 
 
 @dataclass(frozen=True)
@@ -184,18 +187,28 @@ def own_rng(rng: np.random.Generator) -> np.random.Generator:
     return np.random.default_rng(int(rng.integers(2**63)))
 
 
-def plant(rng: np.random.Generator, bush_share: float, conifer_share: float) -> tuple[float, Callable[[], Mesh]]:
-    """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh."""
+def plant(rng: np.random.Generator, bush_share: float,
+          conifer_share: float) -> tuple[float, Callable[[bool], Mesh]]:
+    """Pick a tree or bush: its footprint half size (m) and a builder for its local-frame mesh (given whether it
+    stands near the ego's drive, ``near_the_drive``)."""
     own = own_rng(rng)
     if rng.random() < bush_share:
         radius = float(rng.uniform(0.6, 1.3))
-        return 1.2 * radius, lambda: props.bush(own, radius=radius)
+        return 1.2 * radius, lambda near: props.bush(own, radius=radius, near=near)
     conifer = bool(rng.random() < conifer_share)
     height = float(rng.uniform(5.0, 11.0))
-    return (0.23 if conifer else 0.43) * height, lambda: props.tree(own, conifer=conifer, height=height)
+    return (0.23 if conifer else 0.43) * height, lambda near: props.tree(own, conifer=conifer, height=height,
+                                                                         near=near)
 
 
-def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, spacing: float,
+def near_the_drive(inputs: RoadsideInputs, clear: Clearance, spot: Spot) -> bool:
+    """Whether ``spot`` (posed) stands within ``NEAR_PLANT_M`` of the main road along the stretch the ego drives
+    (from ``NEAR_PLANT_M`` behind its start to ``NEAR_AHEAD_M`` beyond its end)."""
+    s, t = clear.road_frame(0, spot.T_world_local[None, :2, 3])
+    return bool(inputs.start_s - NEAR_PLANT_M < s[0] < inputs.end_s + NEAR_AHEAD_M and abs(t[0]) < NEAR_PLANT_M)
+
+
+def greenery(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator, spacing: float,
              setback: tuple[float, float], bush_share: float = 0.3, conifer_share: float = 0.35) -> list[Mesh]:
     """Trees and bushes along both sides of every piece, ``setback`` (min, max) m beyond the corridor."""
     out: list[Mesh] = []
@@ -206,7 +219,7 @@ def greenery(network: RoadNetwork, clear: Clearance, rng: np.random.Generator, s
             t = side * (corridor_half_width(piece) + float(rng.uniform(*setback)) + half)
             spot = Spot(index, float(s), t, float(rng.uniform(0, 2 * np.pi)), half, half)
             if try_place(clear, piece, spot):
-                placed.append((float(s), transformed(build(), spot.T_world_local)))
+                placed.append((float(s), transformed(build(near_the_drive(inputs, clear, spot)), spot.T_world_local)))
         label = "left" if side > 0 else "right"
         out += _grouped(placed, f"trees {label} piece {index}", "tree")
     return out
@@ -481,6 +494,60 @@ def tunnel(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
     return meshes, s_portal
 
 
+# Utility poles along rural and suburban roads: a row of wooden poles on one side of the main road, each with a
+# cross-arm and porcelain insulators, two or three wires sagging between neighbours (``structures.power_lines``).
+UTILITY_POLE_SPACING_M = (35.0, 50.0)
+UTILITY_WIRE_HEIGHT_M = (8.5, 11.0)  # the wires' height on the cross-arm; the pole reaches 0.6 m above: 9-12 m
+UTILITY_WIRES = (2, 3)
+UTILITY_WIRE_SPACING_M = 0.7
+UTILITY_SAG_PER_M = 0.02  # mid-span sag per metre of span
+UTILITY_SEEN_M = (30.0, 250.0)  # along the main road from this far behind the ego's start to this far beyond its end
+UTILITY_WIRE_SEGMENT_M = 8.0  # wires are seen from afar: longer straight pieces than the shadow illusion's
+UTILITY_CLEAR_M = 1.5  # half the width of the strip under the wires kept clear of crowns (m)
+UTILITY_POLE_HALF_M = 0.2
+
+
+def utility_lines(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator,
+                  setback: tuple[float, float], clear_under: bool) -> list[Mesh]:
+    """A row of utility poles with wires on a drawn side of the main road, ``setback`` (min, max) m beyond its
+    corridor, along the stretch the ego sees (``UTILITY_SEEN_M``); a pole that cannot stand (a junction mouth,
+    another prop) is left out and its wires span over. With ``clear_under`` the strip under the wires is taken, so
+    no crown grows through them (a rural line's cleared way; street trees stand under suburban wires)."""
+    piece = network.main
+    side = 1 if rng.random() < 0.5 else -1
+    spacing = float(rng.uniform(*UTILITY_POLE_SPACING_M))
+    height = float(rng.uniform(*UTILITY_WIRE_HEIGHT_M))
+    n_wires = int(rng.integers(UTILITY_WIRES[0], UTILITY_WIRES[1] + 1))
+    beyond = float(rng.uniform(*setback))
+    t_row = side * (corridor_half_width(piece) + beyond)
+    s0 = max(0.0, inputs.start_s - UTILITY_SEEN_M[0])
+    s1 = min(piece.line.length, inputs.end_s + UTILITY_SEEN_M[1])
+    # A straight span is a chord: on a bend it must not reach in over the corridor (sagitta span^2 / 8R).
+    bend = float(np.abs(piece.line.curvature).max())
+    spacing = min(spacing, float(np.sqrt(8.0 * (beyond - CLEAR_MARGIN_M) / max(bend, 1e-9))))
+    if s1 - s0 < spacing:
+        return []
+    gaps = list(piece.gaps)
+    standing = []
+    for s in pole_stations(s0, s1, spacing):
+        spot = Spot(0, float(s), t_row, 0.0, UTILITY_POLE_HALF_M, UTILITY_POLE_HALF_M)
+        if try_place(clear, piece, spot):
+            standing.append(spot.T_world_local[:3, 3])
+        else:
+            gaps.append((float(s) - 0.5, float(s) + 0.5, side))
+    if len(standing) < 2:
+        return []
+    across = np.array([-UTILITY_CLEAR_M, UTILITY_CLEAR_M])
+    for a, b in zip(standing[:-1], standing[1:]) if clear_under else ():  # the strip under each span
+        normal = np.array([a[1] - b[1], b[0] - a[0]]) / max(float(np.linalg.norm(b[:2] - a[:2])), 1e-9)
+        clear.take(np.array([a[:2] + across[0] * normal, b[:2] + across[0] * normal, b[:2] + across[1] * normal,
+                             a[:2] + across[1] * normal]))
+    return [power_lines(piece.line, s0, s1, (t_row,), n_wires, 0.02, height, pole_spacing=spacing,
+                        wire_spacing=UTILITY_WIRE_SPACING_M, sag=UTILITY_SAG_PER_M * spacing,
+                        ground=ground_height(piece, t_row), gaps=gaps, insulators=True,
+                        segment_m=UTILITY_WIRE_SEGMENT_M, name="utility lines")]
+
+
 def _urban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
     density, night = inputs.density, inputs.night
 
@@ -492,7 +559,7 @@ def _urban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
 
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
     if density > 0:  # a few street trees first, parked cars between them; the blocks fill the frontage behind
-        meshes += greenery(network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
+        meshes += greenery(inputs, network, clear, rng, 45.0 / np.sqrt(density), (0.2, 1.0), bush_share=0.0,
                            conifer_share=0.1)
         meshes += parked_cars(inputs, network, clear, own_rng(rng))
         meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
@@ -512,7 +579,9 @@ def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Gener
 
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
     meshes += parked_cars(inputs, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
-    meshes += greenery(network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
+    meshes += utility_lines(inputs, network, clear, own_rng(rng), (PARKING_ROW_M + 0.8, PARKING_ROW_M + 1.8),
+                            clear_under=False)
+    meshes += greenery(inputs, network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
     return meshes + traffic_signals(inputs, network, clear, own_rng(rng))
@@ -521,7 +590,7 @@ def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Gener
 def _highway(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
     meshes = barriers(network, clear)
     if inputs.density > 0:
-        meshes += greenery(network, clear, rng, 22.0 / inputs.density, (6.0, 35.0), bush_share=0.35,
+        meshes += greenery(inputs, network, clear, rng, 22.0 / inputs.density, (6.0, 35.0), bush_share=0.35,
                            conifer_share=0.5)
     return meshes
 
@@ -535,7 +604,8 @@ def _rural(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
         width, depth = float(r.uniform(9.0, 16.0)), float(r.uniform(7.0, 11.0))
         return width, depth, lambda: props.house(r, width, depth, storeys=1, lit=night, name="farmhouse")
 
-    meshes = greenery(network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)
+    meshes = utility_lines(inputs, network, clear, own_rng(rng), (1.0, 2.5), clear_under=True)
+    meshes += greenery(inputs, network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)
     meshes += rows_of(network, clear, rng, farm, (25.0, 45.0), (90.0 / density, 200.0 / density), "farmhouse")
     return meshes
 
@@ -547,7 +617,7 @@ def _tunnel_approach(inputs: RoadsideInputs, network: RoadNetwork, rng: np.rando
     meshes, s_portal = tunnel(inputs, network, rng)
     clear.closed_s.append((s_portal - 11.0, network.main.line.length))  # the hill claims the ground
     if inputs.density > 0:
-        meshes += greenery(network, clear, rng, 12.0 / inputs.density, (0.5, 20.0), bush_share=0.5,
+        meshes += greenery(inputs, network, clear, rng, 12.0 / inputs.density, (0.5, 20.0), bush_share=0.5,
                            conifer_share=0.6)
     return meshes + wooded_ridge(network, s_portal, TUNNEL_HILL.crest, corridor_half_width(network.main) + 0.6,
                                  TUNNEL_HILL.width, own_rng(rng))

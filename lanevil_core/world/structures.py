@@ -434,10 +434,21 @@ def catenary(p0_world: FloatArray, p1_world: FloatArray, sag: float, segments: i
     return p_world
 
 
+WIRE_SEGMENT_M = 3.0  # a hanging wire is a polyline of pieces about this long (4 to 16 a span)
+INSULATOR: Color = (0.55, 0.56, 0.55)  # glazed porcelain
+INSULATOR_SIZE_M = (0.1, 0.1, 0.2)
+
+
+def pole_stations(s0: float, s1: float, pole_spacing: float) -> FloatArray:
+    """(n,) stations of a row of poles from s0 to s1, evenly spaced, no further apart than ``pole_spacing``."""
+    return _stations(s0, s1, pole_spacing)
+
+
 def power_lines(line: ReferenceLine, s0: float, s1: float, t_poles: Sequence[float], n_wires: int = 3,
                 wire_radius: float = 0.03, heights: Sequence[float] | float = 8.0, pole_spacing: float = 35.0,
                 wire_spacing: float = 0.8, sag: float = 0.5, cross_every: int = 0, cross_skew: float = 0.0,
-                ground: float = 0.0, gaps: Gaps = (), name: str = "power lines") -> Mesh:
+                ground: float = 0.0, gaps: Gaps = (), insulators: bool = False, segment_m: float = WIRE_SEGMENT_M,
+                name: str = "power lines") -> Mesh:
     """Utility poles in rows beside the road with wires along each row and, optionally, wires across the road.
 
     Args:
@@ -450,6 +461,8 @@ def power_lines(line: ReferenceLine, s0: float, s1: float, t_poles: Sequence[flo
             two wires across the road to a pole of the second row (0 = none); ``cross_skew`` moves that pole
             along s (a diagonal crossing).
         gaps: (s0, s1, side) stretches where no pole stands (junction mouths); wires span over them.
+        insulators: a porcelain insulator under every wire on the row poles' cross-arms.
+        segment_m: about how long each straight piece of a hanging wire is.
 
     Returns:
         Mesh, world frame: poles (wood), cross-arms and wires (black).
@@ -459,15 +472,18 @@ def power_lines(line: ReferenceLine, s0: float, s1: float, t_poles: Sequence[flo
         raise ValueError("wire_radius must be at least 0.02 m")
     h_wires = np.broadcast_to(np.asarray(heights, np.float64), (n_wires,)) + ground
     offsets: FloatArray = ((np.arange(n_wires) - (n_wires - 1) / 2) * wire_spacing).astype(np.float64)
-    s_poles = _stations(s0, s1, pole_spacing)
+    s_poles = pole_stations(s0, s1, pole_spacing)
     parts: list[Mesh] = []
     for t_row in t_poles:
         s_row = s_poles[outside_gaps(s_poles, t_row, gaps)]
         if not s_row.size:
             continue
         parts.append(_poles(line, s_row, t_row, ground, h_wires, across=offsets, name=name))
+        if insulators:
+            parts += [_boxes(line, s_row, t_row + o, h + 0.04, INSULATOR_SIZE_M, INSULATOR, name, "pole")
+                      for o, h in zip(offsets, h_wires)]
         for a, b in zip(s_row[:-1], s_row[1:]):
-            parts += [_span(line, (a, t_row + o), (b, t_row + o), h, sag, wire_radius)
+            parts += [_span(line, (a, t_row + o), (b, t_row + o), h, sag, wire_radius, segment_m)
                       for o, h in zip(offsets, h_wires)]
     if cross_every > 0 and len(t_poles) >= 2:
         parts += _crossings(line, s_poles[::cross_every], t_poles[0], t_poles[1], cross_skew, ground, h_wires,
@@ -519,10 +535,11 @@ def _poles(line: ReferenceLine, s_poles: FloatArray, t_row: float, ground: float
 
 
 def _span(line: ReferenceLine, a_road: tuple[float, float], b_road: tuple[float, float], h: float, sag: float,
-          radius: float) -> Mesh:
-    """One wire between two road-frame points ``h`` m above the road, sagging ``sag`` m mid-span."""
+          radius: float, segment_m: float = WIRE_SEGMENT_M) -> Mesh:
+    """One wire between two road-frame points ``h`` m above the road, sagging ``sag`` m mid-span, in straight
+    pieces about ``segment_m`` long."""
     p0 = line.to_world(a_road[0], a_road[1], h)
     p1 = line.to_world(b_road[0], b_road[1], h)
-    segments = int(np.clip(np.linalg.norm(p1 - p0) / 3.0, 4, 16))
+    segments = int(np.clip(np.linalg.norm(p1 - p0) / segment_m, 4, 16))
     vertices, faces = wire(catenary(p0, p1, sag, segments), radius)
     return Mesh(vertices, faces, np.asarray(CABLE, np.float32), kind="wire")

@@ -119,7 +119,7 @@ def test_trees_and_bushes_stand_on_the_ground() -> None:
         for conifer in (True, False):
             tree = props.tree(RNG(seed), conifer=conifer)
             assert_renderable(tree)
-            assert 4.0 < extents(tree)[2] < 12.5
+            assert 4.0 < extents(tree)[2] < 15.0  # a poplar grows taller than the drawn height
             assert -0.4 < tree.vertices[:, 2].min() <= 0.0
         shrub = props.bush(RNG(seed))
         assert extents(shrub)[2] < 2.0 and shrub.vertices[:, 2].min() < 0.05

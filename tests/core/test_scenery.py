@@ -188,3 +188,47 @@ def test_a_traffic_signal_at_each_approach_to_a_town_junction(road: str, approac
                 abs(road_frame(arm, signal.vertices[foot:foot + 1])[1][0]) > kerb for arm in network.pieces[1:])
     _, rural = scenery("rural", road)
     assert not [m for m in rural if m.name.startswith("traffic signal")]
+
+
+UTILITY_KINDS = {"rural", "suburban"}
+
+
+@pytest.mark.parametrize("kind", SCENE_KINDS)
+def test_utility_poles_and_wires_line_rural_and_suburban_roads_only(kind: SceneKind) -> None:
+    network, meshes = scenery(kind, "straight")
+    lines = [mesh for mesh in meshes if mesh.name == "utility lines"]
+    assert len(lines) == (1 if kind in UTILITY_KINDS else 0)
+    if not lines:
+        return
+    _, t, h = road_frame(network.main, lines[0].vertices)
+    row = np.median(t)
+    assert abs(row) > corridor_half_width(network.main)  # beside the verge, one side
+    assert np.all(np.sign(t) == np.sign(row))
+    poles = lines[0].vertices[(h < 0.0)]  # only the poles' footings go below the ground
+    s_feet = np.unique(road_frame(network.main, poles)[0].round(0))
+    gaps = np.diff(s_feet[np.diff(np.concatenate([[-99.0], s_feet])) > 2.0])
+    assert len(gaps) >= 3 and np.all((gaps > 30.0) & (gaps < 52.0))  # 35-50 m apart
+    assert 9.0 <= h.max() <= 12.5  # 9-12 m poles
+
+
+def test_utility_wires_sag_between_poles() -> None:
+    network, meshes = scenery("rural", "straight")
+    line = next(mesh for mesh in meshes if mesh.name == "utility lines")
+    s, _, h = road_frame(network.main, line.vertices)
+    high = h > 7.0
+    wire_top, wire_low = np.percentile(h[high], 95), np.percentile(h[high], 2)
+    assert wire_top - wire_low > 0.5  # a catenary dips mid-span
+
+
+def test_the_roadside_moves_no_lane_label(make_case: Callable[..., Case]) -> None:
+    from lanevil_core.labels import lanes
+    from lanevil_core.pipeline.compile import compile_scene
+    from lanevil_core.render import render_frame
+
+    records = []
+    for density in (0.0, 2.0):
+        case = make_case(scene={"kind": "rural", "density": density}, road={"type": "s_curve"})
+        scene = compile_scene(case)
+        records.append(lanes.tusimple_record(scene, 5, render_frame(scene, 5), "a.png"))
+    assert any(mesh.name == "utility lines" for mesh in scene.meshes)
+    assert records[0]["lanes"] == records[1]["lanes"] and records[0]["line_types"] == records[1]["line_types"]
