@@ -187,3 +187,19 @@ def test_crosswalk_bars_and_stop_line_are_brighter_than_the_asphalt_between(make
         assert at(s_mid, t_bar) > at(s_mid, t_bar + 0.5 * (table.bar_width + table.bar_gap)) + 40
     s_stop = ego_approach.s_edge - table.crosswalk_width - table.stop_before_crosswalk - 0.5 * table.stop_width
     assert at(s_stop, -2.6) > at(s_stop - 1.0, -2.6) + 40
+
+
+def test_the_paint_mesh_draws_every_mark(make_case: Callable[..., Case]) -> None:
+    """The glTF scene and the editor get the marks too: each upright rectangle as quads, each polygon as a fan of
+    its corners less two triangles."""
+    scene = compile_scene(make_case(road={"type": "t_junction"}, scene={"kind": "urban"}))
+    plain = make_case(road={"type": "t_junction"}, scene={"kind": "urban"})
+    marks = junction_marks(scene.network, "custom")
+    vertices, faces, _colors = scene.paint.mesh(scene.network)
+    stripes = scene.paint.stripes(scene.network)
+    polygons = stripes[stripes[:, 5] == POLYGON]
+    fans = sum(len(mark.corners_st) - 2 for mark in marks if not mark.upright)
+    assert len(polygons) == sum(not mark.upright for mark in marks) and fans > 0
+    lines_only = compile_scene(plain.model_copy(update={"road": plain.road.model_copy(update={"type": "straight"})}))
+    assert len(faces) > len(lines_only.paint.mesh(lines_only.network)[1]) + fans
+    assert faces.max() < len(vertices)
