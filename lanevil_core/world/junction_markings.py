@@ -14,7 +14,7 @@ the labels do not change.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -73,11 +73,11 @@ JUNCTION_STANDARDS: dict[MarkingStandardName, JunctionStandard] = {
     "custom": JunctionStandard(0.40, 1.5, 4.0, 0.50, 0.50, "broken", 0.40, 0.50, 0.25, 5.0, 5.0,
                                "a Vienna-convention junction (the German numbers, the older 0.40 m stop line)"),
     "us_mutcd": _US,
-    "de_autobahn": JunctionStandard(**{**_DE.__dict__, "arrow_length": 7.5, "source": _DE.source.replace(
-        "innerorts 5 m lang", "außerorts 7.5 m lang")}),
+    "de_autobahn": replace(_DE, arrow_length=7.5,
+                           source=_DE.source.replace("innerorts 5 m lang", "außerorts 7.5 m lang")),
     "de_urban": _DE,
-    "cn_fast": JunctionStandard(**{**_CN.__dict__, "arrow_length": 6.0}),
-    "cn_slow": JunctionStandard(**{**_CN.__dict__, "arrow_length": 3.0}),
+    "cn_fast": replace(_CN, arrow_length=6.0),
+    "cn_slow": replace(_CN, arrow_length=3.0),
     "jp_expressway": _JP,
     "jp_general": _JP,
 }
