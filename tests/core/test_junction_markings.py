@@ -20,7 +20,7 @@ from lanevil_core.typed import MARKING_STANDARD_NAMES
 from lanevil_core.world import paint as paint_module
 from lanevil_core.world.arrow_shapes import arrow_parts, lane_heads
 from lanevil_core.world.junction_markings import JUNCTION_STANDARDS, Mark, approaches, junction_marks
-from lanevil_core.world.paint import MAX_CORNERS, POLYGON, POLYGON_CORNERS, STRIPE_COLUMNS, mark_row
+from lanevil_core.world.paint import MAX_CORNERS, POLYGON, POLYGON_CORNERS, STRIPE_COLUMNS, mark_row, stripe_index
 
 ASPHALT = 0.055
 APPROACH_REACH_M = 30.0  # crosswalk, stop line and arrows lie within this of the junction's mouth
@@ -203,3 +203,17 @@ def test_the_paint_mesh_draws_every_mark(make_case: Callable[..., Case]) -> None
     lines_only = compile_scene(plain.model_copy(update={"road": plain.road.model_copy(update={"type": "straight"})}))
     assert len(faces) > len(lines_only.paint.mesh(lines_only.network)[1]) + fans
     assert faces.max() < len(vertices)
+
+
+@pytest.mark.parametrize("standard", ["custom", "us_mutcd"])
+def test_every_slot_of_the_stripe_table_starts_in_order_along_the_road(make_case: Callable[..., Case],
+                                                                       standard: str) -> None:
+    """The shader stops at the first row of a slot that starts beyond the pixel: every slot's rows (a boundary's,
+    or the junction's) are sorted by where they start."""
+    markings = ["white_solid", "botts_dots", "yellow_double_solid", "white_dashed", "white_solid"]
+    scene = compile_scene(make_case(road={"type": "crossroad", "markings": markings, "marking_standard": standard},
+                                    scene={"kind": "urban"}))
+    stripes = scene.paint.stripes(scene.network)
+    index = stripe_index(stripes, len(scene.network.pieces), len(markings))
+    for lo, hi in index.reshape(-1, 2):
+        assert (np.diff(stripes[lo:hi, 3]) >= 0).all()
