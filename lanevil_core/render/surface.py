@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..world.paint import PAINT_WEAR
+from ..world.paint import MAX_CORNERS, PAINT_WEAR, POLYGON, POLYGON_CORNERS
 from ._jit import kernel
 from .textures import NOISE_LEVELS, NOISE_SIZE, level_offset
 
@@ -99,22 +99,69 @@ def dot_coverage(ds: float, dt: float, fs: float, ft: float, radius: float) -> t
 
 
 @kernel(inline="always")
+def _clamped_integral(lo: float, hi: float, xa: float, ya: float, slope: float, y0: float, y1: float) -> float:
+    """Integral over x in [lo, hi] of clamp(ya + slope (x - xa), y0, y1) - y0: linear between the points where the
+    line crosses y0 and y1, so each of the three pieces is its length times its middle's value."""
+    if hi <= lo:
+        return 0.0
+    p, q = lo, hi
+    if slope != 0.0:
+        c0 = min(max(xa + (y0 - ya) / slope, lo), hi)
+        c1 = min(max(xa + (y1 - ya) / slope, lo), hi)
+        p, q = min(c0, c1), max(c0, c1)
+    total = 0.0
+    for a, b in ((lo, p), (p, q), (q, hi)):
+        if b > a:
+            total += (b - a) * (min(max(ya + slope * (0.5 * (a + b) - xa), y0), y1) - y0)
+    return total
+
+
+@kernel(inline="always")
+def polygon_coverage(row: np.ndarray, s: float, t: float, fs: float, ft: float) -> float:
+    """Share of the footprint [s -+ fs/2] x [t -+ ft/2] inside the convex polygon of a stripe row (its corners,
+    counter-clockwise in (s, t)): the exact box filter, by Green's theorem, area = -sum over the edges of the
+    integral of (t - t_lo) ds, with s and t clamped to the footprint."""
+    s0, s1 = s - 0.5 * fs, s + 0.5 * fs
+    t0, t1 = t - 0.5 * ft, t + 0.5 * ft
+    area = 0.0
+    for k in range(MAX_CORNERS):
+        j = (k + 1) % MAX_CORNERS
+        sa, ta = row[POLYGON_CORNERS + 2 * k], row[POLYGON_CORNERS + 2 * k + 1]
+        sb, tb = row[POLYGON_CORNERS + 2 * j], row[POLYGON_CORNERS + 2 * j + 1]
+        if sa == sb:
+            continue
+        slope = (tb - ta) / (sb - sa)
+        ua, ub = min(max(sa, s0), s1), min(max(sb, s0), s1)
+        if ub > ua:
+            area -= _clamped_integral(ua, ub, sa, ta, slope, t0, t1)
+        else:
+            area += _clamped_integral(ub, ua, sa, ta, slope, t0, t1)
+    return min(max(area / (fs * ft), 0.0), 1.0)
+
+
+@kernel(inline="always")
 def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, ft: float,
           r: float, g: float, b: float, chips: float, ragged: float) -> tuple[float, float, float]:
     """(r, g, b) with the paint of stripes[lo:hi] blended over it; ``chips`` (noise in [-1, 1], filtered over the
-    pixel) is where worn paint has flaked off, ``ragged`` (likewise) where its edges are eaten away."""
+    pixel) is where worn paint has flaked off, ``ragged`` (likewise) where its edges are eaten away. The rows of
+    one slot start in order along the road, so the first that starts beyond the footprint ends the walk."""
     for k in range(lo, hi):
+        s0, s1 = stripes[k, 3], stripes[k, 4]
+        if s0 >= s + 0.5 * fs:
+            break
         t_c, half = stripes[k, 1], stripes[k, 2]
         if abs(t - t_c) > half + ft:
             continue
-        s0, s1 = stripes[k, 3], stripes[k, 4]
         span = box_overlap(s, fs, s0, s1)
         if span <= 0.0:
             continue
         wear = stripes[k, PAINT_WEAR]
-        dots = stripes[k, 5] > 1.5
+        polygon = stripes[k, 5] > POLYGON - 0.5
+        dots = stripes[k, 5] > 1.5 and not polygon
         shade = 1.0
-        if dots:
+        if polygon:
+            cov = polygon_coverage(stripes[k], s, t, fs, ft)
+        elif dots:
             period = stripes[k, 7]
             ds = s - s0 - half
             ds -= np.floor(ds / period + 0.5) * period  # from the nearest dot's centre
@@ -124,10 +171,11 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
             cov = box_overlap(t, ft, t_c - half + bite, t_c + half - bite)
         else:
             cov = box_overlap(t, ft, t_c - half, t_c + half)
-        cov *= span
+        if not polygon:
+            cov *= span
         if cov <= 0.0:
             continue
-        if stripes[k, 5] > 0.5 and not dots:
+        if stripes[k, 5] > 0.5 and not dots and not polygon:
             cov *= dash_coverage(s - s0, fs, stripes[k, 6], stripes[k, 7])
         dirt = 1.0
         if wear > 0.0:

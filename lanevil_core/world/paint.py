@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..typed import MATERIALS, Float32Array, FloatArray, IntArray, MarkingStandardName
+from .junction_markings import Mark, junction_marks
 from .marking_standards import standard_markings
 from .road_layout import RoadNetwork
 
@@ -54,12 +55,16 @@ def road_albedo(network: RoadNetwork) -> Float32Array:
 
 WHITE_PAINT = (0.70, 0.70, 0.67)
 YELLOW_PAINT = (0.72, 0.46, 0.04)
-STOP_LINE_M = 0.4
 
-# Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots), on, period, r, g, b,
-# boundary index (-1: not tied to a lane boundary), wear (0 = fresh paint)
-STRIPE_COLUMNS = 13
+# Stripe table columns: piece, t_center, half_width, s0, s1, pattern (0 solid, 1 dashed, 2 dots, 3 a convex polygon),
+# on, period, r, g, b, boundary index (-1: not tied to a lane boundary), wear (0 = fresh paint), then a polygon's
+# corners s, t (up to MAX_CORNERS, counter-clockwise; a triangle repeats its last; t_center, half_width, s0 and s1
+# are then its bounding box).
+STRIPE_COLUMNS = 21
 PAINT_WEAR = 12  # the wear column
+POLYGON = 3
+POLYGON_CORNERS = 13
+MAX_CORNERS = 4
 PAINT_LIFT_M = 0.01  # paint quads float this far above the asphalt in meshes (glTF scene, editor)
 PAINT_STEP_M = 1.0  # length of one paint quad along the road
 
@@ -74,6 +79,7 @@ class RoadPaint:
     painted: bool = True
     wear_shift_m: float = 0.0
     dot_groups: bool = False  # Botts' dots in groups that stand in for the dashes (under a marking standard)
+    standard: MarkingStandardName = "custom"  # the manual the junction's markings are painted to
 
     @property
     def line_types(self) -> tuple[str, ...]:
@@ -82,11 +88,11 @@ class RoadPaint:
 
     def stripes(self, network: RoadNetwork) -> FloatArray:
         """The stripe table of this paint on ``network`` (see ``paint_stripes``)."""
-        return paint_stripes(network, self.markings, self.painted, self.dot_groups)
+        return paint_stripes(network, self.markings, self.painted, self.dot_groups, self.standard)
 
     def mesh(self, network: RoadNetwork) -> tuple[FloatArray, IntArray, Float32Array]:
         """The paint as quads (see ``paint_mesh``)."""
-        return paint_mesh(network, self.markings, self.painted, self.dot_groups)
+        return paint_mesh(network, self.markings, self.painted, self.dot_groups, self.standard)
 
 
 def road_paint(road: Road, seed: int = 0) -> RoadPaint:
@@ -94,7 +100,8 @@ def road_paint(road: Road, seed: int = 0) -> RoadPaint:
     switch, and the chip pattern of the case ``seed`` (worn paint flakes differently under another seed)."""
     shift = float(np.random.default_rng([seed, 0x3EA4]).uniform(0.0, WEAR_SHIFT_SPAN_M))
     return RoadPaint(markings=standard_markings(road.markings, road.marking_standard), painted=road.paint,
-                     wear_shift_m=shift, dot_groups=road.marking_standard != "custom")
+                     wear_shift_m=shift, dot_groups=road.marking_standard != "custom",
+                     standard=road.marking_standard)
 
 
 def _color(marking: Marking) -> tuple[float, float, float]:
@@ -137,13 +144,30 @@ def _stripes_of_boundary(piece: int, t: float, marking: Marking, s0: float, s1: 
             for a, b in spans]
 
 
+def mark_row(mark: Mark, wear: float) -> list[float]:
+    """The stripe table's row of a junction mark in white paint worn ``wear``: a solid stripe for an upright
+    rectangle, else a polygon with its corners."""
+    s_road, t_road = mark.corners_st[:, 0], mark.corners_st[:, 1]
+    s0, s1, t0, t1 = float(s_road.min()), float(s_road.max()), float(t_road.min()), float(t_road.max())
+    row = [mark.piece, 0.5 * (t0 + t1), 0.5 * (t1 - t0), s0, s1, 0 if mark.upright else POLYGON, 1.0, 1.0,
+           *WHITE_PAINT, -1, wear] + [0.0] * (STRIPE_COLUMNS - POLYGON_CORNERS)
+    if not mark.upright:
+        corners = np.concatenate([mark.corners_st, np.repeat(mark.corners_st[-1:],
+                                                             MAX_CORNERS - len(mark.corners_st), axis=0)])
+        row[POLYGON_CORNERS:] = corners.ravel().tolist()
+    return row
+
+
 def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True,
-                  dot_groups: bool = False) -> FloatArray:
+                  dot_groups: bool = False, standard: MarkingStandardName = "custom") -> FloatArray:
     """Every painted stripe of the network as rows of the stripe table (none when ``paint`` is False); Botts' dots
-    in groups with ``dot_groups``."""
+    in groups with ``dot_groups``; the junction's markings (``junction_markings``) to ``standard``, as worn as the
+    most worn line, after each piece's lines."""
     rows: list[list[float]] = []
     if not paint:
         return np.zeros((0, STRIPE_COLUMNS), np.float64)
+    marks = junction_marks(network, standard)
+    wear = max((marking.wear for marking in markings), default=0.0)
     for index, piece in enumerate(network.pieces):
         last = len(piece.boundaries_t) - 1
         for k, (t, marking) in enumerate(zip(piece.boundaries_t, markings)):
@@ -153,19 +177,16 @@ def paint_stripes(network: RoadNetwork, markings: Sequence[Marking], paint: bool
                 if side and g_side == side:
                     spans = [(a, b) for a0, b0 in spans for a, b in ((a0, min(b0, g0)), (max(a0, g1), b0)) if b > a]
             for s0, s1 in spans:
-                rows += [[*row, k, marking.wear]
+                rows += [[*row, k, marking.wear] + [0.0] * (STRIPE_COLUMNS - POLYGON_CORNERS)
                          for row in _stripes_of_boundary(index, float(t), marking, s0, s1, dot_groups)]
-        if index:  # a stop line across the arm's lanes that lead into the junction
-            s0 = piece.s_start + 1.5
-            rows.append([index, -piece.half_width / 2, piece.half_width / 2, s0, s0 + STOP_LINE_M, 0,
-                         1.0, 1.0, *WHITE_PAINT, -1, 0.0])
+        rows += [mark_row(mark, wear) for mark in marks if mark.piece == index]
     return np.array(rows, np.float64).reshape(-1, STRIPE_COLUMNS)
 
 
 def stripe_index(stripes: FloatArray, pieces: int, boundaries: int) -> np.ndarray:
     """(pieces, boundaries + 1, 2) int64 [start, stop) rows of the stripe table per piece and boundary; the last
-    slot holds stripes not tied to one boundary (stop lines). The shader looks only at the boundaries near a
-    pixel instead of every stripe."""
+    slot holds stripes not tied to one boundary (the junction's markings). The shader looks only at the boundaries
+    near a pixel instead of every stripe."""
     index = np.zeros((pieces, boundaries + 1, 2), np.int64)
     piece_of, boundary_of = stripes[:, 0].astype(int), stripes[:, 11].astype(int)
     for p in range(pieces):
@@ -185,13 +206,24 @@ def dash_spans(s0: float, s1: float, pattern: int, on: float, period: float) -> 
 
 
 def paint_mesh(network: RoadNetwork, markings: Sequence[Marking], paint: bool = True,
-               dot_groups: bool = False) -> tuple[FloatArray, IntArray, Float32Array]:
-    """Quads of every paint stripe just above the road: vertices (n, 3), faces (m, 3), colours (m, 3)."""
-    stripes = paint_stripes(network, markings, paint, dot_groups).reshape(-1, STRIPE_COLUMNS)
+               dot_groups: bool = False,
+               standard: MarkingStandardName = "custom") -> tuple[FloatArray, IntArray, Float32Array]:
+    """Quads of every paint stripe and fans of every painted polygon just above the road: vertices (n, 3), faces
+    (m, 3), colours (m, 3)."""
+    stripes = paint_stripes(network, markings, paint, dot_groups, standard).reshape(-1, STRIPE_COLUMNS)
     vertices, faces, colors = [], [], []
     count = 0
-    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, _boundary, _wear in stripes:
+    for piece, t_c, half, s0, s1, pattern, on, period, r, g, b, *_rest in stripes:
         line = network.pieces[int(piece)].line
+        if int(pattern) == POLYGON:
+            corners = np.asarray(_rest[POLYGON_CORNERS - 11:]).reshape(MAX_CORNERS, 2)
+            n = MAX_CORNERS if not np.allclose(corners[-1], corners[-2]) else MAX_CORNERS - 1
+            vertices.append(line.to_world(corners[:n, 0], corners[:n, 1], PAINT_LIFT_M))
+            fan = np.array([[0, k, k + 1] for k in range(1, n - 1)]) + count
+            faces.append(fan)
+            colors.append(np.tile([r, g, b], (len(fan), 1)))
+            count += n
+            continue
         for a, b_end in dash_spans(s0, s1, int(pattern), on, period):
             s_road = np.append(np.arange(a, b_end, PAINT_STEP_M), b_end)
             left = line.to_world(s_road, t_c + half, PAINT_LIFT_M)
