@@ -2,12 +2,12 @@
 
 Building faces carry a finish (``world.facade.FINISHES``) and facade coordinates (u along the wall, v up it, m);
 footways and kerbs are addressed in road coordinates (s, t). Every line, joint and bar is box-filtered over the
-pixel's footprint (``dash_coverage``, ``band_coverage``), and every per-unit tone (a brick, a panel, a flag) fades
+pixel's footprint (``lines``, ``band_coverage``), and every per-unit tone (a brick, a panel, a flag) fades
 to its mean as the footprint grows past the unit, so a wall far away is its mean colour and never aliases.
 
 Numbers, from building practice: bricks 215 x 65 mm laid in 10 mm mortar (courses of 75 mm, stretchers 225 mm,
 stretcher bond: each course shifted half a brick); precast panels 2.4 m wide and half a storey high with 20 mm
-sealed joints; paving flags 600 x 600 mm with 8 mm sand joints; kerb stones 915 mm long.
+sealed joints; paving flags 600 x 600 mm with sand joints that dirt widens to 15 mm; kerb stones 915 mm long.
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ PANEL_WIDTH_M = 2.4
 PANEL_HEIGHT_M = 1.6
 PANEL_JOINT_M = 0.02
 PANEL_TONE = 0.06
-JOINT_DARKENING = 0.45  # a sealed panel joint or a flag's sand joint keeps this share of the albedo
-STAIN_DEPTH = 0.07  # broad weathering of a wall (noise in [-1, 1])
-STREAK_DEPTH = 0.16  # dirt washed down a wall from its sills: darker vertical runs under each storey's windows
+JOINT_DARKENING = 0.4  # a sealed panel joint or a flag's sand joint keeps this share of the albedo
+STAIN_DEPTH = 0.10  # broad weathering of a wall (noise in [-1, 1])
+STREAK_DEPTH = 0.22  # dirt washed down a wall from its sills: darker vertical runs under each storey's windows
 STOREY_M = 3.2
 SILL_ABOVE_FLOOR_M = 0.9  # a storey's window sills lie this far above its floor; streaks run down from them
 SPLASH_DEPTH = 0.18  # the grime rain splashes up the foot of a wall, fading over SPLASH_M
@@ -44,8 +44,8 @@ RISER_ALBEDO = (0.05, 0.05, 0.055)
 LINTEL_SHADE_M = 0.12  # the top of a pane lies in the shadow of the window's reveal
 LINTEL_DARKENING = 0.5
 FLAG_M = 0.6
-FLAG_JOINT_M = 0.008
-FLAG_TONE = 0.07
+FLAG_JOINT_M = 0.015
+FLAG_TONE = 0.09
 KERB_STONE_M = 0.915
 KERB_JOINT_M = 0.008
 
@@ -64,6 +64,15 @@ def band_coverage(x: float, width: float, lo: float, hi: float) -> float:
 
 
 @kernel(inline="always")
+def lines(x: float, foot: float, width: float, period: float) -> float:
+    """Share of the footprint [x - foot/2, x + foot/2] on lines ``width`` wide every ``period`` (the first from x = 0
+    on), faded to their mean share as the footprint passes a quarter of the period: a box filter alone leaves moire
+    where lines come a few pixels apart."""
+    fade = min(max(4.0 * foot / period - 1.0, 0.0), 1.0)
+    return dash_coverage(x, foot, width, period) * (1.0 - fade) + width / period * fade
+
+
+@kernel(inline="always")
 def joints_over(r: float, g: float, b: float, joint: float, tone: float, jr: float, jg: float,
                 jb: float) -> tuple[float, float, float]:
     """(r, g, b) toned by ``tone`` with a share ``joint`` covered by the joint colour (jr, jg, jb)."""
@@ -77,8 +86,8 @@ def brick_wall(u: float, v: float, fu: float, fv: float, r: float, g: float,
     """Stretcher-bond brickwork of colour (r, g, b) in facade coordinates, footprint (fu, fv)."""
     course = np.floor(v / COURSE_M)
     across = u + 0.5 * BRICK_M * (course - 2.0 * np.floor(0.5 * course))
-    bed = dash_coverage(v + 0.5 * MORTAR_M, fv, MORTAR_M, COURSE_M)
-    head = dash_coverage(across + 0.5 * MORTAR_M, fu, MORTAR_M, BRICK_M)
+    bed = lines(v + 0.5 * MORTAR_M, fv, MORTAR_M, COURSE_M)
+    head = lines(across + 0.5 * MORTAR_M, fu, MORTAR_M, BRICK_M)
     blur = min(fv / COURSE_M, 1.0)  # a footprint over several courses sees their head joints' mean
     head = head * (1.0 - blur) + MORTAR_M / BRICK_M * blur
     fade = max(1.0 - 2.0 * fv / COURSE_M, 0.0) * max(1.0 - fu / BRICK_M, 0.0)
@@ -90,8 +99,8 @@ def brick_wall(u: float, v: float, fu: float, fv: float, r: float, g: float,
 def panel_wall(u: float, v: float, fu: float, fv: float, r: float, g: float,
                b: float) -> tuple[float, float, float]:
     """Precast concrete panels with sealed joints."""
-    joint = max(dash_coverage(u + 0.5 * PANEL_JOINT_M, fu, PANEL_JOINT_M, PANEL_WIDTH_M),
-                dash_coverage(v + 0.5 * PANEL_JOINT_M, fv, PANEL_JOINT_M, PANEL_HEIGHT_M))
+    joint = max(lines(u + 0.5 * PANEL_JOINT_M, fu, PANEL_JOINT_M, PANEL_WIDTH_M),
+                lines(v + 0.5 * PANEL_JOINT_M, fv, PANEL_JOINT_M, PANEL_HEIGHT_M))
     fade = max(1.0 - max(fu, fv) / PANEL_HEIGHT_M, 0.0)
     tone = 1.0 + PANEL_TONE * fade * cell_hash(np.floor(u / PANEL_WIDTH_M), np.floor(v / PANEL_HEIGHT_M))
     dark = JOINT_DARKENING * tone
@@ -119,7 +128,7 @@ def glazing(finish: int, u: float, v: float, fu: float, fv: float, r: float, g: 
         shade = 1.0 - LINTEL_DARKENING * band_coverage(v, fv, PANE_HEIGHT_M - LINTEL_SHADE_M, PANE_HEIGHT_M + 1.0)
         r, g, b = joints_over(r, g, b, bars, shade, BAR_ALBEDO[0], BAR_ALBEDO[1], BAR_ALBEDO[2])
         return r, g, b, 1.0 - bars
-    bars = max(dash_coverage(u + 0.5 * SHOP_BAR_M, fu, SHOP_BAR_M, SHOP_BAY_M),
+    bars = max(lines(u + 0.5 * SHOP_BAR_M, fu, SHOP_BAR_M, SHOP_BAY_M),
                band_coverage(v, fv, SHOP_TRANSOM_M - 0.5 * SHOP_BAR_M, SHOP_TRANSOM_M + 0.5 * SHOP_BAR_M))
     riser = band_coverage(v, fv, -1.0, SHOP_RISER_M)
     solid = riser + (1.0 - riser) * bars
@@ -150,12 +159,12 @@ def footway(kerb: bool, s: float, t: float, fs: float, ft: float, r: float, g: f
             b: float) -> tuple[float, float, float]:
     """(r, g, b) of a footway of square paving flags, or of kerb stones, with their joints, in road coordinates."""
     if kerb:
-        joint = dash_coverage(s + 0.5 * KERB_JOINT_M, fs, KERB_JOINT_M, KERB_STONE_M)
+        joint = lines(s + 0.5 * KERB_JOINT_M, fs, KERB_JOINT_M, KERB_STONE_M)
         fade = max(1.0 - fs / KERB_STONE_M, 0.0)
         tone = 1.0 + FLAG_TONE * fade * cell_hash(np.floor(s / KERB_STONE_M), 7.0)
     else:
-        joint = max(dash_coverage(s + 0.5 * FLAG_JOINT_M, fs, FLAG_JOINT_M, FLAG_M),
-                    dash_coverage(t + 0.5 * FLAG_JOINT_M, ft, FLAG_JOINT_M, FLAG_M))
+        joint = max(lines(s + 0.5 * FLAG_JOINT_M, fs, FLAG_JOINT_M, FLAG_M),
+                    lines(t + 0.5 * FLAG_JOINT_M, ft, FLAG_JOINT_M, FLAG_M))
         fade = max(1.0 - 2.0 * max(fs, ft) / FLAG_M, 0.0)
         tone = 1.0 + FLAG_TONE * fade * cell_hash(np.floor(s / FLAG_M), np.floor(t / FLAG_M))
     dark = JOINT_DARKENING * tone

@@ -199,7 +199,7 @@ def _road_surface(network: RoadNetwork) -> RoadSurface:
 
 # How strongly the photographic surface texture (weathering, grime, leaf clumps, tufts) marks each kind of mesh
 # and each road material when the case's camera has a sensor (``Environment.detail``); 0 = flat colour.
-TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.3, "tunnel": 0.6,
+TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.12, "tunnel": 0.6,
                                      "bridge": 0.5, "barrier": 0.3, "guard_rail": 0.2, "fence": 0.2, "pole": 0.3,
                                      "streetlight": 0.15, "vehicle": 0.08, "pedestrian": 0.15, "bicycle": 0.1}
 DEFAULT_TEXTURE = 0.3

@@ -90,7 +90,7 @@ CHIP_FLAKES = 0.55  # share of the chip noise that is flakes (the rest: longer w
 STAIN_TEXEL_M = 0.8  # broad weathering stains on walls (m)
 STREAK_TEXEL_M = 0.4  # streaks down walls: the noise stretched STREAK_STRETCH times across, ten times along
 STREAK_STRETCH = 4.0
-FINISHED_TEXTURE = 0.15  # a wall with a finish shows this share of the photographic clumps (its structure is drawn)
+FINISHED_TEXTURE = 0.4  # a wall with a finish shows this share of the photographic clumps (its structure is drawn)
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 

@@ -494,7 +494,9 @@ def _walls(width: float, depth: float, height: float, color: ColorLike, finish: 
     faces."""
     hx, hy, z0 = width / 2, depth / 2, -footing
     corners = np.array([(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)])  # counter-clockwise seen from above
-    vertices, uv, faces = [], [], []
+    vertices: list[tuple[float, float, float]] = []
+    uv: list[tuple[float, float]] = []
+    faces: list[tuple[int, int, int]] = []
     along = 0.0
     for i in range(4):
         (x0, y0), (x1, y1) = corners[i], corners[(i + 1) % 4]
@@ -616,6 +618,7 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
     rects = [(c - half_w - frame, c + half_w + frame, z + 0.95 - frame, z + 2.55 + frame, 0.01, 0.01),
              (c - half_w, c + half_w, z + 0.95, z + 0.95 + PANE_HEIGHT_M, 0.02, 0.02),
              (c - half_w - 0.08, c + half_w + 0.08, z + 0.95 - frame, z + 0.95 - frame - 0.05, 0.01, SILL_DEPTH_M)]
+    pane: np.ndarray
     if rng is None:
         pane = np.broadcast_to(np.asarray(color, np.float32), (n, 3))
     else:
@@ -646,8 +649,8 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
 def _grid_columns(span: float, pitch: float) -> tuple[FloatArray, int, float]:
     """(centres along the facade, number of columns, half width of a pane) of the window columns on ``span``."""
     columns = max(int(span // pitch), 1)
-    centres = (np.arange(columns) - (columns - 1) / 2) * (span / columns)
-    return centres, columns, min(0.7, 0.3 * span / columns)
+    centres = (np.arange(columns) - (columns - 1) / 2.0) * (span / columns)
+    return centres.astype(np.float64), columns, min(0.7, 0.3 * span / columns)
 
 
 def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
