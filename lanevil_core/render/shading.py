@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..world.facade import GLASS as GLASS_FINISH
 from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
@@ -449,12 +450,13 @@ def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, n
 
 @kernel(inline="always")
 def shade_lit(color: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
-              sun: tuple[float, float, float, float, float, float],
+              glow: float, sun: tuple[float, float, float, float, float, float],
               lamps: tuple[float, float, float, float, float, float]) -> tuple[float, float, float]:
-    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and emission."""
-    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0],
-            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1],
-            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2])
+    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and the face's
+    emission times ``glow`` (the share of a lit window that is glass, not bars; else 1)."""
+    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0] * glow,
+            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1] * glow,
+            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2] * glow)
 
 
 @kernel(inline="always")
@@ -548,6 +550,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         kind = material if material >= 0 else OBJECT_ROW
         wet = 0.0
         glass = 0.0  # the share of the pixel that is window glass (a mirror)
+        glow = 1.0  # the share of the face's emission the pixel shows: a lit window's bars hide its light
         up = 0.6 + 0.4 * nz
         if material >= 0:
             if f != grad_face:
@@ -605,6 +608,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                                         sample_noise(coarse, STREAK_TEXEL_M, u * STREAK_STRETCH, v * 0.1 + 7.0,
                                                      fu * STREAK_STRETCH), r, g, b)
                 texture *= FINISHED_TEXTURE
+                if finish >= GLASS_FINISH:
+                    glow = glass
             if detail > 0.0:  # weathering, grime and leaf clumps on objects, in world space on the face's plane
                 u, v = object_plane(px, py, pz, nx, ny, nz)
                 foot = dist / fx
@@ -633,7 +638,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         retro = RETROREFLECTION * (1.0 - WET_RETRO_LOSS * surface_wet) if material >= 0 else 0.0
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny, retro)
-        r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
+        r, g, b = shade_lit((r, g, b), ambient, up, emission, f, glow, direct, lamps)
         if shiny > 0.0:  # wet road or glossy paint: a mirror of the sky, or on the road of the objects
             strength = fresnel_schlick(n_dot_v, surface[kind, MIRROR_F0]) * (
                 wet + (surface_wet - wet) * WET_FILM_MIRROR + gloss)

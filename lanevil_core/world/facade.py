@@ -21,7 +21,7 @@ from ..typed import FloatArray
 
 Finish = Literal["plain", "brick", "render", "panels", "glass", "shop_glass"]
 FINISHES: tuple[Finish, ...] = ("plain", "brick", "render", "panels", "glass", "shop_glass")
-PLAIN, BRICK, RENDER, PANELS, GLASS, SHOP_GLASS = range(len(FINISHES))
+PLAIN, BRICK, RENDER, PANELS, GLASS, SHOP_GLASS = range(len(FINISHES))  # the glass finishes last
 
 PANE_HEIGHT_M = 1.6  # a window pane's height; its transom bar lies TRANSOM_M above its foot
 TRANSOM_M = 1.12
