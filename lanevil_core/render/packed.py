@@ -41,7 +41,7 @@ class PackedScene:
 
     vertices: FloatArray  # (n, 3) world
     faces: IntArray  # (m, 3)
-    vertex_st: Float32Array  # (n, 2) road-frame s, t (road vertices only)
+    vertex_st: Float32Array  # (n, 2) road-frame s, t of road vertices, facade coordinates of objects (or 0)
     vertex_piece: IntArray  # (n,) road piece or -1
     face_material: IntArray  # (m,) MATERIALS index for road faces, -1 for objects
     face_object: IntArray  # (m,) id-buffer value
@@ -49,6 +49,7 @@ class PackedScene:
     face_emission: Float32Array  # (m, 3)
     face_gloss: Float32Array  # (m,)
     face_texture: Float32Array  # (m,) strength of the photographic surface texture (``TEXTURE_BY_KIND``)
+    face_finish: np.ndarray  # (m,) int8 ``facade.FINISHES`` index of object faces (0 = plain, and on the road)
     face_normal: Float32Array  # (m, 3) world, unit
     face_grad_st: Float32Array  # (m, 6) world gradients of s and of t on each road face (0 for objects)
     camera_faces: IntArray  # faces drawn in the camera
@@ -198,12 +199,12 @@ def _road_surface(network: RoadNetwork) -> RoadSurface:
 
 # How strongly the photographic surface texture (weathering, grime, leaf clumps, tufts) marks each kind of mesh
 # and each road material when the case's camera has a sensor (``Environment.detail``); 0 = flat colour.
-TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.55, "tunnel": 0.6,
+TEXTURE_BY_KIND: dict[str, float] = {"tree": 1.0, "bush": 1.0, "terrain": 0.9, "building": 0.12, "tunnel": 0.6,
                                      "bridge": 0.5, "barrier": 0.3, "guard_rail": 0.2, "fence": 0.2, "pole": 0.3,
                                      "streetlight": 0.15, "vehicle": 0.08, "pedestrian": 0.15, "bicycle": 0.1}
 DEFAULT_TEXTURE = 0.3
 # Per road material (index = typed.MATERIALS): asphalt, concrete, grass, gravel, kerb, dirt, slab.
-MATERIAL_TEXTURE = np.array([0.3, 0.5, 1.0, 0.8, 0.45, 0.8, 0.15], np.float32)
+MATERIAL_TEXTURE = np.array([0.3, 0.15, 1.0, 0.8, 0.2, 0.8, 0.15], np.float32)
 
 
 def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:
@@ -213,6 +214,7 @@ def _road_arrays(road: RoadSurface) -> dict[str, list[np.ndarray]]:
             "mat": [road.material], "obj": [np.where(road.carriageway, ID_ROAD, ID_ROADSIDE).astype(np.int32)],
             "color": [MATERIAL_ALBEDO[road.material]], "emission": [np.zeros((m, 3), np.float32)],
             "gloss": [np.zeros(m, np.float32)], "texture": [MATERIAL_TEXTURE[road.material]],
+            "finish": [np.zeros(m, np.int8)],
             "shadow": [np.zeros(m, bool)], "visible": [np.ones(m, bool)], "mirror": [np.zeros(m, bool)]}
 
 
@@ -222,7 +224,9 @@ def _append_meshes(arrays: dict[str, list[np.ndarray]], meshes: list[Mesh], firs
         m = len(mesh.faces)
         arrays["verts"].append(mesh.vertices)
         arrays["faces"].append(mesh.faces + offset)
-        arrays["st"].append(np.zeros((len(mesh.vertices), 2)))
+        # an object's vertices carry its facade coordinates where it has them (read only on faces with a finish)
+        arrays["st"].append(np.zeros((len(mesh.vertices), 2)) if mesh.uv is None else mesh.uv)
+        arrays["finish"].append(np.zeros(m, np.int8) if mesh.finish is None else mesh.finish)
         arrays["piece"].append(np.full(len(mesh.vertices), -1, np.int32))
         arrays["mat"].append(np.full(m, -1, np.int32))
         arrays["obj"].append(np.full(m, FIRST_OBJECT_ID + index, np.int32))
@@ -300,7 +304,7 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         vertex_piece=joined["piece"], face_material=joined["mat"],
         face_object=joined["obj"], face_color=joined["color"].astype(np.float32),
         face_emission=joined["emission"].astype(np.float32), face_gloss=joined["gloss"],
-        face_texture=joined["texture"],
+        face_texture=joined["texture"], face_finish=joined["finish"].astype(np.int8),
         face_normal=np.concatenate([roadside.normals, _face_normals(all_v, rest)]),
         face_grad_st=grad_st,
         camera_faces=np.flatnonzero(joined["visible"]).astype(np.int32),

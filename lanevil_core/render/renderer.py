@@ -164,7 +164,7 @@ def _nothing_mirrored(height: int, width: int) -> Float32Array:
 def _geometry(packed: PackedScene) -> Geometry:
     return Geometry(packed.faces, packed.vertex_st, packed.vertex_piece, packed.face_grad_st, packed.face_normal,
                     packed.face_material, packed.face_color, packed.face_emission, packed.face_gloss,
-                    packed.face_texture)
+                    packed.face_texture, packed.face_finish)
 
 
 def _surface_table(network: RoadNetwork) -> FloatArray:

@@ -21,9 +21,11 @@ from typing import NamedTuple
 import numpy as np
 
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..world.facade import GLASS as GLASS_FINISH
 from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
+from .facades import cell_hash, facade, footway
 from .lighting import (
     BEAM_LOW,
     FOOTPRINT_TAP_TEXELS,
@@ -52,9 +54,12 @@ from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA, DETAIL = range(9)
 ASPHALT = MATERIALS.index("asphalt")
 SLAB = MATERIALS.index("slab")
+CONCRETE = MATERIALS.index("concrete")  # footways: paving flags
+KERB = MATERIALS.index("kerb")
 PAVED = ("asphalt", "concrete", "kerb", "slab")  # hold a water film; grass, gravel and dirt soak it up
 # surface_table columns; its rows are the road MATERIALS, then one for every object
-ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0 = range(7)
+ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0, GRAIN = range(8)
+FLAG_GRAIN = 0.4  # paving flags and kerb stones are smoother than asphalt: this share of its grain and stains
 OBJECT_ROW = len(MATERIALS)
 WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
 FOOTPRINT_SCALE = 0.75  # box-filter width in pixels' worth of road coordinate
@@ -83,6 +88,10 @@ DRIP_HALF_WIDTH_M = 0.35  # the oil-drip stain down the middle of every lane (en
 DRIP_DARKENING = 0.22
 CHIP_STRETCH = 0.4  # worn paint's chips run about 2.5 times longer along the line than across it
 CHIP_FLAKES = 0.55  # share of the chip noise that is flakes (the rest: longer worn and kept stretches)
+STAIN_TEXEL_M = 0.8  # broad weathering stains on walls (m)
+STREAK_TEXEL_M = 0.4  # streaks down walls: the noise stretched STREAK_STRETCH times across, ten times along
+STREAK_STRETCH = 4.0
+FINISHED_TEXTURE = 0.4  # a wall with a finish shows this share of the photographic clumps (its structure is drawn)
 SKY_STEP = 8  # sky radiance is evaluated every SKY_STEP columns of a row and interpolated between
 SKY_EXACT_NEAR_SUN = 0.95  # cosine to the sun above which the sky is evaluated per pixel (glow, halo and disk)
 
@@ -111,6 +120,7 @@ class Geometry(NamedTuple):
     face_emission: Float32Array
     face_gloss: Float32Array
     face_texture: Float32Array
+    face_finish: np.ndarray
 
 
 class RoadLook(NamedTuple):
@@ -165,9 +175,12 @@ class Reflection(NamedTuple):
 
 
 def surface_table(albedo: np.ndarray = MATERIAL_ALBEDO) -> FloatArray:
-    """(materials + 1, 7) float64 per road material, then for objects: albedo r, g, b (objects: their faces'),
-    roughness, Fresnel f0 of highlights, holds a water film (0/1), Fresnel f0 of the mirror image."""
-    table = np.zeros((OBJECT_ROW + 1, 7))
+    """(materials + 1, 8) float64 per road material, then for objects: albedo r, g, b (objects: their faces'),
+    roughness, Fresnel f0 of highlights, holds a water film (0/1), Fresnel f0 of the mirror image, the share of
+    asphalt's grain and stains it shows."""
+    table = np.zeros((OBJECT_ROW + 1, 8))
+    table[:, GRAIN] = 1.0
+    table[[CONCRETE, KERB], GRAIN] = FLAG_GRAIN
     table[:OBJECT_ROW, ALBEDO_R:ALBEDO_B + 1] = albedo
     table[:, ROUGHNESS], table[:, F0], table[:, MIRROR_F0] = 0.35, 0.04, 0.02
     table[ASPHALT, ROUGHNESS], table[ASPHALT, F0] = 0.55, 0.02
@@ -271,6 +284,22 @@ def pixel_steps(R_world_camera: np.ndarray, fx: float, fy: float, depth: float, 
 
 
 @kernel(inline="always")
+def facade_footprint(du: tuple[float, float, float], dv: tuple[float, float, float], nx: float,
+                     ny: float) -> tuple[float, float]:
+    """(fu, fv): how far the pixel's footprint (world steps du, dv on the face's plane) reaches along a wall (the
+    horizontal in the face's plane) and up it."""
+    hx, hy = -ny, nx
+    h = np.sqrt(hx * hx + hy * hy)
+    if h > 1e-6:
+        hx, hy = hx / h, hy / h
+    else:  # a horizontal face: "along" is any horizontal, x
+        hx, hy = 1.0, 0.0
+    fu = abs(du[0] * hx + du[1] * hy) + abs(dv[0] * hx + dv[1] * hy)
+    fv = abs(du[2]) + abs(dv[2])
+    return min(FOOTPRINT_SCALE * fu + 1e-3, MAX_FOOTPRINT_M), min(FOOTPRINT_SCALE * fv + 1e-3, MAX_FOOTPRINT_M)
+
+
+@kernel(inline="always")
 def road_coordinates(faces: np.ndarray, vertex_st: np.ndarray, bary: np.ndarray, row: int, col: int,
                      f: int) -> tuple[float, float]:
     """(s, t) of the pixel on road face ``f`` from its perspective-correct barycentric weights."""
@@ -286,9 +315,10 @@ def road_coordinates(faces: np.ndarray, vertex_st: np.ndarray, bary: np.ndarray,
 @kernel(inline="always")
 def albedo(surface: np.ndarray, material: int, grain: float, blotch: float,
            detail: float) -> tuple[float, float, float]:
-    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1]); ``detail``
-    (0 = the ideal render) deepens both as a photograph shows them."""
-    tone = (1.0 + 0.35 * (1.0 + detail) * grain) * (1.0 + 0.18 * (1.0 + 1.5 * detail) * blotch)
+    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1]), as much as
+    the material shows (``GRAIN``); ``detail`` (0 = the ideal render) deepens both as a photograph shows them."""
+    share = surface[material, GRAIN]
+    tone = (1.0 + 0.35 * share * (1.0 + detail) * grain) * (1.0 + 0.18 * share * (1.0 + 1.5 * detail) * blotch)
     return surface[material, ALBEDO_R] * tone, surface[material, ALBEDO_G] * tone, surface[material, ALBEDO_B] * tone
 
 
@@ -300,9 +330,8 @@ def slab_joints(s: float, t: float, fs: float, ft: float, lane_width: float, sta
     bands, box-filtered over the pixel's footprint (fs, ft); ``stain`` (noise in [-1, 1]) varies the smeared
     sealant and the drip."""
     i, j = np.floor(s / JOINT_SPACING_M), np.floor(t / lane_width)
-    hashed = np.sin(i * 12.9898 + j * 78.233) * 43758.5453
     fade = max(1.0 - 2.0 * max(fs, ft) / JOINT_SPACING_M, 0.0)  # far away a pixel spans many slabs
-    tone = 1.0 + SLAB_TONE * fade * (2.0 * (hashed - np.floor(hashed)) - 1.0)
+    tone = 1.0 + SLAB_TONE * fade * cell_hash(i, j)
     across = (t / lane_width - j - 0.5) * lane_width / DRIP_HALF_WIDTH_M
     spread = min(ft / lane_width, 1.0)  # a footprint across the lane sees the drip's lane-wide mean
     drip = np.exp(-across * across) * (1.0 - spread) + np.sqrt(np.pi) * DRIP_HALF_WIDTH_M / lane_width * spread
@@ -421,12 +450,13 @@ def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, n
 
 @kernel(inline="always")
 def shade_lit(color: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
-              sun: tuple[float, float, float, float, float, float],
+              glow: float, sun: tuple[float, float, float, float, float, float],
               lamps: tuple[float, float, float, float, float, float]) -> tuple[float, float, float]:
-    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and emission."""
-    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0],
-            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1],
-            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2])
+    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and the face's
+    emission times ``glow`` (the share of a lit window that is glass, not bars; else 1)."""
+    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0] * glow,
+            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1] * glow,
+            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2] * glow)
 
 
 @kernel(inline="always")
@@ -465,7 +495,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     kernel's time."""
     R, c_world, fx, fy, cx, _ = view
     faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss, \
-        face_texture = geometry
+        face_texture, face_finish = geometry
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
         overhead_params, paint_wear, wear_shift = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
@@ -519,6 +549,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         material = face_material[f]
         kind = material if material >= 0 else OBJECT_ROW
         wet = 0.0
+        glass = 0.0  # the share of the pixel that is window glass (a mirror)
+        glow = 1.0  # the share of the face's emission the pixel shows: a lit window's bars hide its light
         up = 0.6 + 0.4 * nz
         if material >= 0:
             if f != grad_face:
@@ -533,6 +565,8 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),
                               sample_noise(fine, MID_TEXEL_M, s, t + 5.0, footprint))
                 r, g, b = r * tone, g * tone, b * tone
+            if material == CONCRETE or material == KERB:
+                r, g, b = footway(material == KERB, s, t, fs, ft, r, g, b)
             if material == SLAB:
                 r, g, b = slab_joints(s, t, fs, ft, lane_width,
                                       sample_noise(coarse, COARSE_TEXEL_M, s * 2.0 + 53.0, t, footprint), r, g, b)
@@ -563,13 +597,26 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             up *= sky_openness(overhead, overhead_params, px, py)  # ground under a roof sees less sky
         else:
             r, g, b = color[f, 0], color[f, 1], color[f, 2]
+            texture = face_texture[f]
+            finish = face_finish[f]
+            if finish > 0:  # brick, render, panels, window glass: drawn in facade coordinates over the footprint
+                u, v = road_coordinates(faces, vertex_st, bary, row, col, f)
+                du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
+                fu, fv = facade_footprint(du, dv, nx, ny)
+                r, g, b, glass = facade(finish, u, v, fu, fv,
+                                        sample_noise(coarse, STAIN_TEXEL_M, u * 0.5 + 19.0, v, max(fu, fv)),
+                                        sample_noise(coarse, STREAK_TEXEL_M, u * STREAK_STRETCH, v * 0.1 + 7.0,
+                                                     fu * STREAK_STRETCH), r, g, b)
+                texture *= FINISHED_TEXTURE
+                if finish >= GLASS_FINISH:
+                    glow = glass
             if detail > 0.0:  # weathering, grime and leaf clumps on objects, in world space on the face's plane
                 u, v = object_plane(px, py, pz, nx, ny, nz)
                 foot = dist / fx
-                tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, u, v, foot),
+                tone = clumps(detail * texture, sample_noise(fine, CLUMP_TEXEL_M, u, v, foot),
                               sample_noise(fine, MID_TEXEL_M, v + 3.0, u, foot))
                 r, g, b = r * tone, g * tone, b * tone
-        gloss = face_gloss[f]  # 0 on the road
+        gloss = face_gloss[f] + glass  # 0 on the road
         surface_wet = max(wetness * surface[kind, HOLDS_WATER], wet)  # 0 on objects
         r, g, b, roughness = wet_surface(r, g, b, surface[kind, ROUGHNESS], surface_wet, wet)
         shiny = surface_wet + gloss
@@ -591,7 +638,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
         retro = RETROREFLECTION * (1.0 - WET_RETRO_LOSS * surface_wet) if material >= 0 else 0.0
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny, retro)
-        r, g, b = shade_lit((r, g, b), ambient, up, emission, f, direct, lamps)
+        r, g, b = shade_lit((r, g, b), ambient, up, emission, f, glow, direct, lamps)
         if shiny > 0.0:  # wet road or glossy paint: a mirror of the sky, or on the road of the objects
             strength = fresnel_schlick(n_dot_v, surface[kind, MIRROR_F0]) * (
                 wet + (surface_wet - wet) * WET_FILM_MIRROR + gloss)

@@ -32,7 +32,7 @@ WEAR_SHIFT_SPAN_M = 4096.0  # worn paint's chip pattern starts this far along th
 # Linear albedo of the cross-section materials (index = typed.MATERIALS).
 MATERIAL_ALBEDO = np.array([
     [0.055, 0.055, 0.058],  # asphalt
-    [0.30, 0.29, 0.27],  # concrete
+    [0.25, 0.245, 0.23],  # concrete: paving flags of footways (weathered, 0.2-0.3)
     [0.075, 0.11, 0.045],  # grass (mown lawn and verge, a little yellow and grey in it)
     [0.16, 0.145, 0.13],  # gravel
     [0.38, 0.37, 0.35],  # kerb

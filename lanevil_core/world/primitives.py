@@ -101,8 +101,15 @@ def merge(meshes: Sequence[Mesh], name: str = "object", kind: str = "prop", glos
             mesh.emission if mesh.emission is not None else np.zeros((len(mesh.faces), 3), np.float32)
             for mesh in meshes
         ])
+    finish = uv = None
+    if any(mesh.finish is not None for mesh in meshes):  # faces and vertices without a finish stay plain
+        finish = np.concatenate([mesh.finish if mesh.finish is not None else np.zeros(len(mesh.faces), np.int8)
+                                 for mesh in meshes])
+        uv = np.concatenate([mesh.uv if mesh.uv is not None else np.zeros((len(mesh.vertices), 2), np.float32)
+                             for mesh in meshes])
     return Mesh(vertices, faces, colors, name=name, kind=kind, gloss=max(m.gloss for m in meshes) if gloss is None
-                else gloss, emission=emission, casts_shadow=any(mesh.casts_shadow for mesh in meshes))
+                else gloss, emission=emission, casts_shadow=any(mesh.casts_shadow for mesh in meshes), finish=finish,
+                uv=uv)
 
 
 def transformed(mesh: Mesh, T_world_local: FloatArray) -> Mesh:
@@ -113,7 +120,7 @@ def transformed(mesh: Mesh, T_world_local: FloatArray) -> Mesh:
     faces = mesh.faces[:, ::-1] if np.linalg.det(T_world_local[:3, :3]) < 0 else mesh.faces
     return Mesh(p_world, faces.copy(), mesh.colors.copy(), name=mesh.name, kind=mesh.kind,
                 casts_shadow=mesh.casts_shadow, gloss=mesh.gloss, emission=emission, visible=mesh.visible,
-                source=mesh.source)
+                source=mesh.source, finish=mesh.finish, uv=mesh.uv)
 
 
 def translation(offset: ColorLike) -> FloatArray:

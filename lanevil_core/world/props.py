@@ -15,6 +15,19 @@ import numpy as np
 import trimesh
 
 from ..typed import FloatArray, IntArray
+from .facade import (
+    AWNING_COLORS,
+    BALCONY_SHARE,
+    BRICK,
+    FASCIA_COLORS,
+    PANE_HEIGHT_M,
+    PLAIN,
+    RENDER,
+    SHOP_AWNING_SHARE,
+    SHOP_GLASS,
+    wall_finish,
+)
+from .facade import GLASS as GLASS_FINISH
 from .primitives import ColorLike, PointsLike, beam, box, cylinder, loft, merge, prism, quad, to_mesh, translation
 from .scene import Mesh
 
@@ -38,8 +51,6 @@ SHIRTS = ((0.5, 0.04, 0.03), (0.03, 0.08, 0.35), (0.6, 0.6, 0.58), (0.05, 0.05, 
 TROUSERS = ((0.02, 0.03, 0.1), (0.03, 0.03, 0.03), (0.15, 0.12, 0.08), (0.18, 0.18, 0.19), (0.05, 0.08, 0.2))
 SKINS = ((0.6, 0.38, 0.27), (0.45, 0.27, 0.17), (0.25, 0.13, 0.07), (0.12, 0.06, 0.035), (0.7, 0.5, 0.38))
 HAIRS = ((0.02, 0.015, 0.01), (0.12, 0.06, 0.02), (0.35, 0.25, 0.1), (0.3, 0.3, 0.3))
-FACADES = ((0.45, 0.4, 0.33), (0.3, 0.3, 0.3), (0.35, 0.12, 0.07), (0.55, 0.53, 0.5), (0.4, 0.3, 0.2),
-           (0.2, 0.22, 0.25))
 ROOFS = ((0.2, 0.05, 0.03), (0.06, 0.06, 0.07), (0.15, 0.1, 0.07))
 LEAVES = ((0.045, 0.1, 0.035), (0.055, 0.115, 0.04), (0.035, 0.075, 0.035), (0.07, 0.115, 0.035), (0.05, 0.09, 0.045))
 
@@ -526,30 +537,118 @@ def _leaf_colors(green: FloatArray, rng: np.random.Generator, m: int) -> FloatAr
 def building(rng: np.random.Generator, width: float = 20.0, depth: float = 14.0, height: float = 15.0, *,
              facade: ColorLike | None = None, shopfront: bool = False, lit: bool = False,
              name: str = "building") -> Mesh:
-    """An apartment or office block: ``width`` along X, ``depth`` along Y, a grid of dark windows on every
-    facade, a parapet; ``shopfront`` darkens the ground floor of the front (+Y) facade. ``lit`` (night): a share of
-    the windows glows (``light_windows``), and half the shops keep their window lit."""
-    facade = _choose(rng, facade, FACADES)
+    """An apartment or office block: ``width`` along X, ``depth`` along Y, walls of brick, render or concrete panels
+    (``facade.wall_finish``; ``facade`` overrides the colour), a grid of framed windows on every facade seen from
+    the road, a cornice at the roof line. ``shopfront``: the front (+Y) ground floor is a shop window under a
+    coloured fascia, half of them under an awning; otherwise the block has an entrance door, and half of such
+    (residential) blocks have balconies. ``lit`` (night): a share of the windows glows (``light_windows``), and half
+    the shops keep their window lit."""
+    finish, wall = wall_finish(rng)
+    wall = np.asarray(facade, np.float64) if facade is not None else wall
     hy = depth / 2
-    parts = [box((width, depth, height + 0.5), (0.0, 0.0, height / 2 - 0.25), facade),
-             box((width + 0.2, depth + 0.2, 0.6), (0.0, 0.0, height + 0.1), facade * 0.7)]
-    storeys = max(int(height // 3.2), 1)
+    parts = [_walls(width, depth, height, wall, finish),
+             box((width + 0.5, depth + 0.5, 0.6), (0.0, 0.0, height + 0.1), wall * 0.75)]  # cornice
+    storeys = max(int(height // STOREY_M), 1)
     pitch = float(rng.uniform(2.6, 3.6))
     glass = np.asarray(GLASS) * 2.0
     first = 1 if shopfront else 0
-    if shopfront:
-        parts.append(box((width - 1.0, 0.1, 2.6), (0.0, hy, 1.6), glass))
+    shop = _shopfront(rng, width, hy) if shopfront else []
     panes = []
     for axis_len, across, sign, along_x in _facades_seen(width, depth):
         grid = _window_grid(axis_len, across, sign, along_x, storeys, pitch, first, glass, rng)
         parts += grid
         panes += grid[1::3]
+    if not shopfront:
+        parts.append(_door(0.0, hy, 1.4, 2.4, DOOR_COLORS[int(rng.integers(len(DOOR_COLORS)))]))
+        if storeys > 1 and rng.random() < BALCONY_SHARE:
+            parts.append(_balconies(width, hy, storeys, pitch, wall))
+    parts += shop
     if lit:  # drawn after everything else, so a night block has the day's shape and colours
         light_windows(panes, rng)
         if shopfront and rng.random() < SHOP_LIT_SHARE:
             glow = np.asarray(ROOM_LIGHTS[2], np.float32) * np.float32(rng.uniform(*SHOP_GLOW))
-            parts[2].emission = np.ascontiguousarray(np.broadcast_to(glow, (len(parts[2].faces), 3)))
+            shop[0].emission = np.ascontiguousarray(np.broadcast_to(glow, (len(shop[0].faces), 3)))
     return merge(parts, name=name, kind="building", gloss=0.1)
+
+
+STOREY_M = 3.2
+DOOR_COLORS = ((0.10, 0.05, 0.025), (0.02, 0.05, 0.03), (0.03, 0.03, 0.035), (0.25, 0.24, 0.22))
+SHOP_GLASS_TOP_M = 2.9  # the shop window reaches from its stall riser to here; the fascia sits above it
+
+
+def _walls(width: float, depth: float, height: float, color: ColorLike, finish: int, footing: float = 0.5) -> Mesh:
+    """Four walls (from ``footing`` below the ground to ``height``) and a flat roof of a block centred on the
+    origin, each wall with facade coordinates (u along it, v = height above the ground) for its ``finish``; 10
+    faces."""
+    hx, hy, z0 = width / 2, depth / 2, -footing
+    corners = np.array([(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)])  # counter-clockwise seen from above
+    vertices: list[tuple[float, float, float]] = []
+    uv: list[tuple[float, float]] = []
+    faces: list[tuple[int, int, int]] = []
+    along = 0.0
+    for i in range(4):
+        (x0, y0), (x1, y1) = corners[i], corners[(i + 1) % 4]
+        length = float(np.hypot(x1 - x0, y1 - y0))
+        k = len(vertices)
+        vertices += [(x0, y0, z0), (x1, y1, z0), (x1, y1, height), (x0, y0, height)]
+        uv += [(along, z0), (along + length, z0), (along + length, height), (along, height)]
+        faces += [(k, k + 1, k + 2), (k, k + 2, k + 3)]
+        along += length
+    k = len(vertices)
+    vertices += [(x, y, height) for x, y in corners]
+    uv += [(x, y) for x, y in corners]
+    faces += [(k, k + 1, k + 2), (k, k + 2, k + 3)]
+    finishes = np.full(10, finish, np.int8)
+    finishes[8:] = PLAIN  # the roof is seen from above only
+    return Mesh(np.array(vertices), np.array(faces), np.asarray(color, np.float32), finish=finishes,
+                uv=np.array(uv, np.float32))
+
+
+def _glazing(u0: float, u1: float, z0: float, z1: float, y: float, color: ColorLike, finish: int) -> Mesh:
+    """A pane facing +Y at ``y`` over x in [u0, u1], z in [z0, z1], its facade coordinates across it from its
+    centre and up from its foot."""
+    corners = [(u0, y, z0), (u1, y, z0), (u1, y, z1), (u0, y, z1)]
+    mid = (u0 + u1) / 2
+    pane = _panel(corners, (0.0, 1.0, 0.0), color)
+    uv = np.array([(x - mid, z - z0) for x, _, z in pane.vertices], np.float32)
+    return Mesh(pane.vertices, pane.faces, pane.colors, finish=np.full(len(pane.faces), finish, np.int8), uv=uv)
+
+
+def _door(x: float, hy: float, width: float, height: float, color: ColorLike) -> Mesh:
+    """An entrance door (a glazed door leaf in a dark frame) on the +Y front at x."""
+    return _panel([(x - width / 2, hy + 0.02, 0.0), (x + width / 2, hy + 0.02, 0.0),
+                   (x + width / 2, hy + 0.02, height), (x - width / 2, hy + 0.02, height)], (0.0, 1.0, 0.0), color)
+
+
+def _shopfront(rng: np.random.Generator, width: float, hy: float) -> list[Mesh]:
+    """The front ground floor of a shop: its window (first, ``SHOP_GLASS`` finish: bays, transom, stall riser), a
+    fascia band in the trade's colour above it and, for ``SHOP_AWNING_SHARE`` of shops, an awning over it."""
+    half = width / 2 - 0.5
+    interior = np.asarray(GLASS) * rng.uniform(2.0, 5.0)
+    parts = [_glazing(-half, half, 0.0, SHOP_GLASS_TOP_M, hy + 0.03, interior, SHOP_GLASS),
+             box((width - 0.6, 0.2, 0.7), (0.0, hy + 0.1, SHOP_GLASS_TOP_M + 0.4),
+                 FASCIA_COLORS[int(rng.integers(len(FASCIA_COLORS)))])]
+    if rng.random() < SHOP_AWNING_SHARE:
+        reach, drop = float(rng.uniform(1.0, 1.6)), 0.5
+        cloth = AWNING_COLORS[int(rng.integers(len(AWNING_COLORS)))]
+        parts.append(_panel([(-half, hy, SHOP_GLASS_TOP_M + 0.05), (half, hy, SHOP_GLASS_TOP_M + 0.05),
+                             (half, hy + reach, SHOP_GLASS_TOP_M + 0.05 - drop),
+                             (-half, hy + reach, SHOP_GLASS_TOP_M + 0.05 - drop)], (0.0, drop, reach), cloth))
+    return parts
+
+
+def _balconies(width: float, hy: float, storeys: int, pitch: float, wall: FloatArray) -> Mesh:
+    """Balconies with solid fronts on the +Y facade, under every other window column from the first floor up
+    (one box each: slab and parapet 1.05 m high, 1.1 m deep)."""
+    centres, _, half_w = _grid_columns(width, pitch)
+    columns = centres[::2]
+    levels = np.arange(1, storeys) * STOREY_M
+    c, z = (grid.ravel() for grid in np.meshgrid(columns, levels))
+    slab = box((2 * half_w + 0.6, 1.1, 1.05))
+    offsets = np.stack([c, np.full_like(c, hy + 0.55), z + 0.525], 1)
+    vertices = (slab.vertices[None] + offsets[:, None]).reshape(-1, 3)
+    faces = (slab.faces[None] + np.arange(len(c))[:, None, None] * len(slab.vertices)).reshape(-1, 3)
+    return Mesh(vertices, faces, np.asarray(wall * 0.85, np.float32))
 
 
 def _facades_seen(width: float, depth: float) -> tuple[tuple[float, float, float, bool], ...]:
@@ -592,12 +691,11 @@ def light_windows(panes: list[Mesh], rng: np.random.Generator) -> None:
 def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys: int, pitch: float,
                  first_storey: int, color: FloatArray, rng: np.random.Generator | None = None) -> list[Mesh]:
     """Windows on one facade (the facade plane at ``sign * across``: y if ``along_x`` else x): each a frame, a
-    pane and a sill under it. The panes' colours (``color`` times a drawn factor per pane, when ``rng`` is given)
-    stand for what glass shows by day: the sky mirrored (pale, more so up the facade), a dark room, a curtain."""
-    columns = max(int(span // pitch), 1)
-    centres = (np.arange(columns) - (columns - 1) / 2) * (span / columns)
-    half_w = min(0.7, 0.3 * span / columns)
-    levels = np.arange(first_storey, storeys) * 3.2
+    pane and a sill under it. The panes have the ``GLASS`` finish (the renderer draws their bars and mirrors the
+    sky in them) and facade coordinates from the pane's centre and foot; their colours (``color`` times a drawn
+    factor per pane, when ``rng`` is given) are what lies behind the glass: a dark room, a drawn curtain."""
+    centres, _, half_w = _grid_columns(span, pitch)
+    levels = np.arange(first_storey, storeys) * STOREY_M
     if levels.size == 0:
         return []
     c, z = (grid.ravel() for grid in np.meshgrid(centres, levels))
@@ -606,20 +704,24 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
     # (n, 4) corners along the facade (u) and up it (v), and their offsets off the wall (w): frame, pane and sill
     # (a quad jutting out and down from the frame's foot)
     rects = [(c - half_w - frame, c + half_w + frame, z + 0.95 - frame, z + 2.55 + frame, 0.01, 0.01),
-             (c - half_w, c + half_w, z + 0.95, z + 2.55, 0.02, 0.02),
+             (c - half_w, c + half_w, z + 0.95, z + 0.95 + PANE_HEIGHT_M, 0.02, 0.02),
              (c - half_w - 0.08, c + half_w + 0.08, z + 0.95 - frame, z + 0.95 - frame - 0.05, 0.01, SILL_DEPTH_M)]
+    pane: np.ndarray
     if rng is None:
         pane = np.broadcast_to(np.asarray(color, np.float32), (n, 3))
     else:
-        sky = np.clip(0.25 + 0.12 * z / 3.2 + rng.uniform(-0.1, 0.25, n), 0.0, 1.0)[:, None]
-        pane = np.asarray(color) * (1.0 + 5.0 * sky) * rng.uniform(0.7, 1.3, (n, 1))
+        pane = np.asarray(color) * rng.uniform(0.6, 2.0, (n, 1))
         curtains = rng.random(n) < 0.2
-        pane[curtains] = rng.choice([0.35, 0.5], curtains.sum())[:, None] * np.array([0.55, 0.5, 0.42])
+        pane[curtains] = rng.choice([0.12, 0.25], curtains.sum())[:, None] * np.array([0.55, 0.5, 0.42])
     frame_color = np.broadcast_to(np.asarray(WINDOW_FRAMES[0 if rng is None else int(rng.integers(2))]), (n, 3))
     meshes = []
-    for (a, b, z0, z1, w0, w1), colors in zip(rects, (frame_color, pane, frame_color)):
+    for i, ((a, b, z0, z1, w0, w1), colors) in enumerate(zip(rects, (frame_color, pane, frame_color))):
         u = np.stack([a, b, b, a], 1)
         v = np.stack([z0, z0, z1, z1], 1)
+        finish, uv = None, None
+        if i == 1:  # the pane
+            finish = np.full(2 * n, GLASS_FINISH, np.int8)
+            uv = np.stack([u - c[:, None], v - z0[:, None]], -1).reshape(-1, 2).astype(np.float32)
         w = sign * (across + np.stack([np.full(n, w0), np.full(n, w0), np.full(n, w1), np.full(n, w1)], 1))
         corners = np.stack([u, w, v] if along_x else [w, u, v], -1).reshape(-1, 3)
         quads = np.arange(n)[:, None] * 4
@@ -627,8 +729,16 @@ def _window_grid(span: float, across: float, sign: float, along_x: bool, storeys
         # The (u, v) order is counter-clockwise seen from +Y for an x-running facade and from -X otherwise.
         if (sign > 0) == along_x:
             faces = faces[:, ::-1]
-        meshes.append(Mesh(corners, faces, np.concatenate([colors, colors]).astype(np.float32)))
+        meshes.append(Mesh(corners, faces, np.concatenate([colors, colors]).astype(np.float32), finish=finish,
+                           uv=uv))
     return meshes
+
+
+def _grid_columns(span: float, pitch: float) -> tuple[FloatArray, int, float]:
+    """(centres along the facade, number of columns, half width of a pane) of the window columns on ``span``."""
+    columns = max(int(span // pitch), 1)
+    centres = (np.arange(columns) - (columns - 1) / 2.0) * (span / columns)
+    return centres.astype(np.float64), columns, min(0.7, 0.3 * span / columns)
 
 
 def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
@@ -638,9 +748,9 @@ def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, 
     storeys = int(rng.integers(1, 3)) if storeys is None else storeys
     wall_h = 2.9 * storeys
     hx, hy = width / 2, depth / 2
-    wall = _choose(rng, None, FACADES[:2] + FACADES[3:5])
+    finish, wall = wall_finish(rng, (BRICK, RENDER), (0.5, 0.5))
     roof_h = float(rng.uniform(0.3, 0.45)) * depth
-    parts = [box((width, depth, wall_h + 0.3), (0.0, 0.0, wall_h / 2 - 0.15), wall),
+    parts = [_walls(width, depth, wall_h, wall, finish, footing=0.3),
              prism([(-hy - 0.4, wall_h - 0.05), (hy + 0.4, wall_h - 0.05), (0.0, wall_h + roof_h)],
                    -hx - 0.3, hx + 0.3, _pick(rng, ROOFS), axis="x")]
     glass = np.asarray(GLASS) * 2.0

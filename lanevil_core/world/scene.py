@@ -45,6 +45,10 @@ class Mesh:
         source: the illusion index that added it, or -1 for the road and roadside.
         heading: world yaw (radians, counter-clockwise from +X) of a traffic participant's forward axis, set where it
             is placed (exports need it: a footprint's long axis cannot tell front from back, nor a person's facing).
+        finish: (m,) int8 what a building face is made of (``facade.FINISHES`` index: plain, brick, render, panels,
+            glass, shop glass), or None (all plain); the renderer draws its structure per pixel.
+        uv: (n, 2) float32 facade coordinates of each vertex (m): along a wall and up it, or across a pane from its
+            centre and up from its foot; or None. Read where ``finish`` is not plain.
     """
 
     vertices: FloatArray
@@ -58,6 +62,8 @@ class Mesh:
     visible: bool = True
     source: int = -1
     heading: float | None = None
+    finish: np.ndarray | None = None
+    uv: Float32Array | None = None
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64)

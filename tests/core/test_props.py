@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Road
-from lanevil_core.world import props
+from lanevil_core.world import facade, props
 from lanevil_core.world.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
@@ -130,7 +130,7 @@ def test_trees_and_bushes_stand_on_the_ground() -> None:
 def test_building_and_house_fill_their_footprint() -> None:
     block = props.building(RNG(0), 20.0, 12.0, 16.0, shopfront=True)
     assert_renderable(block)
-    np.testing.assert_allclose(extents(block), (20.2, 12.2, 16.9), atol=0.1)  # parapet, footing
+    np.testing.assert_allclose(extents(block), (20.5, 12.5, 16.9), atol=0.1)  # cornice, footing
     assert outward_share(block) > 0.85  # all but the parapet's underside
     tri = block.vertices[block.faces]
     on_pane = (np.abs(np.abs(tri[..., 1]) - 6.02) < 1e-6).all(1) | (np.abs(np.abs(tri[..., 0]) - 10.02) < 1e-6).all(1)
@@ -142,6 +142,50 @@ def test_building_and_house_fill_their_footprint() -> None:
     home = props.house(RNG(1), 10.0, 8.0, storeys=2)
     size = extents(home)
     assert 10.0 <= size[0] < 11.0 and 8.0 <= size[1] < 9.0 and 7.0 < size[2] < 10.0
+
+
+def test_building_faces_carry_their_finish_and_facade_coordinates() -> None:
+    walls, shops, doors = set(), 0, 0
+    for seed in range(12):
+        shop = seed % 2 == 0
+        block = props.building(RNG(seed), 20.0, 12.0, 16.0, shopfront=shop)
+        assert block.finish is not None and block.uv is not None
+        assert block.finish.shape == (len(block.faces),) and block.uv.shape == (len(block.vertices), 2)
+        tri = block.vertices[block.faces]
+        on_pane = ((np.abs(np.abs(tri[..., 1]) - 6.02) < 1e-6).all(1)
+                   | (np.abs(np.abs(tri[..., 0]) - 10.02) < 1e-6).all(1)) & (tri[..., 2].min(1) > 0.9)  # not the door
+        assert (block.finish[on_pane] == facade.GLASS).all()  # every window pane is glass
+        pane_uv = block.uv[block.faces[block.finish == facade.GLASS]].reshape(-1, 2)
+        assert np.abs(pane_uv[:, 0]).max() <= 0.7 + 1e-6  # across the pane from its centre ...
+        assert pane_uv[:, 1].min() > -1e-6 and pane_uv[:, 1].max() < facade.PANE_HEIGHT_M + 1e-5  # ... up from its foot
+        wall_faces = np.isin(block.finish, facade.WALL_FINISHES)
+        assert wall_faces.sum() == 8  # four walls, two triangles each
+        walls.add(int(block.finish[wall_faces][0]))
+        # along a wall, u grows by the wall's length and v is the height above the ground
+        wall_uv = block.uv[block.faces[wall_faces]]
+        np.testing.assert_allclose(wall_uv[..., 1], tri[wall_faces][..., 2], atol=1e-5)
+        if shop:
+            shops += int((block.finish == facade.SHOP_GLASS).sum() == 2)
+        else:
+            front = (np.abs(tri[..., 1] - 6.02) < 1e-6).all(1) & (tri[..., 2].max(1) < 2.5) & (tri[..., 2].min(1) >= 0)
+            doors += int(front.sum() >= 2)
+    assert walls == set(facade.WALL_FINISHES)  # brick, render and panels all occur
+    assert shops == 6 and doors == 6  # every shop has its window, every other block its door
+    np.testing.assert_array_equal(props.building(RNG(5), 20.0, 12.0, 16.0).uv,
+                                  props.building(RNG(5), 20.0, 12.0, 16.0).uv)  # deterministic
+
+
+def test_merge_and_transform_keep_the_finish() -> None:
+    block = props.building(RNG(2), 14.0, 10.0, 9.6)
+    plain = box((1.0, 1.0, 1.0))
+    both = merge([plain, block])
+    assert both.finish is not None and both.uv is not None
+    assert (both.finish[:12] == facade.PLAIN).all() and (both.uv[:len(plain.vertices)] == 0).all()
+    np.testing.assert_array_equal(both.finish[12:], block.finish)
+    moved = transformed(block, pose_on_road(build_network(Road(), "urban").main.line, 30.0, 12.0, 0.5))
+    np.testing.assert_array_equal(moved.finish, block.finish)
+    np.testing.assert_array_equal(moved.uv, block.uv)
+    assert merge([plain, plain]).finish is None
 
 
 def test_jersey_barrier_profile() -> None:
