@@ -63,7 +63,6 @@ MOW_PERIOD_M = 1.3  # a mower's two passes
 MOW_CONTRAST = 0.09
 KERB_WEEDS_M = 0.22  # the weedy strip along the pavement's edge
 PATCH_TEXEL_M = 5.0  # texel of the noise of colour variation inside a field and of damp patches
-WANDER_TEXEL_M = 2.5  # texel of the noise along the road (the worn strip's edge, the verge's straw)
 PATCH_TONE = 0.14
 DAMP_DARKENING = 0.3  # a damp hollow's albedo is up to this much darker
 WET_DARKENING = 0.35  # soaked ground (the weather's wetness 1) is this much darker
@@ -84,10 +83,19 @@ def ground_table(pieces: list[RoadPiece]) -> FloatArray:
 
 
 @kernel(inline="always")
+def fract(x: float) -> float:
+    """The fractional part of x (in [0, 1))."""
+    return x - np.floor(x)
+
+
+@kernel(inline="always")
 def plot_hash(a: float, b: float, c: float) -> float:
-    """A number in [0, 1) fixed by the plot's indices (a, b, c)."""
-    h = np.sin(a * 12.9898 + b * 78.233 + c * 37.719) * 43758.5453
-    return h - np.floor(h)
+    """A number in [0, 1) fixed by the plot's indices (a, b, c): a hash of multiplies and fractions only (no sine:
+    a grass pixel takes several)."""
+    x, y, z = fract(a * 0.1031), fract(b * 0.1030), fract(c * 0.0973)
+    d = x * (z + 31.32) + y * (y + 31.32) + z * (x + 31.32)
+    x, y, z = x + d, y + d, z + d
+    return fract((x + y) * z)
 
 
 @kernel(inline="always")
@@ -165,11 +173,12 @@ def lawn(s: float, u: float, fs: float, ft: float, salt: float) -> tuple[float, 
 
 
 @kernel(inline="always")
-def ground(table: np.ndarray, piece: int, s: float, t: float, fs: float, ft: float, patch: float, wander: float,
-           stain: float, wetness: float) -> tuple[float, float, float, float]:
+def ground(table: np.ndarray, piece: int, s: float, t: float, fs: float, ft: float, patch: float, stain: float,
+           wetness: float) -> tuple[float, float, float, float]:
     """(r, g, b, texture): the albedo of the grass at road point (s, t) of ``piece`` and a factor of its clumps'
-    strength. ``patch`` and ``wander`` are noise samples (in [-1, 1], filtered) at ``PATCH_TEXEL_M`` over (s, t)
-    and at ``WANDER_TEXEL_M`` along the road; ``stain`` the material's stain noise (weeds in the worn strip)."""
+    strength. ``patch`` is a noise sample (in [-1, 1], filtered) at ``PATCH_TEXEL_M`` (colour variation, damp
+    patches, the straw in the verge and the worn strip's wandering edge); ``stain`` the material's stain noise
+    (weeds in the worn strip)."""
     land = table[piece, LAND]
     side = 1.0 if t >= 0.0 else -1.0
     u = abs(t) - table[piece, INNER_M]
@@ -177,7 +186,7 @@ def ground(table: np.ndarray, piece: int, s: float, t: float, fs: float, ft: flo
     texture = 1.0
     if land == LAWNS:
         rgb = lawn(s, u, fs, ft, salt)
-        edge = box_overlap(u, ft, -1.0, KERB_WEEDS_M * (1.0 + 0.5 * wander))
+        edge = box_overlap(u, ft, -1.0, KERB_WEEDS_M * (1.0 + 0.5 * patch))
         rgb = mix(rgb, mix(DRY, WEEDS, min(max(2.0 * stain, 0.0), 1.0)), edge)
     else:
         verge = VERGE_M[0] + VERGE_M[1] * plot_hash(salt, 11.0, 0.0)
@@ -185,8 +194,8 @@ def ground(table: np.ndarray, piece: int, s: float, t: float, fs: float, ft: flo
         rgb = VERGE
         if in_verge < 1.0:
             rgb = mix(field(s, u - verge, fs, ft, salt), VERGE, in_verge)
-        rgb = mix(rgb, (0.13, 0.125, 0.065), 0.5 * in_verge * min(max(wander, 0.0), 1.0))  # straw in the verge
-        dry = box_overlap(u, ft, -1.0, DRY_M[0] + DRY_M[1] * wander)
+        rgb = mix(rgb, (0.13, 0.125, 0.065), 0.5 * in_verge * min(max(patch, 0.0), 1.0))  # straw in the verge
+        dry = box_overlap(u, ft, -1.0, DRY_M[0] + DRY_M[1] * patch)
         rgb = mix(rgb, mix(DRY, WEEDS, min(max(2.0 * stain, 0.0), 1.0)), dry)
         texture = FIELD_TEXTURE + (1.0 - FIELD_TEXTURE) * in_verge
     tone = (1.0 + PATCH_TONE * patch) * (1.0 - DAMP_DARKENING * min(max(3.0 * (patch - 0.35), 0.0), 1.0)) \

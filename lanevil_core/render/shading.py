@@ -24,7 +24,7 @@ from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
-from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, WANDER_TEXEL_M, ground
+from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
 from .lighting import (
     BEAM_LOW,
     FOOTPRINT_TAP_TEXELS,
@@ -535,9 +535,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             if material == GRASS and ground_rows[vertex_piece[faces[f, 0]], 1] != NO_LAND:  # verges, fields, lawns
                 tone = r / surface[GRASS, ALBEDO_R]
                 r, g, b, rougher = ground(ground_rows, vertex_piece[faces[f, 0]], s, t, fs, ft,
-                                          sample_noise(coarse, PATCH_TEXEL_M, s, t, footprint),
-                                          sample_noise(coarse, WANDER_TEXEL_M, s, 0.0 if t > 0.0 else 97.0, fs),
-                                          stain, wetness)
+                                          sample_noise(coarse, PATCH_TEXEL_M, s, t, footprint), stain, wetness)
                 r, g, b, texture = r * tone, g * tone, b * tone, texture * rougher
             if detail > 0.0:  # tufts, aggregate patches and stains at the scale a camera resolves
                 tone = clumps(detail * texture, sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),

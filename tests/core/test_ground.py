@@ -22,7 +22,7 @@ RURAL = ROOT / "scenes" / "00_clean" / "02_s_curve_rural.json"
 
 def albedo_over(table: np.ndarray, s: np.ndarray, t: np.ndarray, foot: float, wetness: float = 0.0) -> np.ndarray:
     """(n, 3) ground albedo at road points (s, t) of piece 0 with a square footprint ``foot``, no noise."""
-    return np.array([ground(table, 0, float(a), float(b), foot, foot, 0.0, 0.0, 0.0, wetness)[:3]
+    return np.array([ground(table, 0, float(a), float(b), foot, foot, 0.0, 0.0, wetness)[:3]
                      for a, b in zip(s, t, strict=True)])
 
 
