@@ -13,6 +13,7 @@ from lanevil_core.labels.lanes import tusimple_record
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame, renderer
 from lanevil_core.render.ground import FIELDS, INNER_M, LAND, LAWNS, NO_LAND, ground, ground_table
+from lanevil_core.typed import SceneKind
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import ID_ROAD
 
@@ -28,7 +29,7 @@ def albedo_over(table: np.ndarray, s: np.ndarray, t: np.ndarray, foot: float, we
 
 @pytest.mark.parametrize(("kind", "land"), [("rural", FIELDS), ("highway", FIELDS), ("suburban", LAWNS),
                                              ("urban", NO_LAND), ("tunnel_approach", NO_LAND)])
-def test_each_scene_kind_gets_its_land(kind: str, land: float) -> None:
+def test_each_scene_kind_gets_its_land(kind: SceneKind, land: float) -> None:
     case = load_case(RURAL)
     case = case.model_copy(update={"scene": case.scene.model_copy(update={"kind": kind})})
     network = build_network(case.road, kind)
