@@ -57,12 +57,14 @@ def main() -> None:
             for rounds in args.rounds if "self-train" in how else [1]:
                 name = f"{model}-{how}-r{rounds}"
                 folder = args.cache / "models" / name
-                _cli("adapt", "--weights", model, "--frames", str(args.adapt_on), "--out", str(folder),
-                     "--method", how, "--rounds", str(rounds), "--quiet")
+                if not (folder / "training.json").is_file():  # reruns resume
+                    _cli("adapt", "--weights", model, "--frames", str(args.adapt_on), "--out", str(folder),
+                         "--method", how, "--rounds", str(rounds), "--quiet")
                 training = json.loads((folder / "training.json").read_text())
+                family = json.loads((folder / "config.json").read_text())["family"]  # runs as its family
                 rows.append({"model": model, "adapt": how, "rounds": rounds,
-                             "pseudo_labelled": training.get("self_training", {}),
-                             **score(args.score_on, model, ["--weights", str(folder)],
+                             "pseudo_labelled": training.get("self_training", {}).get("pseudo_labelled"),
+                             **score(args.score_on, family, ["--weights", str(folder)],
                                      args.cache / "pred" / f"{name}.json")})
     if args.json:
         print(json.dumps(rows, indent=2))

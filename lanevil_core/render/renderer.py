@@ -20,6 +20,7 @@ from ..world.road_layout import RoadNetwork
 from ..world.scene import ID_EGO, ID_SKY, CompiledScene, Environment
 from .bands import run_bands
 from .develop import NO_STREAKS, Streaks, develop, motion_blur
+from .ground import ground_table
 from .lighting import LIGHT_COLUMNS, face_sun_terms, light_row
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish, glare
@@ -178,7 +179,7 @@ def _road_look(scene: CompiledScene, packed: PackedScene) -> RoadLook:
                     float(scene.network.lanes_per_direction), float(scene.network.lane_width), packed.layers.texels,
                     packed.layers.table, packed.layers.first_level, fine, coarse, packed.overhead,
                     packed.overhead_params, float(packed.stripes[:, PAINT_WEAR].max(initial=0.0)),
-                    scene.paint.wear_shift_m)
+                    scene.paint.wear_shift_m, ground_table(scene.network.pieces))
 
 
 def _sun_terms(scene: CompiledScene, packed: PackedScene) -> np.ndarray:

@@ -26,6 +26,7 @@ from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
 from .facades import cell_hash, facade, footway
+from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
 from .lighting import (
     BEAM_LOW,
     FOOTPRINT_TAP_TEXELS,
@@ -140,6 +141,7 @@ class RoadLook(NamedTuple):
     overhead_params: FloatArray
     paint_wear: float  # the most worn stripe's wear (0: fresh paint everywhere, no chip noise is sampled)
     wear_shift: float  # where along the road worn paint's chip and edge noise starts (m; by the case's seed)
+    ground: FloatArray  # (pieces, 2) ground.ground_table: where each piece's grass begins and what land it is
 
 
 class Lighting(NamedTuple):
@@ -497,7 +499,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
     faces, vertex_st, vertex_piece, grad_st, normal, face_material, color, emission, face_gloss, \
         face_texture, face_finish = geometry
     surface, stripes, stripe_index, lanes, lane_width, texels, table, first, fine, coarse, overhead, \
-        overhead_params, paint_wear, wear_shift = road
+        overhead_params, paint_wear, wear_shift, ground_rows = road
     env_f, sun_dir, sun_color, zenith, horizon, lights, fog_lut, ambient, fog_color, sun = lighting
     maps, cells, shadow_params, R_light, sun_terms = shadow
     refl_rgb, refl_depth = reflection
@@ -559,10 +561,16 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             fs, ft = road_footprint(R, fx, fy, grad_cam, depth, norm, x_cam, y_cam, nx, ny, nz, n_dot_v)
             footprint = max(fs, ft)
             s, t = road_coordinates(faces, vertex_st, bary, row, col, f)
-            r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint),
-                             sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint), detail)
+            stain = sample_noise(coarse, COARSE_TEXEL_M, s * 0.5, t, footprint)
+            r, g, b = albedo(surface, material, sample_noise(fine, FINE_TEXEL_M, s, t, footprint), stain, detail)
+            texture = face_texture[f]
+            if material == GRASS and ground_rows[vertex_piece[faces[f, 0]], 1] != NO_LAND:  # verges, fields, lawns
+                tone = r / surface[GRASS, ALBEDO_R]
+                r, g, b, rougher = ground(ground_rows, vertex_piece[faces[f, 0]], s, t, fs, ft,
+                                          sample_noise(coarse, PATCH_TEXEL_M, s, t, footprint), stain, wetness)
+                r, g, b, texture = r * tone, g * tone, b * tone, texture * rougher
             if detail > 0.0:  # tufts, aggregate patches and stains at the scale a camera resolves
-                tone = clumps(detail * face_texture[f], sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),
+                tone = clumps(detail * texture, sample_noise(fine, CLUMP_TEXEL_M, s + 11.0, t, footprint),
                               sample_noise(fine, MID_TEXEL_M, s, t + 5.0, footprint))
                 r, g, b = r * tone, g * tone, b * tone
             if material == CONCRETE or material == KERB:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..typed import FloatArray
 from . import props
+from .facade import BRICK, RENDER, wall_finish
 from .primitives import merge, pose_on_road, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
@@ -381,7 +382,7 @@ def house_shell(rng: np.random.Generator, width: float) -> Mesh:
     house running back along +Y): its front wall, the front slope of its gable roof and its two gable ends."""
     depth, eaves = float(rng.uniform(7.0, 10.0)), float(rng.uniform(3.0, 6.0))
     ridge = eaves + float(rng.uniform(0.3, 0.5)) * depth
-    wall = np.asarray(props.FACADES[int(rng.integers(len(props.FACADES)))])
+    _, wall = wall_finish(rng, (BRICK, RENDER), (0.5, 0.5))  # far away: the finish's colour, not its courses
     roof = np.asarray(props.ROOFS[int(rng.integers(len(props.ROOFS)))]) * float(rng.uniform(0.8, 1.3))
     gable = [(0.0, -0.5), (depth, -0.5), (depth, eaves), (depth / 2, ridge), (0.0, eaves)]
     vertices = [(x, y, z) for x in (0.0, width) for y, z in gable]  # 0-4 one end, 5-9 the other
