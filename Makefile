@@ -9,7 +9,7 @@ TORCH ?= torch==2.13.0
 # Every extra: the library alone needs none of them (pip install -e . gives cases, renderer, labels, dataset, metrics).
 EXTRAS ?= web,dask,report,learn,test
 
-.PHONY: run preview test lint test-fast test-slow test-browser bench models models-transfer clean
+.PHONY: run preview test lint test-fast test-slow test-browser bench models models-transfer models-world clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -108,6 +108,11 @@ models: $(STAMP)
 # machine (about 8 minutes with 16 cores: WORKERS=15 LOADERS=3 THREADS=2 DEVICE=cuda); hours on two CPU cores.
 models-transfer: $(STAMP)
 	PY=$(PY) scripts/models-transfer
+
+# The five other families fine-tuned on structured worlds, chosen and compared on held-out synthetic splits
+# (docs/learning.md); measured, not shipped. About an hour on two CPU cores.
+models-world: $(STAMP)
+	PY=$(PY) scripts/models-world
 
 bench: $(STAMP)
 	$(PY) -m lanevil_core.cli bench

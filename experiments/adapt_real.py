@@ -61,14 +61,16 @@ def main() -> None:
     for method in args.methods:
         for how in ["shipped", *args.adapt]:
             weights: list[str] = []
+            runs_as = method
             if how != "shipped":
                 model = args.cache / "adapted" / f"{method}-{how}"
                 _cli("adapt", "--weights", method, "--frames", str(frames), "--out", str(model), "--method", how,
                      "--quiet")
                 weights = ["--weights", str(model)]
+                runs_as = json.loads((model / "config.json").read_text())["family"]  # a bundled model's family
             pred = args.cache / "pred" / f"adapt_{method}_{how}.json"
             pred.parent.mkdir(parents=True, exist_ok=True)
-            _cli("detect", str(split), "--method", method, *weights, "--out", str(pred))
+            _cli("detect", str(split), "--method", runs_as, *weights, "--out", str(pred))
             result = evaluate(split, pred, "ego")
             rows.append({"method": method, "model": how, "share": result["match_share"],
                          "point_accuracy": result["point_accuracy"], "per_clip": clip_shares(split, pred)})
