@@ -62,6 +62,7 @@ MODELS_DATA ?= out/models-data
 MODELS_DATA_VARIED ?= out/models-data-v
 MODELS_DATA_VARIED2 ?= out/models-data-v2
 MODELS_TRAIN ?= out/models-train
+MODELS_DATA_WORLD ?= out/models-data-w
 NEW_FAMILIES ?= laneatt bezier ganet scnn
 SHIPPED := lanevil_core/detect/models
 models: $(STAMP)
@@ -71,6 +72,8 @@ models: $(STAMP)
 	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA_VARIED2) --train-frames 4000 --size 640x360 \
 	  --vary-camera --seed 1
 	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_TRAIN) --train-frames 40000 --format jpg --workers 2
+	$(PY) -m app.cli dataset --cases scenes/00_clean --out $(MODELS_DATA_WORLD) --train-frames 2000 --size 640x360 \
+	  --seed 11
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ufld-base --model ufld --epochs 12
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/seg-base --model seg --epochs 10
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ufld-v --model ufld --epochs 6 \
@@ -89,16 +92,20 @@ models: $(STAMP)
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/laneatt-base --model laneatt --epochs 6
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/ganet-base --model ganet --epochs 10
 	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier-base --model bezier --epochs 6
-	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier --model bezier --epochs 10 --lr 1e-3 \
+	$(PY) -m app.cli train --data $(MODELS_DATA) --out out/models/bezier-v --model bezier --epochs 10 --lr 1e-3 \
 	  --threads 1 --init out/models/bezier-base/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_WORLD) --out out/models/bezier --model bezier --epochs 2 --lr 5e-4 \
+	  --threads 1 --init out/models/bezier-v/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/ganet-v --model ganet --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/ganet-base/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED2) --out out/models/ganet --model ganet --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/ganet-v/weights.pt
 	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt-v --model laneatt --epochs 5 --lr 1e-3 \
 	  --threads 1 --init out/models/laneatt-base/weights.pt
-	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt --model laneatt --epochs 8 --lr 1e-3 \
-	  --threads 1 --init out/models/laneatt-v/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_VARIED) --out out/models/laneatt-v2 --model laneatt --epochs 8 \
+	  --lr 1e-3 --threads 1 --init out/models/laneatt-v/weights.pt
+	$(PY) -m app.cli train --data $(MODELS_DATA_WORLD) --out out/models/laneatt --model laneatt --epochs 2 \
+	  --lr 5e-4 --threads 1 --init out/models/laneatt-v2/weights.pt
 	for family in ufld seg $(NEW_FAMILIES); do mkdir -p $(SHIPPED)/$$family && \
 	  cp out/models/$$family/config.json out/models/$$family/model.onnx out/models/$$family/training.json \
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
