@@ -31,7 +31,8 @@ def test_same_case_gives_the_same_backdrop_and_the_seed_changes_it() -> None:
     _, c = backdrop("rural", "bend", seed=4)
     assert [m.name for m in a] == [m.name for m in b]
     for field in ("vertices", "faces", "colors"):
-        np.testing.assert_array_equal(*(np.concatenate([getattr(m, field) for m in x]) for x in (a, b)))
+        joined_a, joined_b = (np.concatenate([getattr(m, field) for m in x]) for x in (a, b))
+        np.testing.assert_array_equal(joined_a, joined_b)
     hills_a = next(m for m in a if m.name == "near hills")
     hills_c = next(m for m in c if m.name == "near hills")
     assert not np.array_equal(hills_a.vertices, hills_c.vertices)
