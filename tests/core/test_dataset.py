@@ -216,10 +216,12 @@ def test_frames_from_other_settings_are_not_reused(dataset: Path, cases_dir: Pat
     out = tmp_path / "resized"
     shutil.copytree(dataset, out)
     assert run_cli("--cases", str(cases_dir), "--out", str(out), "--workers", "1", "--size", "128x72",
-                   "--frames-per-case", "1", "--quiet") == 0
+                   "--frames-per-case", "1", "--sampling", "even", "--quiet") == 0
     line = capsys.readouterr().out
     assert "(3 rendered, 0 kept); rendering " in line and " frames/s; total wall time " in line
-    with Image.open(out / "test/Shadow/Fence/00_uphill_rural_noon/00_original/000000.png") as image:
+    labels = json.loads((out / "test/Shadow/Fence/00_uphill_rural_noon/00_original/labels.json").read_text())
+    (record,) = labels if isinstance(labels, list) else [labels]
+    with Image.open(out / "test" / record["raw_file"]) as image:  # the one frame this run wrote for the case
         assert image.size == (128, 72)
     manifest = json.loads((out / "manifest.json").read_text())
     assert [entry["split"] for entry in manifest["cases"]] == ["test"] * 3
