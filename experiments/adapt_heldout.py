@@ -20,6 +20,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from lanevil_core.detect.model_spec import ModelSpec
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -61,7 +63,7 @@ def main() -> None:
                     _cli("adapt", "--weights", model, "--frames", str(args.adapt_on), "--out", str(folder),
                          "--method", how, "--rounds", str(rounds), "--quiet")
                 training = json.loads((folder / "training.json").read_text())
-                family = json.loads((folder / "config.json").read_text())["family"]  # runs as its family
+                family = ModelSpec.load(folder).family  # runs as its family
                 rows.append({"model": model, "adapt": how, "rounds": rounds,
                              "pseudo_labelled": training.get("self_training", {}).get("pseudo_labelled"),
                              **score(args.score_on, family, ["--weights", str(folder)],

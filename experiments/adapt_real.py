@@ -23,6 +23,8 @@ from pathlib import Path
 import cv2
 from real_footage import PACKAGE, WHEEL, _video_frames, clip_shares
 
+from lanevil_core.detect.model_spec import ModelSpec
+
 ROOT = Path(__file__).resolve().parents[1]
 ADAPT_CLIP = "test_videos/project_video03.mp4"
 CLIP_FRAMES = 1260
@@ -67,7 +69,7 @@ def main() -> None:
                 _cli("adapt", "--weights", method, "--frames", str(frames), "--out", str(model), "--method", how,
                      "--quiet")
                 weights = ["--weights", str(model)]
-                runs_as = json.loads((model / "config.json").read_text())["family"]  # a bundled model's family
+                runs_as = ModelSpec.load(model).family  # a bundled model's family
             pred = args.cache / "pred" / f"adapt_{method}_{how}.json"
             pred.parent.mkdir(parents=True, exist_ok=True)
             _cli("detect", str(split), "--method", runs_as, *weights, "--out", str(pred))
