@@ -18,10 +18,11 @@ import numpy as np
 from ..typed import FloatArray
 from . import props
 from .facade import BRICK, RENDER, wall_finish
-from .primitives import merge, pose_on_road, transformed
+from .primitives import merge, pick, pose_on_road, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
 from .scenery import Clearance, RoadsideInputs, corridor_half_width, ground_h, own_rng
+from .vegetation import LEAVES
 
 MAX_HILL_ELEVATION_DEG = 3.0  # the distant hills' crest seen from any point of the road, 1.5 m above it
 HILL_MARGIN_M = 350.0  # the nearest ring of hills stands this far beyond the farthest road point from its centre
@@ -205,7 +206,7 @@ def canopy(base: FloatArray, back: FloatArray, crowns: FloatArray, rng: np.rando
     n = len(base)
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(base[:, :2], axis=0), axis=1))])
     top, bulge = crowns * np.clip(np.minimum(along, along[-1] - along) / TAPER_M, 0.3, 1.0) ** 0.5
-    green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
+    green = pick(rng, LEAVES)
     levels = [(0.3 * top, 0.15 * top), (0.68 * top, 0.25 * top - 0.8 * bulge), (top, 0.25 * top)]
     levels = [(h, lean + rng.uniform(-0.02, 0.02, n) * top) for h, lean in levels]
     tone = smooth_tone(along, rng, 40.0, 0.25)
@@ -383,7 +384,7 @@ def house_shell(rng: np.random.Generator, width: float) -> Mesh:
     depth, eaves = float(rng.uniform(7.0, 10.0)), float(rng.uniform(3.0, 6.0))
     ridge = eaves + float(rng.uniform(0.3, 0.5)) * depth
     _, wall = wall_finish(rng, (BRICK, RENDER), (0.5, 0.5))  # far away: the finish's colour, not its courses
-    roof = np.asarray(props.ROOFS[int(rng.integers(len(props.ROOFS)))]) * float(rng.uniform(0.8, 1.3))
+    roof = pick(rng, props.ROOFS) * float(rng.uniform(0.8, 1.3))
     gable = [(0.0, -0.5), (depth, -0.5), (depth, eaves), (depth / 2, ridge), (0.0, eaves)]
     vertices = [(x, y, z) for x in (0.0, width) for y, z in gable]  # 0-4 one end, 5-9 the other
     faces = [(0, 5, 9), (0, 9, 4), (4, 9, 8), (4, 8, 3)]  # the front wall, the roof's front slope
@@ -404,7 +405,7 @@ def crown_lump(rng: np.random.Generator, width: float) -> Mesh:
             for a in np.arange(4) * np.pi / 2 + float(rng.uniform(0.0, 0.8))]
     vertices = np.array([*ring, (r, 0.0, h), (r, 0.0, 2.0)])
     faces = [(k, (k + 1) % 4, 4) for k in range(4)] + [((k + 1) % 4, k, 5) for k in range(4)]
-    green = np.asarray(props.LEAVES[int(rng.integers(len(props.LEAVES)))])
+    green = pick(rng, LEAVES)
     colors = (green * rng.uniform(0.75, 1.25, (8, 1))).astype(np.float32)
     return Mesh(vertices, np.array(faces), colors, name="garden tree behind", kind="tree")
 

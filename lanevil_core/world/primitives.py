@@ -21,6 +21,11 @@ ColorLike = Sequence[float] | np.ndarray
 PointsLike = npt.ArrayLike  # (n, k) coordinates: nested sequences or an array
 
 
+def pick(rng: np.random.Generator, palette: Sequence[ColorLike]) -> FloatArray:
+    """(3,) float64 colour of ``palette`` drawn uniformly by ``rng`` (one ``rng.integers`` draw)."""
+    return np.asarray(palette[int(rng.integers(len(palette)))], np.float64)
+
+
 def to_mesh(
     tm: trimesh.Trimesh,
     color: ColorLike,

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..typed import FloatArray, SceneKind
-from . import props
+from . import props, vegetation
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh, PointLight
@@ -25,7 +25,7 @@ TUNNEL_HEIGHT_M = 6.0
 ROW_RETRY_STEP_M = 3.0
 NEAR_PLANT_M = 18.0  # trees and bushes farther than this from the main road's centre line, or from the stretch
 NEAR_AHEAD_M = 60.0  # the ego drives (this far beyond its end), are only ever seen from afar: built with less
-# detail (``props.FAR_DETAIL``)
+# detail (``vegetation.FAR_DETAIL``)
 
 
 @dataclass(frozen=True)
@@ -194,11 +194,11 @@ def plant(rng: np.random.Generator, bush_share: float,
     own = own_rng(rng)
     if rng.random() < bush_share:
         radius = float(rng.uniform(0.6, 1.3))
-        return 1.2 * radius, lambda near: props.bush(own, radius=radius, near=near)
+        return 1.2 * radius, lambda near: vegetation.bush(own, radius=radius, near=near)
     conifer = bool(rng.random() < conifer_share)
     height = float(rng.uniform(5.0, 11.0))
-    return (0.23 if conifer else 0.43) * height, lambda near: props.tree(own, conifer=conifer, height=height,
-                                                                         near=near)
+    return (0.23 if conifer else 0.43) * height, lambda near: vegetation.tree(own, conifer=conifer, height=height,
+                                                                              near=near)
 
 
 def near_the_drive(inputs: RoadsideInputs, clear: Clearance, spot: Spot) -> bool:

@@ -1,4 +1,4 @@
-"""Props: real dimensions, resting on the ground, faces wound outwards, deterministic, renderable arrays."""
+"""Props and vegetation: real dimensions, resting on the ground, faces wound outwards, deterministic, renderable."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Road
-from lanevil_core.world import facade, props
+from lanevil_core.world import facade, props, vegetation
 from lanevil_core.world.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
@@ -117,13 +117,13 @@ def test_pedestrian_colours_come_from_rng_or_arguments() -> None:
 def test_trees_and_bushes_stand_on_the_ground() -> None:
     for seed in range(6):
         for conifer in (True, False):
-            tree = props.tree(RNG(seed), conifer=conifer)
+            tree = vegetation.tree(RNG(seed), conifer=conifer)
             assert_renderable(tree)
             assert 4.0 < extents(tree)[2] < 15.0  # a poplar grows taller than the drawn height
             assert -0.4 < tree.vertices[:, 2].min() <= 0.0
-        shrub = props.bush(RNG(seed))
+        shrub = vegetation.bush(RNG(seed))
         assert extents(shrub)[2] < 2.0 and shrub.vertices[:, 2].min() < 0.05
-    tree = props.tree(RNG(0), height=8.0, conifer=False)
+    tree = vegetation.tree(RNG(0), height=8.0, conifer=False)
     assert abs(tree.vertices[:, 2].max() - 8.0) < 1.5
 
 
@@ -208,7 +208,7 @@ def test_tunnel_portal_keeps_its_opening_clear() -> None:
 
 
 def test_props_are_deterministic() -> None:
-    for build in (props.tree, props.bush, props.pedestrian, props.bicycle_with_rider, props.house):
+    for build in (vegetation.tree, vegetation.bush, props.pedestrian, props.bicycle_with_rider, props.house):
         a, b = build(RNG(7)), build(RNG(7))
         np.testing.assert_array_equal(a.vertices, b.vertices)
         np.testing.assert_array_equal(a.colors, b.colors)
