@@ -7,14 +7,15 @@ to its mean as the footprint grows past the unit, so a wall far away is its mean
 
 Numbers, from building practice: bricks 215 x 65 mm laid in 10 mm mortar (courses of 75 mm, stretchers 225 mm,
 stretcher bond: each course shifted half a brick); precast panels 2.4 m wide and half a storey high with 20 mm
-sealed joints; paving flags 600 x 600 mm with sand joints that dirt widens to 15 mm; kerb stones 915 mm long.
+sealed joints; paving flags 600 x 600 mm with sand joints that dirt widens to 15 mm; kerb stones 915 mm long;
+interlocking concrete roof tiles about 420 x 330 mm laid at a 345 mm gauge (about 300 mm cover across), broken bond.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..world.facade import BRICK, GLASS, PANE_HEIGHT_M, PANELS, SHOP_GLASS, TRANSOM_M
+from ..world.facade import BRICK, GLASS, PANE_HEIGHT_M, PANELS, SHOP_GLASS, TILES, TRANSOM_M
 from ._jit import kernel
 from .surface import dash_coverage
 
@@ -48,6 +49,13 @@ FLAG_JOINT_M = 0.015
 FLAG_TONE = 0.09
 KERB_STONE_M = 0.915
 KERB_JOINT_M = 0.008
+TILE_GAUGE_M = 0.345  # a roof's courses up the slope
+TILE_COVER_M = 0.30  # a tile's width across the slope; each course shifted half a tile
+TILE_BUTT_M = 0.035  # the shadow a course's butt (lower edge) casts on the course below
+TILE_SIDE_M = 0.01  # the interlock between neighbours in a course
+TILE_SHADE = 0.35  # the butt's shadow and the interlock keep this share of the tile's albedo
+TILE_TONE = 0.14  # each tile's albedo differs by up to this share (weathered, replaced)
+ROOF_STAIN_DEPTH = 0.25  # moss and lichen in broad patches (noise in [-1, 1]), deeper than on a wall
 
 
 @kernel(inline="always")
@@ -108,6 +116,23 @@ def panel_wall(u: float, v: float, fu: float, fv: float, r: float, g: float,
 
 
 @kernel(inline="always")
+def roof_tiles(u: float, v: float, fu: float, fv: float, r: float, g: float,
+               b: float) -> tuple[float, float, float]:
+    """Courses of roof tiles of colour (r, g, b) laid up the slope (u along the eaves, v up from them), footprint
+    (fu, fv): each course's butt shades the one below, neighbours interlock, every tile its own tone."""
+    course = np.floor(v / TILE_GAUGE_M)
+    across = u + 0.5 * TILE_COVER_M * (course - 2.0 * np.floor(0.5 * course))
+    butt = lines(v + 0.5 * TILE_BUTT_M, fv, TILE_BUTT_M, TILE_GAUGE_M)
+    side = lines(across + 0.5 * TILE_SIDE_M, fu, TILE_SIDE_M, TILE_COVER_M)
+    blur = min(fv / TILE_GAUGE_M, 1.0)  # a footprint over several courses sees their interlocks' mean
+    side = side * (1.0 - blur) + TILE_SIDE_M / TILE_COVER_M * blur
+    fade = max(1.0 - 2.0 * fv / TILE_GAUGE_M, 0.0) * max(1.0 - fu / TILE_COVER_M, 0.0)
+    tone = 1.0 + TILE_TONE * fade * cell_hash(course + 31.0, np.floor(across / TILE_COVER_M))
+    dark = TILE_SHADE * tone
+    return joints_over(r, g, b, butt + (1.0 - butt) * side, tone, r * dark, g * dark, b * dark)
+
+
+@kernel(inline="always")
 def weathered(v: float, stain: float, streak: float) -> float:
     """Albedo factor of a wall's weathering at height ``v``: broad stains, streaks run down from the sills (both
     noise in [-1, 1]) and the splash-back at its foot."""
@@ -146,6 +171,10 @@ def facade(finish: int, u: float, v: float, fu: float, fv: float, stain: float, 
     (fu, fv): its structure, then the weathering of walls (``stain``, ``streak``: noise in [-1, 1])."""
     if finish == GLASS or finish == SHOP_GLASS:
         return glazing(finish, u, v, fu, fv, r, g, b)
+    if finish == TILES:  # a roof: moss and lichen in patches, no sills to streak it
+        r, g, b = roof_tiles(u, v, fu, fv, r, g, b)
+        moss = 1.0 + ROOF_STAIN_DEPTH * stain
+        return r * moss, g * moss, b * moss, 0.0
     if finish == BRICK:
         r, g, b = brick_wall(u, v, fu, fv, r, g, b)
     elif finish == PANELS:

@@ -100,8 +100,8 @@ def _mirror_pass(packed: PackedScene, scene: CompiledScene, camera: PinholeCamer
                                   env.sky_horizon.astype(np.float64))
     view = View(camera.R_world_camera, camera.p_world_camera, k.fx, k.fy, k.cx, k.cy)
     run_bands(lambda band, bands: shade_mirror(frags.face, frags.depth, packed.face_color, packed.face_emission,
-                                               packed.face_normal, view, env.sun_dir_world, sun_color, env_f,
-                                               zenith, horizon, spill, img, band, bands), threads)
+                                               packed.face_normal, packed.face_finish, view, env.sun_dir_world,
+                                               sun_color, env_f, zenith, horizon, spill, img, band, bands), threads)
     blur_columns(img, frags.depth, max(1, round(MIRROR_BLUR_PX_AT_1280 * k.width / 1280)), threads)
     return img, frags.depth
 

@@ -22,10 +22,12 @@ import numpy as np
 
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
 from ..world.facade import GLASS as GLASS_FINISH
+from ..world.facade import LEAVES as LEAVES_FINISH
 from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
 from .facades import cell_hash, facade, footway
+from .foliage import leaf_cosine, leaf_sky, leaf_transmission
 from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
 from .lighting import (
     BEAM_LOW,
@@ -57,6 +59,7 @@ ASPHALT = MATERIALS.index("asphalt")
 SLAB = MATERIALS.index("slab")
 CONCRETE = MATERIALS.index("concrete")  # footways: paving flags
 KERB = MATERIALS.index("kerb")
+MIN_SLOPE_SINE = 0.2  # a facade coordinate's footprint up a face no flatter than this (12 deg roofs and steeper)
 PAVED = ("asphalt", "concrete", "kerb", "slab")  # hold a water film; grass, gravel and dirt soak it up
 # surface_table columns; its rows are the road MATERIALS, then one for every object
 ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0, GRAIN = range(8)
@@ -286,10 +289,10 @@ def pixel_steps(R_world_camera: np.ndarray, fx: float, fy: float, depth: float, 
 
 
 @kernel(inline="always")
-def facade_footprint(du: tuple[float, float, float], dv: tuple[float, float, float], nx: float,
-                     ny: float) -> tuple[float, float]:
-    """(fu, fv): how far the pixel's footprint (world steps du, dv on the face's plane) reaches along a wall (the
-    horizontal in the face's plane) and up it."""
+def facade_footprint(du: tuple[float, float, float], dv: tuple[float, float, float], nx: float, ny: float,
+                     nz: float) -> tuple[float, float]:
+    """(fu, fv): how far the pixel's footprint (world steps du, dv on the face's plane) reaches along a wall or
+    roof (the horizontal in the face's plane) and up it (up a roof's slope: its rise over the slope's sine)."""
     hx, hy = -ny, nx
     h = np.sqrt(hx * hx + hy * hy)
     if h > 1e-6:
@@ -297,7 +300,7 @@ def facade_footprint(du: tuple[float, float, float], dv: tuple[float, float, flo
     else:  # a horizontal face: "along" is any horizontal, x
         hx, hy = 1.0, 0.0
     fu = abs(du[0] * hx + du[1] * hy) + abs(dv[0] * hx + dv[1] * hy)
-    fv = abs(du[2]) + abs(dv[2])
+    fv = (abs(du[2]) + abs(dv[2])) / max(np.sqrt(max(1.0 - nz * nz, 0.0)), MIN_SLOPE_SINE)
     return min(FOOTPRINT_SCALE * fu + 1e-3, MAX_FOOTPRINT_M), min(FOOTPRINT_SCALE * fv + 1e-3, MAX_FOOTPRINT_M)
 
 
@@ -554,6 +557,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         glass = 0.0  # the share of the pixel that is window glass (a mirror)
         glow = 1.0  # the share of the face's emission the pixel shows: a lit window's bars hide its light
         up = 0.6 + 0.4 * nz
+        leafy = False  # a crown's face, lit as a volume of leaves (``foliage``)
         if material >= 0:
             if f != grad_face:
                 grad_cam = gradients_camera(R, grad_st, f)
@@ -607,10 +611,13 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             r, g, b = color[f, 0], color[f, 1], color[f, 2]
             texture = face_texture[f]
             finish = face_finish[f]
-            if finish > 0:  # brick, render, panels, window glass: drawn in facade coordinates over the footprint
+            leafy = finish == LEAVES_FINISH
+            if leafy:
+                up = leaf_sky(nz)
+            elif finish > 0:  # brick, render, panels, window glass: drawn in facade coordinates over the footprint
                 u, v = road_coordinates(faces, vertex_st, bary, row, col, f)
                 du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
-                fu, fv = facade_footprint(du, dv, nx, ny)
+                fu, fv = facade_footprint(du, dv, nx, ny, nz)
                 r, g, b, glass = facade(finish, u, v, fu, fv,
                                         sample_noise(coarse, STAIN_TEXEL_M, u * 0.5 + 19.0, v, max(fu, fv)),
                                         sample_noise(coarse, STREAK_TEXEL_M, u * STREAK_STRETCH, v * 0.1 + 7.0,
@@ -630,6 +637,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         shiny = surface_wet + gloss
         fresnel = fresnel_schlick(n_dot_v, max(surface[kind, F0], gloss * 0.08))
         n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
+        through = 0.0  # the share of the sun seen through a crown's leaves
+        if leafy:
+            through = leaf_transmission(n_dot_l)
+            n_dot_l = leaf_cosine(n_dot_l)
         direct = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if sun_i > 0.0 and n_dot_l > 0.0:
             # The ideal render reads the point; a photograph filters over the pixel's footprint, unless no side of
@@ -644,6 +655,9 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
                 vis = sun_visibility(px, py, pz, nx, ny, nz, sun_terms[f, SUN_OFFSET], sun_terms[f, SUN_BIAS], maps,
                                      cells, shadow_params, R_light, penumbra)
             direct = sun_lit(sun_dir, sun, vis, n_dot_l, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny)
+        if through > 0.0 and sun_i > 0.0:
+            direct = (direct[0] + sun[0] * through, direct[1] + sun[1] * through, direct[2] + sun[2] * through,
+                      direct[3], direct[4], direct[5])
         retro = RETROREFLECTION * (1.0 - WET_RETRO_LOSS * surface_wet) if material >= 0 else 0.0
         lamps = lamp_light(lights, px, py, pz, nx, ny, nz, dx, dy, dz, roughness, fresnel, shiny, retro)
         r, g, b = shade_lit((r, g, b), ambient, up, emission, f, glow, direct, lamps)
@@ -673,9 +687,9 @@ def shade(face: np.ndarray, depth: np.ndarray, bary: np.ndarray, view: View, geo
 
 @kernel
 def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.ndarray, face_emission: np.ndarray,
-                 face_normal: np.ndarray, view: View, sun_dir: np.ndarray, sun_color: np.ndarray, env_f: np.ndarray,
-                 zenith: np.ndarray, horizon: np.ndarray, lamp_spill: float, out: np.ndarray, band: int,
-                 bands: int) -> None:
+                 face_normal: np.ndarray, face_finish: np.ndarray, view: View, sun_dir: np.ndarray,
+                 sun_color: np.ndarray, env_f: np.ndarray, zenith: np.ndarray, horizon: np.ndarray, lamp_spill: float,
+                 out: np.ndarray, band: int, bands: int) -> None:
     """Shade the mirrored objects of one row band (no shadows): what a wet road reflects.
 
     A pixel sees the real object from the camera mirrored below the ground, along its ray with z flipped: each
@@ -692,8 +706,12 @@ def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.nda
                 continue
             dx, dy, dz, _ = pixel_ray(R, (col + 0.5 - view.cx) / view.fx, y_cam)
             nx, ny, nz, _ = facing_normal(face_normal, f, dx, dy, -dz)
-            n_dot_l = max(nx * sun_x + ny * sun_y + nz * sun_z, 0.0)
+            n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
             up = 0.6 + 0.4 * nz
+            if face_finish[f] == LEAVES_FINISH:  # a crown: lit as a volume of leaves, as ``shade_row`` lights it
+                up = leaf_sky(nz)
+                n_dot_l = leaf_cosine(n_dot_l) + leaf_transmission(n_dot_l)
+            n_dot_l = max(n_dot_l, 0.0)
             for c in range(3):
                 amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * SKY_AMBIENT_GAIN * up + lamp_spill
                 out[row, col, c] = face_color[f, c] * (SUN_SCALE * env_f[SUN_I] * sun_color[c] * n_dot_l + amb) \

@@ -18,7 +18,8 @@ import numpy as np
 from ..typed import FloatArray
 from . import props
 from .facade import BRICK, RENDER, wall_finish
-from .primitives import merge, pick, pose_on_road, transformed
+from .facade import LEAVES as LEAVES_FINISH
+from .primitives import merge, pick, pose_on_road, transformed, with_finish
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
 from .scenery import Clearance, RoadsideInputs, corridor_half_width, ground_h, own_rng
@@ -36,7 +37,8 @@ FOREST = ((0.05, 0.085, 0.035), (0.065, 0.1, 0.04), (0.045, 0.075, 0.04), (0.07,
 FIELDS = ((0.11, 0.13, 0.05), (0.16, 0.14, 0.07), (0.08, 0.11, 0.04), (0.13, 0.12, 0.06))
 UNDERSTOREY = 0.45  # the shade under a forest edge's canopy, as a share of its leaves' colour
 CANOPY_SHADES = (UNDERSTOREY, 1.0, 1.05)  # understorey, crowns, their tops
-CROWN_DOME = 0.6  # a crown's dome: its height over its radius
+CROWN_DOME = 0.9  # a crown's dome: its height over its radius
+NEIGHBOUR_SPREAD = (0.9, 1.05)  # a crown's height over its stand's: a ragged top, no cliff between neighbours
 EMERGENT_SHARE = 0.1  # the crowns that rise well above their neighbours
 TAPER_M = 12.0  # a line of vegetation thins out over this length at its ends
 DRIVE_AHEAD_M = 600.0  # tree lines stand along the main road from behind the ego's start to this far beyond its end
@@ -175,12 +177,13 @@ def crown_tops(s: FloatArray, rng: np.random.Generator, height: tuple[float, flo
     top = np.zeros_like(s)
     bulge = np.zeros_like(s)
     c = float(s[0]) - crown[1]
+    stand = float(rng.uniform(*height))  # one stand's height: neighbours differ by a tenth, not by the whole range
     groves = smooth_tone(s, rng, 70.0, 0.2)  # stands of taller and lower trees
     while c < s[-1] + crown[1]:
         r = float(rng.uniform(*crown))
-        h = float(rng.uniform(*height)) * float(np.interp(c, s, groves))
+        h = stand * float(rng.uniform(*NEIGHBOUR_SPREAD)) * float(np.interp(c, s, groves))
         if rng.random() < EMERGENT_SHARE:  # a tree standing out of the mass
-            h *= 1.2
+            h *= 1.12
         inside = np.flatnonzero(np.abs(s - c) < r)
         round_ = r * np.sqrt(1.0 - ((s[inside] - c) / r) ** 2)
         dome = h + CROWN_DOME * (round_ - r)
@@ -207,12 +210,12 @@ def canopy(base: FloatArray, back: FloatArray, crowns: FloatArray, rng: np.rando
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(base[:, :2], axis=0), axis=1))])
     top, bulge = crowns * np.clip(np.minimum(along, along[-1] - along) / TAPER_M, 0.3, 1.0) ** 0.5
     green = pick(rng, LEAVES)
-    levels = [(0.3 * top, 0.15 * top), (0.68 * top, 0.25 * top - 0.8 * bulge), (top, 0.25 * top)]
+    levels = [(0.3 * top, 0.15 * top), (0.68 * top, 0.25 * top - 0.4 * bulge), (top, 0.25 * top)]
     levels = [(h, lean + rng.uniform(-0.02, 0.02, n) * top) for h, lean in levels]
     tone = smooth_tone(along, rng, 40.0, 0.25)
     faces_tone = np.tile(0.5 * (tone[:-1] + tone[1:]), 2)[:, None] * rng.uniform(0.92, 1.08, (2 * (n - 1), 1))
     colors = [green * faces_tone * shade for shade in CANOPY_SHADES]
-    return layered(base, back, levels, colors, name, "tree")
+    return with_finish(layered(base, back, levels, colors, name, "tree"), LEAVES_FINISH)
 
 
 def layered(base: FloatArray, back: FloatArray, levels: list[tuple[FloatArray, FloatArray]],
@@ -407,7 +410,7 @@ def crown_lump(rng: np.random.Generator, width: float) -> Mesh:
     faces = [(k, (k + 1) % 4, 4) for k in range(4)] + [((k + 1) % 4, k, 5) for k in range(4)]
     green = pick(rng, LEAVES)
     colors = (green * rng.uniform(0.75, 1.25, (8, 1))).astype(np.float32)
-    return Mesh(vertices, np.array(faces), colors, name="garden tree behind", kind="tree")
+    return with_finish(Mesh(vertices, np.array(faces), colors, name="garden tree behind", kind="tree"), LEAVES_FINISH)
 
 
 RIDGE_HALF_LENGTH_M = 900.0  # the ridge a tunnel enters runs this far to both sides of the road

@@ -19,9 +19,12 @@ import numpy as np
 
 from ..typed import FloatArray
 
-Finish = Literal["plain", "brick", "render", "panels", "glass", "shop_glass"]
-FINISHES: tuple[Finish, ...] = ("plain", "brick", "render", "panels", "glass", "shop_glass")
-PLAIN, BRICK, RENDER, PANELS, GLASS, SHOP_GLASS = range(len(FINISHES))  # the glass finishes last
+Finish = Literal["plain", "brick", "render", "panels", "tiles", "leaves", "glass", "shop_glass"]
+FINISHES: tuple[Finish, ...] = ("plain", "brick", "render", "panels", "tiles", "leaves", "glass", "shop_glass")
+PLAIN, BRICK, RENDER, PANELS, TILES, LEAVES, GLASS, SHOP_GLASS = range(len(FINISHES))  # the glass finishes last
+# ``TILES`` is a pitched roof's covering (u along the eaves, v up the slope from them). ``LEAVES`` is not a building
+# at all: it marks the faces of a crown, hedge or forest edge, which the renderer lights as a volume of leaves
+# (``render/foliage.py``) and draws no structure over.
 
 PANE_HEIGHT_M = 1.6  # a window pane's height; its transom bar lies TRANSOM_M above its foot
 TRANSOM_M = 1.12

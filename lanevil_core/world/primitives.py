@@ -6,6 +6,7 @@ with ``transformed(mesh, pose_on_road(line, s, t, yaw))``.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from functools import lru_cache
 
@@ -19,6 +20,13 @@ from .scene import Mesh
 
 ColorLike = Sequence[float] | np.ndarray
 PointsLike = npt.ArrayLike  # (n, k) coordinates: nested sequences or an array
+
+
+def with_finish(mesh: Mesh, finish: int) -> Mesh:
+    """``mesh`` with every face of ``finish`` (a ``facade.FINISHES`` index that needs no facade coordinates, such
+    as ``LEAVES``)."""
+    return dataclasses.replace(mesh, finish=np.full(len(mesh.faces), finish, np.int8),
+                               uv=np.zeros((len(mesh.vertices), 2), np.float32))
 
 
 def pick(rng: np.random.Generator, palette: Sequence[ColorLike]) -> FloatArray:

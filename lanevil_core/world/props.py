@@ -23,6 +23,7 @@ from .facade import (
     RENDER,
     SHOP_AWNING_SHARE,
     SHOP_GLASS,
+    TILES,
     wall_finish,
 )
 from .facade import GLASS as GLASS_FINISH
@@ -537,6 +538,21 @@ def _grid_columns(span: float, pitch: float) -> tuple[FloatArray, int, float]:
     return centres.astype(np.float64), columns, min(0.7, 0.3 * span / columns)
 
 
+def gable_roof(half_length: float, half_span: float, eaves: float, rise: float, color: ColorLike) -> Mesh:
+    """A gable roof (local frame: the ridge along X over the origin, ``half_length`` to both ends, the eaves
+    ``half_span`` to both sides at height ``eaves``, the ridge ``rise`` above them): its two slopes tiled (finish
+    ``TILES``: u along the eaves, v up the slope from them), its soffit and gable ends plain."""
+    roof = prism([(-half_span, eaves), (half_span, eaves), (0.0, eaves + rise)], -half_length, half_length, color,
+                 axis="x")
+    up_slope = np.where(roof.vertices[:, 2] > eaves + 1e-6, float(np.hypot(half_span, rise)), 0.0)
+    p = roof.vertices[roof.faces]
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    nz = normal[:, 2] / np.linalg.norm(normal, axis=1)
+    roof.finish = np.where((np.abs(nz) > 0.1) & (np.abs(nz) < 0.999), TILES, PLAIN).astype(np.int8)
+    roof.uv = np.column_stack([roof.vertices[:, 0], up_slope]).astype(np.float32)
+    return roof
+
+
 def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, storeys: int | None = None,
           lit: bool = False, name: str = "house") -> Mesh:
     """A detached house: walls, a gable roof (ridge along X), windows all round and a door on the +Y front;
@@ -547,8 +563,7 @@ def house(rng: np.random.Generator, width: float = 10.0, depth: float = 8.0, *, 
     finish, wall = wall_finish(rng, (BRICK, RENDER), (0.5, 0.5))
     roof_h = float(rng.uniform(0.3, 0.45)) * depth
     parts = [_walls(width, depth, wall_h, wall, finish, footing=0.3),
-             prism([(-hy - 0.4, wall_h - 0.05), (hy + 0.4, wall_h - 0.05), (0.0, wall_h + roof_h)],
-                   -hx - 0.3, hx + 0.3, pick(rng, ROOFS), axis="x")]
+             gable_roof(hx + 0.3, hy + 0.4, wall_h - 0.05, roof_h + 0.05, pick(rng, ROOFS))]
     glass = np.asarray(GLASS) * 2.0
     pitch = float(rng.uniform(2.8, 3.6))
     panes = []

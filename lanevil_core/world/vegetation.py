@@ -17,7 +17,8 @@ import numpy as np
 import trimesh
 
 from ..typed import FloatArray, IntArray
-from .primitives import ColorLike, loft, merge, pick, to_mesh
+from .facade import LEAVES as LEAVES_FINISH
+from .primitives import ColorLike, loft, merge, pick, to_mesh, with_finish
 from .scene import Mesh
 
 # Linear albedos: the bark of most trees, and the greens of broadleaf leaves, spruce needles, bushes and the
@@ -170,7 +171,7 @@ def _spruce(rng: np.random.Generator, height: float) -> list[Mesh]:
         shade = 1.0 - 0.35 * (1.0 - share) + 0.15 * share  # the lower tiers stand in the upper ones' shade
         colors = _leaf_colors(green * shade, rng, len(faces))
         colors[n:] *= 1.0 - SELF_SHADE  # the tier's underside
-        parts.append(to_mesh(trimesh.Trimesh(vertices, faces, process=False), colors))
+        parts.append(with_finish(to_mesh(trimesh.Trimesh(vertices, faces, process=False), colors), LEAVES_FINISH))
     return parts
 
 
@@ -205,7 +206,7 @@ def _leaf_cluster(rng: np.random.Generator, size: float, centre: FloatArray, squ
     down = normal[:, 2] / np.maximum(np.linalg.norm(normal, axis=1), 1e-12)
     colors = _leaf_colors(green, rng, len(all_faces))
     colors *= (1.0 - 0.5 * SELF_SHADE * np.clip(-down, 0.0, 1.0))[:, None]
-    return Mesh(vertices, all_faces, colors.astype(np.float32))
+    return with_finish(Mesh(vertices, all_faces, colors.astype(np.float32)), LEAVES_FINISH)
 
 
 TETRAHEDRON = np.array([(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)]) / np.sqrt(3.0)

@@ -17,7 +17,7 @@ def _wall(finish: int, u: np.ndarray, v: np.ndarray, foot: float) -> np.ndarray:
     return np.array([fc.facade(finish, float(a), float(b), foot, foot, 0.0, 0.0, *WALL)[:3] for a, b in zip(u, v)])
 
 
-@pytest.mark.parametrize("finish", [facade.BRICK, facade.PANELS])
+@pytest.mark.parametrize("finish", [facade.BRICK, facade.PANELS, facade.TILES])
 def test_walls_show_their_joints_up_close_and_their_mean_far_away(finish: int) -> None:
     rng = np.random.default_rng(0)
     u, v = rng.uniform(0.0, 20.0, 400), rng.uniform(2.0, 3.0, 400)  # one band of height, away from the foot
@@ -33,6 +33,17 @@ def test_brick_courses_are_75_mm_with_mortar_between() -> None:
     mortar = grey > 0.9 * fc.MORTAR_ALBEDO[0]  # the mortar is paler than this brick
     starts = v[1:][mortar[1:] & ~mortar[:-1]]
     np.testing.assert_allclose(np.diff(starts), fc.COURSE_M, atol=0.003)
+
+
+def test_roof_tiles_lie_in_courses_at_their_gauge_each_shading_the_one_below() -> None:
+    v = np.arange(0.0, 1.5, 0.0025) + 0.2
+    grey = _wall(facade.TILES, np.full(v.size, 0.07), v, 0.002)[:, 0]
+    butt = grey < 0.5 * WALL[0]  # the shadow under each course's lower edge
+    starts = v[1:][butt[1:] & ~butt[:-1]]
+    np.testing.assert_allclose(np.diff(starts), fc.TILE_GAUGE_M, atol=0.003)
+    moss = fc.facade(facade.TILES, 0.07, 0.5, 3.0, 3.0, -1.0, 0.0, *WALL)[0]
+    clean = fc.facade(facade.TILES, 0.07, 0.5, 3.0, 3.0, 0.0, 1.0, *WALL)[0]
+    assert moss < clean  # moss darkens a roof; no sill streaks run down it
 
 
 def test_lines_fade_to_their_mean_share_before_they_alias() -> None:

@@ -127,6 +127,34 @@ def test_trees_and_bushes_stand_on_the_ground() -> None:
     assert abs(tree.vertices[:, 2].max() - 8.0) < 1.5
 
 
+def test_leaves_are_marked_for_the_renderer_and_bark_is_not() -> None:
+    for seed in range(4):
+        for conifer in (True, False):
+            tree = vegetation.tree(RNG(seed), conifer=conifer)
+            assert tree.finish is not None and tree.finish.shape == (len(tree.faces),)
+            leaves = tree.finish == facade.LEAVES
+            assert (tree.finish[~leaves] == facade.PLAIN).all()
+            # the crown is leaves (greener than red), the trunk and branches bark (browner)
+            assert (tree.colors[leaves, 1] > tree.colors[leaves, 0]).all()
+            assert (tree.colors[~leaves, 0] > tree.colors[~leaves, 1]).all() and (~leaves).sum() >= 16
+        shrub = vegetation.bush(RNG(seed))
+        assert shrub.finish is not None and (shrub.finish == facade.LEAVES).all()
+
+
+def test_a_house_roof_is_tiled_up_its_slopes() -> None:
+    roof = props.gable_roof(5.3, 4.4, 5.75, 3.0, props.ROOFS[0])
+    assert roof.finish is not None and roof.uv is not None
+    tiled = roof.finish == facade.TILES
+    assert tiled.sum() == 4  # two slopes, two triangles each; the soffit and gable ends stay plain
+    slope = float(np.hypot(4.4, 3.0))
+    for face in roof.faces[tiled]:
+        z, v = roof.vertices[face, 2], roof.uv[face, 1]
+        np.testing.assert_allclose(v, np.where(z > 5.75 + 1e-6, slope, 0.0), atol=1e-5)  # up from the eaves
+        np.testing.assert_allclose(roof.uv[face, 0], roof.vertices[face, 0], atol=1e-5)  # along them
+    home = props.house(RNG(2), 10.0, 8.0)
+    assert home.finish is not None and (home.finish == facade.TILES).sum() == 4
+
+
 def test_building_and_house_fill_their_footprint() -> None:
     block = props.building(RNG(0), 20.0, 12.0, 16.0, shopfront=True)
     assert_renderable(block)
