@@ -353,6 +353,44 @@ def street_furniture(network: RoadNetwork, clear: Clearance, rng: np.random.Gene
     return out
 
 
+PASSER_SPACING_M = {"urban": 16.0, "suburban": 60.0}  # one person about every this many metres of each sidewalk
+PASSERS_BEHIND_M, PASSERS_AHEAD_M = 10.0, 80.0  # people stand along the main road from this far behind the ego's
+# start to this far beyond its end (further on they are a few pixels and only cost triangles)
+WALKING_SHARE = 0.7  # of the people on a sidewalk, those walking along it (the rest stand, facing any way)
+
+
+def sidewalk_width(piece: RoadPiece) -> float:
+    """How wide a piece's sidewalk is from its kerb side: its raised strips before the ground beyond (0: none)."""
+    raised = [strip.width for strip in piece.strips[:-1] if strip.height > 0.05]
+    return float(sum(raised))
+
+
+def passers_by(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
+    """People on both sidewalks of the main road, about every ``PASSER_SPACING_M`` of the scene kind (over the
+    density) along the stretch the ego sees: most walking along the sidewalk one way or the other, the rest
+    standing; at least 0.9 m from the kerb (clear of the lamps and furniture at its edge) and 0.5 m from the
+    sidewalk's back; none where another road crosses."""
+    piece, kerb = network.main, sidewalk_kerb(network.main)
+    width = sidewalk_width(piece)
+    if kerb is None or width < 1.6 or inputs.density <= 0:
+        return []
+    spacing = PASSER_SPACING_M[inputs.kind] / inputs.density
+    s0, s1 = max(inputs.start_s - PASSERS_BEHIND_M, 0.0), min(inputs.end_s + PASSERS_AHEAD_M, piece.line.length)
+    out: list[Mesh] = []
+    for side in (-1, 1):
+        placed = []
+        for s in stations(s0, s1, spacing, rng):
+            t = side * (kerb[0] + float(rng.uniform(0.9, width - 0.5)))
+            walking = bool(rng.random() < WALKING_SHARE)
+            yaw = float(rng.choice([0.0, np.pi])) if walking else float(rng.uniform(-np.pi, np.pi))
+            person = props.pedestrian(own_rng(rng), height=float(rng.uniform(1.55, 1.9)), walking=walking)
+            T_world_local = pose_on_road(piece.line, float(s), t, yaw, kerb[1])
+            if not clear.on_road(T_world_local[None, :2, 3], margin=0.8, skip=0):
+                placed.append((float(s), transformed(person, T_world_local)))
+        out += _grouped(placed, f"passers-by {'left' if side > 0 else 'right'}", "pedestrian")
+    return out
+
+
 PARKED_SETBACK_M = 0.45  # a parked vehicle's side from the edge of the sidewalk (its footprint keeps 0.1 m more)
 PARKING_ROW_M = 2.6  # the depth of the row of parked vehicles beyond the sidewalk: a van's width and a door's room
 PARKED_GAP_M = (0.7, 2.5)  # bumper to bumper between parked vehicles
@@ -565,7 +603,8 @@ def _urban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
         meshes += rows_of(network, clear, rng, block, (0.5 + PARKING_ROW_M, 2.5 + PARKING_ROW_M),
                           (1.0 / density, 10.0 / density), "building")
         meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes + traffic_signals(inputs, network, clear, own_rng(rng))
+    meshes += traffic_signals(inputs, network, clear, own_rng(rng))
+    return meshes + passers_by(inputs, network, clear, own_rng(rng))
 
 
 def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
@@ -584,7 +623,8 @@ def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Gener
     meshes += greenery(inputs, network, clear, rng, 14.0 / density, (0.5, 3.0), bush_share=0.4)
     meshes += rows_of(network, clear, rng, home, (5.0, 10.0), (6.0 / density, 16.0 / density), "house")
     meshes += street_furniture(network, clear, own_rng(rng))
-    return meshes + traffic_signals(inputs, network, clear, own_rng(rng))
+    meshes += traffic_signals(inputs, network, clear, own_rng(rng))
+    return meshes + passers_by(inputs, network, clear, own_rng(rng))
 
 
 def _highway(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generator, clear: Clearance) -> list[Mesh]:
