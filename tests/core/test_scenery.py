@@ -16,7 +16,7 @@ from lanevil_core.world.scenery import corridor_half_width, roadside_meshes
 
 OVERHEAD_CLEARANCE_M = 4.5  # what is this high above the road (a lamp arm, a tunnel lintel) may span it
 # Structures allowed inside the roadside strips (but never on the carriageway).
-ON_VERGE = {"barrier", "pole", "street_furniture", "pedestrian"}  # lamp posts, the furniture and the people of sidewalks
+ON_VERGE = {"barrier", "pole", "street_furniture", "pedestrian"}  # lamp posts, furniture and people on sidewalks
 
 
 def road_frame(piece: RoadPiece, p_world: np.ndarray) -> tuple[np.ndarray, ...]:
