@@ -54,6 +54,8 @@ def main() -> None:
     parser.add_argument("--source", type=Path, default=None,
                         help="labelled split of the train worlds, for the dann methods")
     parser.add_argument("--epochs", type=int, default=3, help="lanevil adapt --epochs (default 3)")
+    parser.add_argument("--domain-weight", type=float, default=1.0,
+                        help="lanevil adapt --domain-weight of the dann methods (0: the source-only control)")
     parser.add_argument("--threads", type=int, default=0, help="lanevil adapt --threads (default every core)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
@@ -65,16 +67,18 @@ def main() -> None:
                      **score(args.score_on, model, [], args.cache / "pred" / f"{model}.json")})
         for how in args.adapt:
             for rounds in args.rounds if "self-train" in how else [1]:
-                name = f"{model}-{how}-r{rounds}"
+                weight = f"-w{args.domain_weight:g}" if "dann" in how and args.domain_weight != 1.0 else ""
+                name = f"{model}-{how}-r{rounds}{weight}"
                 folder = args.cache / "models" / name
                 if not (folder / "training.json").is_file():  # reruns resume
-                    source = ["--source", str(args.source)] if "dann" in how else []
+                    source = (["--source", str(args.source), "--domain-weight", str(args.domain_weight)]
+                              if "dann" in how else [])
                     _cli("adapt", "--weights", model, "--frames", str(args.adapt_on), "--out", str(folder),
                          "--method", how, "--rounds", str(rounds), "--epochs", str(args.epochs),
                          "--threads", str(args.threads), *source, "--quiet")
                 training = json.loads((folder / "training.json").read_text())
                 family = ModelSpec.load(folder).family  # runs as its family
-                rows.append({"model": model, "adapt": how, "rounds": rounds,
+                rows.append({"model": model, "adapt": how + weight, "rounds": rounds,
                              "pseudo_labelled": training.get("self_training", {}).get("pseudo_labelled"),
                              "domain_accuracy": training.get("dann", {}).get("domain_accuracy"),
                              "seconds": training["seconds"],

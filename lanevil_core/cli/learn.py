@@ -143,6 +143,9 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
                              "labels, as `lanevil train --data` reads) to keep the lanes learned on; repeatable")
     parser.add_argument("--epochs", type=count(1), default=3,
                         help="self-training epochs, and passes over the --source frames with dann (default 3)")
+    parser.add_argument("--domain-weight", type=float, default=1.0,
+                        help="with a dann method: scale of the reversed domain gradient (default 1; 0 fine-tunes on "
+                             "--source alone, the control that says what the alignment adds)")
     parser.add_argument("--rounds", type=count(1), default=1,
                         help="self-training rounds, each on the last round's model's readings (default 1)")
     parser.add_argument("--lr", type=float, default=2e-4,
@@ -174,7 +177,8 @@ def _run_adapt(args: argparse.Namespace) -> int:
                 raise UsageError(f"{flag} {folder}: no such folder")
     try:
         settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
-                                 source=tuple(args.source), epochs=args.epochs, rounds=args.rounds, lr=args.lr,
+                                 source=tuple(args.source), epochs=args.epochs,
+                                 domain_weight=args.domain_weight, rounds=args.rounds, lr=args.lr,
                                  max_frames=args.max_frames, device=args.device, seed=args.seed,
                                  threads=args.threads)
         summary = adapt(settings, show_progress=not args.quiet)

@@ -66,6 +66,7 @@ class AdaptSettings:
     method: str = "adabn+self-train"
     source: tuple[Path, ...] = ()  # labelled split folders of renders (lanevil dataset), read by the dann methods
     epochs: int = 3  # self-training epochs, and passes over the source with dann
+    domain_weight: float = 1.0  # scales dann's reversed gradient (0: a fine-tune on the source alone, a control)
     rounds: int = 1  # self-training rounds: each reads the frames again with the model the last round left
     batch: int = 16
     lr: float = 2e-4
@@ -84,6 +85,8 @@ class AdaptSettings:
             raise AdaptError(f"--source: --method {self.method} needs a labelled split of renders (--source DIR)")
         if self.source and "dann" not in self.method:
             raise AdaptError(f"--source: only with a dann method (not {self.method})")
+        if self.domain_weight < 0:
+            raise AdaptError(f"--domain-weight {self.domain_weight:g}: must be at least 0")
 
 
 def frame_files(folders: tuple[Path, ...], max_frames: int) -> list[Path]:
@@ -204,7 +207,7 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     if "dann" in settings.method:
         source = source_frames(settings, spec)
         summary["dann"] = adversarial_training(model, source, images, settings.epochs, settings.batch, settings.lr,
-                                               settings.seed, device, show_progress)
+                                               settings.seed, device, settings.domain_weight, show_progress)
     if "adabn" in settings.method:  # after dann, whose training moves the statistics
         summary["adabn_layers"] = adapt_batch_norm(model, images, device)
     if "self-train" in settings.method:

@@ -87,10 +87,13 @@ def _target_tensor(images: np.ndarray, flips: np.ndarray, input_size: tuple[int,
 
 
 def adversarial_training(model: LaneNet, source: LabelledFrames, target: np.ndarray, epochs: int, batch: int,
-                         lr: float, seed: int, device: torch.device, show_progress: bool = False) -> dict[str, Any]:
+                         lr: float, seed: int, device: torch.device, domain_weight: float = 1.0,
+                         show_progress: bool = False) -> dict[str, Any]:
     """Train ``model`` on the labelled ``source`` frames and, adversarially, on the unlabelled ``target`` images
     ((N, H, W, 3) uint8 at the input size) for ``epochs`` passes over the source; per epoch the mean detector and
-    domain losses and the classifier's accuracy (0.5: it can no longer tell the domains apart)."""
+    domain losses and the classifier's accuracy (0.5: it can no longer tell the domains apart). ``domain_weight``
+    scales the reversed gradient (0: the classifier still learns, the backbone never hears of it, which leaves a
+    fine-tune on the source alone, the control of a measurement)."""
     spec = model.spec
     domain = DomainClassifier(model.backbone.channels[-1]).to(device)
     optimizer = torch.optim.AdamW([{"params": model.parameters(), "base_lr": lr},
@@ -113,7 +116,7 @@ def adversarial_training(model: LaneNet, source: LabelledFrames, target: np.ndar
         sums = np.zeros(3)
         for indices, sample in zip(chosen, loader, strict=True):
             progress = step / total
-            weight = reversal_weight(progress)
+            weight = domain_weight * reversal_weight(progress)
             for group in optimizer.param_groups:
                 group["lr"] = annealed_lr(group["base_lr"], progress)
             sample = {k: v.to(device) for k, v in sample.items()}
@@ -135,5 +138,5 @@ def adversarial_training(model: LaneNet, source: LabelledFrames, target: np.ndar
             report[key].append(round(float(value), 4))
         if show_progress:
             print(f"adversarial epoch {epoch + 1}/{epochs}: detector loss {means[0]:.4f}, domain loss {means[1]:.4f}, "
-                  f"domain accuracy {means[2]:.3f} (reversal weight {reversal_weight(step / total):.3f})", flush=True)
+                  f"domain accuracy {means[2]:.3f} (reversal weight {weight:.3f})", flush=True)
     return report

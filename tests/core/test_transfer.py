@@ -262,6 +262,8 @@ def test_dann_without_source_or_source_without_dann_exits_2(tiny_dataset, tmp_pa
     assert "--source: only with a dann method" in capsys.readouterr().err
     assert main([*base, "--method", "dann", "--source", str(tmp_path / "nowhere")]) == 2
     assert "--source" in capsys.readouterr().err and not (tmp_path / "o").exists()
+    assert main([*base, "--method", "dann", "--source", str(tiny_dataset / "train"), "--domain-weight", "-1"]) == 2
+    assert "--domain-weight -1: must be at least 0" in capsys.readouterr().err
 
 
 def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, monkeypatch, capsys):  # noqa: F811
