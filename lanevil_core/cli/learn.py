@@ -186,6 +186,9 @@ def _run_adapt(args: argparse.Namespace) -> int:
         raise UsageError(str(error)) from None
     kept = summary.get("self_training", {}).get("pseudo_labelled")
     extra = "" if kept is None else f", {kept} frames pseudo-labelled"
+    if "dann" in summary:
+        extra += (f", {summary['dann']['source_frames']} source frames, domain accuracy "
+                  f"{summary['dann']['domain_accuracy'][-1]:.2f}")
     print(f"{args.out}: adapted on {summary['frames']} frames ({args.method}{extra}) in {summary['seconds']:.0f} s")
     return 0
 
