@@ -132,14 +132,26 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frames", type=Path, required=True, action="append",
                         help="folder of your own unlabelled frames (png/jpg, searched recursively); repeatable")
     parser.add_argument("--out", type=Path, required=True, help="model folder to write")
-    parser.add_argument("--method", choices=("adabn", "self-train", "adabn+self-train"), default="adabn+self-train",
+    parser.add_argument("--method", choices=("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann",
+                                             "dann+self-train"), default="adabn+self-train",
                         help="AdaBN (normalisation statistics re-estimated), self-training on confident "
-                             "pseudo-labels, or both in that order (default)")
-    parser.add_argument("--epochs", type=count(1), default=3, help="self-training epochs (default 3)")
+                             "pseudo-labels, both in that order (default), or domain-adversarial training on "
+                             "--source renders and your frames (dann; adabn+dann estimates the statistics after it, "
+                             "dann+self-train self-trains the model it leaves)")
+    parser.add_argument("--source", type=Path, action="append", default=[],
+                        help="with a dann method: a labelled split folder of renders (`lanevil dataset`, TuSimple "
+                             "labels, as `lanevil train --data` reads) to keep the lanes learned on; repeatable")
+    parser.add_argument("--epochs", type=count(1), default=3,
+                        help="self-training epochs, and passes over the --source frames with dann (default 3)")
+    parser.add_argument("--domain-weight", type=float, default=1.0,
+                        help="with a dann method: scale of the reversed domain gradient (default 1; 0 fine-tunes on "
+                             "--source alone, the control that says what the alignment adds)")
     parser.add_argument("--rounds", type=count(1), default=1,
                         help="self-training rounds, each on the last round's model's readings (default 1)")
-    parser.add_argument("--lr", type=float, default=2e-4, help="self-training learning rate (default 2e-4)")
-    parser.add_argument("--max-frames", type=count(1), default=2000, help="frames read at most (default 2000)")
+    parser.add_argument("--lr", type=float, default=2e-4,
+                        help="self-training and adversarial learning rate (default 2e-4)")
+    parser.add_argument("--max-frames", type=count(1), default=2000,
+                        help="frames read at most, of --frames and of --source each (default 2000)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto", help="default auto")
     parser.add_argument("--seed", type=count(0), default=0, help="default 0")
     parser.add_argument("--threads", type=count(0), default=0, help="CPU threads (default every core)")
@@ -159,24 +171,30 @@ def _run_adapt(args: argparse.Namespace) -> int:
     model = shipped_model_dir(args.weights) if shipped else Path(args.weights)
     if not model.is_dir():
         raise UsageError(f"--weights {args.weights}: no such model folder")
-    for folder in args.frames:
-        if not folder.is_dir():
-            raise UsageError(f"--frames {folder}: no such folder")
-    settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
-                             epochs=args.epochs, rounds=args.rounds, lr=args.lr, max_frames=args.max_frames,
-                             device=args.device, seed=args.seed, threads=args.threads)
+    for flag, folders in (("--frames", args.frames), ("--source", args.source)):
+        for folder in folders:
+            if not folder.is_dir():
+                raise UsageError(f"{flag} {folder}: no such folder")
     try:
+        settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
+                                 source=tuple(args.source), epochs=args.epochs,
+                                 domain_weight=args.domain_weight, rounds=args.rounds, lr=args.lr,
+                                 max_frames=args.max_frames, device=args.device, seed=args.seed,
+                                 threads=args.threads)
         summary = adapt(settings, show_progress=not args.quiet)
     except (AdaptError, ModelSpecError) as error:
         raise UsageError(str(error)) from None
     kept = summary.get("self_training", {}).get("pseudo_labelled")
     extra = "" if kept is None else f", {kept} frames pseudo-labelled"
+    if "dann" in summary:
+        extra += (f", {summary['dann']['source_frames']} source frames, domain accuracy "
+                  f"{summary['dann']['domain_accuracy'][-1]:.2f}")
     print(f"{args.out}: adapted on {summary['frames']} frames ({args.method}{extra}) in {summary['seconds']:.0f} s")
     return 0
 
 
 COMMANDS: dict[str, Command] = {
-    "adapt": Command("adapt a learned detector to your own unlabelled frames (AdaBN, self-training)",
+    "adapt": Command("adapt a learned detector to your own unlabelled frames (AdaBN, self-training, DANN)",
                      _adapt_arguments, _run_adapt),
     "train": Command("train a learned lane detector (ufld, seg, laneatt, bezier, ganet or scnn) on a dataset's "
                      "clean train split",

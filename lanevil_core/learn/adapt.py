@@ -1,6 +1,6 @@
 """``lanevil adapt``: adapt a trained detector to a user's own unlabelled footage (a folder of their frames).
 
-Two methods, used in this order (``--method``):
+Three methods (``--method``), combined as named:
 
 - **AdaBN** (Li et al., "Revisiting Batch Normalization For Practical Domain Adaptation"): every batch-norm layer's
   running mean and variance are estimated again, as a cumulative average over the user's frames, with the weights
@@ -12,6 +12,10 @@ Two methods, used in this order (``--method``):
   (``learn.randomise.photometric``) at a small learning rate, which keeps it near what it learned from renders.
   With ``rounds`` above 1 the frames are read again by the fine-tuned model and it is fine-tuned on its new
   readings, round after round (each round's lanes must again agree with their mirror).
+- **DANN** (``learn.dann``, Ganin & Lempitsky's domain-adversarial training): fine-tuned on labelled renders
+  (``source``, a ``lanevil dataset`` split) while a domain classifier behind gradient reversal pushes its backbone
+  features of renders and of the user's frames together. With ``adabn+dann`` the batch-norm statistics are estimated
+  on the user's frames *after* it (training moves them); ``dann+self-train`` self-trains the model it leaves.
 
 The result is a model folder like ``lanevil train``'s (``config.json``, ``weights.pt``, ``model.onnx``,
 ``training.json`` with what was adapted on), usable wherever a detector is chosen (``--weights``).
@@ -41,12 +45,13 @@ from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_F
 from ..detect.split import IMAGE_SUFFIXES, read_rgb
 from ..files import write_atomic
 from ..labels.lanes import TUSIMPLE_H_SAMPLES
-from .data import _Frames, resized
+from .dann import adversarial_training
+from .data import LabelledFrames, _Frames, read_splits, resized
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
 
-METHODS = ("adabn", "self-train", "adabn+self-train")
+METHODS = ("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann", "dann+self-train")
 
 
 class AdaptError(ValueError):
@@ -59,16 +64,29 @@ class AdaptSettings:
     frames: tuple[Path, ...]  # folders of the user's unlabelled frames (png/jpg, searched recursively)
     out: Path
     method: str = "adabn+self-train"
-    epochs: int = 3
+    source: tuple[Path, ...] = ()  # labelled split folders of renders (lanevil dataset), read by the dann methods
+    epochs: int = 3  # self-training epochs, and passes over the source with dann
+    domain_weight: float = 1.0  # scales dann's reversed gradient (0: a fine-tune on the source alone, a control)
     rounds: int = 1  # self-training rounds: each reads the frames again with the model the last round left
     batch: int = 16
     lr: float = 2e-4
     agreement: float = 0.015  # mean |x - x_mirrored| as a share of the width for a lane to be kept
     min_lanes: int = 2
-    max_frames: int = 2000  # frames read at most (evenly over the folders' sorted files)
+    max_frames: int = 2000  # frames read at most (evenly over the folders' sorted files), of the source too
     device: str = "auto"
     seed: int = 0
     threads: int = 0
+
+    def __post_init__(self) -> None:
+        """The rules between settings, each broken one named as the command line names it (``AdaptError``)."""
+        if self.method not in METHODS:
+            raise AdaptError(f"--method {self.method}: choose from {', '.join(METHODS)}")
+        if "dann" in self.method and not self.source:
+            raise AdaptError(f"--source: --method {self.method} needs a labelled split of renders (--source DIR)")
+        if self.source and "dann" not in self.method:
+            raise AdaptError(f"--source: only with a dann method (not {self.method})")
+        if self.domain_weight < 0:
+            raise AdaptError(f"--domain-weight {self.domain_weight:g}: must be at least 0")
 
 
 def frame_files(folders: tuple[Path, ...], max_frames: int) -> list[Path]:
@@ -165,8 +183,6 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     ``training.json`` content."""
     from .train import pick_device
 
-    if settings.method not in METHODS:
-        raise AdaptError(f"--method {settings.method}: choose from {', '.join(METHODS)}")
     torch.manual_seed(settings.seed)
     torch.set_num_threads(settings.threads or os.cpu_count() or 1)
     device = pick_device(settings.device)
@@ -183,10 +199,16 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     state = torch.load(weights, map_location="cpu", weights_only=True)
     model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in state.items()})
     model = model.to(device)
-    summary: dict[str, Any] = {"adapted_from": settings.model.name, "frames": len(files),
-                               "settings": {k: (str(v) if isinstance(v, Path) else v)
-                                            for k, v in asdict(settings).items() if k not in ("frames", "out")}}
-    if "adabn" in settings.method:
+    recorded = {k: (str(v) if isinstance(v, Path) else v)
+                for k, v in asdict(settings).items() if k not in ("frames", "out", "source")}
+    summary: dict[str, Any] = {"adapted_from": settings.model.name, "frames": len(files), "settings": recorded}
+    if settings.source:
+        summary["source"] = [folder.name for folder in settings.source]
+    if "dann" in settings.method:
+        source = source_frames(settings, spec)
+        summary["dann"] = adversarial_training(model, source, images, settings.epochs, settings.batch, settings.lr,
+                                               settings.seed, device, settings.domain_weight, show_progress)
+    if "adabn" in settings.method:  # after dann, whose training moves the statistics
         summary["adabn_layers"] = adapt_batch_norm(model, images, device)
     if "self-train" in settings.method:
         rounds = [_self_train(model, images, settings, device, show_progress) for _ in range(settings.rounds)]
@@ -200,6 +222,19 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     summary.update(spec=asdict(spec), seconds=round(time.perf_counter() - started, 1), torch=torch.__version__)
     write_atomic(out / TRAINING_FILE, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     return summary
+
+
+def source_frames(settings: AdaptSettings, spec: ModelSpec) -> LabelledFrames:
+    """The labelled source frames of ``settings.source`` at the model's input size (flipped half the time while
+    training), thinned evenly to ``settings.max_frames``."""
+    try:
+        frames, _ = read_splits(settings.source)
+    except ValueError as error:
+        raise AdaptError(str(error).replace("--data", "--source")) from None
+    indices = None
+    if len(frames) > settings.max_frames:
+        indices = [int(i) for i in np.linspace(0, len(frames) - 1, settings.max_frames).round()]
+    return LabelledFrames(frames, spec, indices, train=True, seed=settings.seed)
 
 
 def _self_train(model: LaneNet, images: np.ndarray, settings: AdaptSettings, device: torch.device,

@@ -193,3 +193,20 @@ def running_statistics(model: nn.Module) -> Iterator[None]:
     finally:
         for m in norms:
             m.train()
+
+
+@contextmanager
+def pooled_features(model: LaneNet) -> Iterator[list[torch.Tensor]]:
+    """Inside the block, every forward pass of ``model`` appends its last backbone stage, global-average-pooled to
+    ``(N, C)``, to the yielded list (gradients flow through it): the features a domain classifier reads, alike for
+    every family, since each reads its image through ``LaneNet.stages``."""
+    captured: list[torch.Tensor] = []
+
+    def keep(_module: nn.Module, _inputs: object, stages: tuple[torch.Tensor, ...]) -> None:
+        captured.append(torch.flatten(F.adaptive_avg_pool2d(stages[-1], 1), 1))
+
+    handle = model.backbone.register_forward_hook(keep)
+    try:
+        yield captured
+    finally:
+        handle.remove()

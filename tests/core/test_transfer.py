@@ -1,6 +1,6 @@
 """Training that transfers: the domain randomiser is deterministic per seed and keeps the paint, ImageNet
 checkpoints in torchvision's layout load into the backbone (and wrong ones are refused in one line), and
-``lanevil adapt`` writes a usable model from unlabelled frames."""
+``lanevil adapt`` writes a usable model from unlabelled frames (with ``--method dann``, from labelled renders too)."""
 
 from __future__ import annotations
 
@@ -18,11 +18,12 @@ from test_learn import TINY_SPEC, _train, straight_record, tiny_dataset  # noqa:
 from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.lane_slots import LaneLine, lane_lines  # noqa: E402
 from lanevil_core.detect.learned import LearnedDetector  # noqa: E402
-from lanevil_core.detect.model_spec import ModelSpec  # noqa: E402
+from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
 from lanevil_core.learn.adapt import adapt_batch_norm, agreeing_lanes, frame_files  # noqa: E402
 from lanevil_core.learn.backbone import BackboneWeightsError, ResNet, load_backbone_weights  # noqa: E402
+from lanevil_core.learn.dann import reversal_weight, reverse_gradient, target_batches  # noqa: E402
 from lanevil_core.learn.data import LabelledFrames, read_splits  # noqa: E402
-from lanevil_core.learn.models import build_model  # noqa: E402
+from lanevil_core.learn.models import build_model, pooled_features  # noqa: E402
 from lanevil_core.learn.randomise import paint_mask, photometric, randomise, recolour  # noqa: E402
 
 SIZE = (320, 180)
@@ -162,10 +163,7 @@ def test_adabn_re_estimates_the_normalization_statistics_only():
 
 def test_adapt_writes_a_model_usable_as_weights(tiny_dataset, tmp_path, capsys):  # noqa: F811
     assert _train(tiny_dataset, tmp_path / "model", "ufld") == 0
-    frames = tmp_path / "my_frames"
-    frames.mkdir()
-    for index, path in enumerate(sorted((tiny_dataset / "train").rglob("*.png"))[:4]):
-        (frames / f"{index}.png").write_bytes(path.read_bytes())
+    frames = _my_frames(tiny_dataset, tmp_path / "my_frames")
     assert frame_files((frames,), 2) == [frames / "0.png", frames / "3.png"]
     out = tmp_path / "adapted"
     code = main(["adapt", "--weights", str(tmp_path / "model"), "--frames", str(frames), "--out", str(out),
@@ -185,6 +183,87 @@ def test_adapt_writes_a_model_usable_as_weights(tiny_dataset, tmp_path, capsys):
     rounds = json.loads((again / "training.json").read_text())["self_training"]
     assert "adabn_layers" not in json.loads((again / "training.json").read_text())
     assert "rounds" in rounds and len(rounds["rounds"]) == 2
+
+
+def _my_frames(dataset: Path, folder: Path, count: int = 4) -> Path:
+    """``count`` frames of a dataset copied, unlabelled, into ``folder``."""
+    folder.mkdir()
+    for index, path in enumerate(sorted((dataset / "train").rglob("*.png"))[:count]):
+        (folder / f"{index}.png").write_bytes(path.read_bytes())
+    return folder
+
+
+def test_gradient_reversal_flips_the_sign_of_gradients_and_nothing_else():
+    features = torch.randn(3, 5, generator=torch.Generator().manual_seed(0), requires_grad=True)
+    weights = torch.randn(5, generator=torch.Generator().manual_seed(1))
+    reversed_out = reverse_gradient(features, 0.7)
+    assert torch.equal(reversed_out, features)
+    (reversed_out * weights).sum().backward()
+    assert torch.allclose(features.grad, -0.7 * weights.expand(3, 5))
+    plain = features.detach().clone().requires_grad_(True)
+    (plain * weights).sum().backward()
+    assert torch.allclose(features.grad, -0.7 * plain.grad)
+    ramp = [reversal_weight(p) for p in np.linspace(0.0, 1.0, 11)]
+    assert ramp[0] == 0.0 and abs(ramp[-1] - 0.99991) < 1e-5 and abs(ramp[1] - 0.4621) < 1e-4 and all(np.diff(ramp) > 0)
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_pooled_features_reach_the_backbone_of_every_family(family):
+    model = build_model(ModelSpec(family=family, **TINY_SPEC)).train()
+    images = torch.rand(2, 3, TINY_SPEC["input_size"][1], TINY_SPEC["input_size"][0])
+    with pooled_features(model) as features:
+        model(images)
+    model(images)  # outside the block: nothing more is kept
+    assert len(features) == 1 and features[0].shape == (2, model.backbone.channels[-1])
+    features[0].sum().backward()
+    assert float(model.backbone.conv1.weight.grad.abs().sum()) > 0.0
+
+
+def test_target_batches_cover_every_frame_before_repeating_one():
+    batches = target_batches(5, 3, 4, np.random.default_rng(0))
+    assert [len(b) for b in batches] == [3, 3, 3, 3]
+    assert sorted(np.concatenate(batches)[:5].tolist()) == [0, 1, 2, 3, 4]
+
+
+@pytest.mark.parametrize(("family", "method"), [("ufld", "adabn+dann"), ("seg", "dann")])
+def test_dann_adapts_on_labelled_renders_and_writes_a_loadable_model(tiny_dataset, tmp_path, capsys,  # noqa: F811
+                                                                      family, method):
+    assert _train(tiny_dataset, tmp_path / "model", family) == 0
+    frames = _my_frames(tiny_dataset, tmp_path / "my_frames")
+    runs = []
+    for name in ("a", "b"):  # the same seed twice: the same weights
+        out = tmp_path / name
+        code = main(["adapt", "--weights", str(tmp_path / "model"), "--frames", str(frames), "--out", str(out),
+                     "--method", method, "--source", str(tiny_dataset / "train"), "--epochs", "2", "--seed", "3",
+                     "--quiet"])
+        assert code == 0, capsys.readouterr().err
+        runs.append(torch.load(out / "weights.pt", weights_only=True))
+    assert all(torch.equal(runs[0][k], runs[1][k]) for k in runs[0])
+    before = torch.load(tmp_path / "model" / "weights.pt", weights_only=True)
+    assert any(not torch.equal(before[k], runs[0][k]) for k in before if "backbone.layer1" in k)
+    summary = json.loads((tmp_path / "a" / "training.json").read_text())
+    dann = summary["dann"]
+    assert summary["source"] == ["train"] and dann["source_frames"] == 10 and dann["target_frames"] == 4
+    assert len(dann["domain_accuracy"]) == 2 and all(0.0 <= a <= 1.0 for a in dann["domain_accuracy"])
+    assert ("adabn_layers" in summary) == ("adabn" in method) and "self_training" not in summary
+    detector = LearnedDetector(tmp_path / "a")
+    rgb = cv2.imread(str(frames / "0.png"))[..., ::-1]
+    assert isinstance(detector(np.ascontiguousarray(rgb), list(range(100, 144, 4))), list)
+
+
+def test_dann_without_source_or_source_without_dann_exits_2(tiny_dataset, tmp_path, capsys):  # noqa: F811
+    frames = _my_frames(tiny_dataset, tmp_path / "my_frames", 1)
+    base = ["adapt", "--weights", "seg", "--frames", str(frames), "--out", str(tmp_path / "o")]
+    for method in ("dann", "adabn+dann", "dann+self-train"):
+        assert main([*base, "--method", method]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and "--source" in err, err
+    assert main([*base, "--source", str(tiny_dataset / "train")]) == 2
+    assert "--source: only with a dann method" in capsys.readouterr().err
+    assert main([*base, "--method", "dann", "--source", str(tmp_path / "nowhere")]) == 2
+    assert "--source" in capsys.readouterr().err and not (tmp_path / "o").exists()
+    assert main([*base, "--method", "dann", "--source", str(tiny_dataset / "train"), "--domain-weight", "-1"]) == 2
+    assert "--domain-weight -1: must be at least 0" in capsys.readouterr().err
 
 
 def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, monkeypatch, capsys):  # noqa: F811
