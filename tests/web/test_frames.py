@@ -83,13 +83,20 @@ def test_a_busy_renderer_answers_503_with_retry_after(client, state, monkeypatch
 
 def test_the_scene_cache_is_bounded_by_bytes() -> None:
     case = load_case(SCENES / "00_clean" / "00_straight_urban.json")
-    service = FrameService(cache_bytes=0, threads=1, scene_cache_bytes=10_000_000)
-    service.frame(case, 0, (160, 90))
-    scene = service.scenes.get(case_hash(case))
-    assert scene is not None and service.scenes.total == scene.nbytes() > 1_000_000  # weighed with its packed arrays
     other = case.model_copy(update={"seed": 7})
+    sizes = []
+    for each in (case, other):  # each scene's weight, with its packed arrays, in a cache with room for both
+        roomy = FrameService(cache_bytes=0, threads=1)
+        roomy.frame(each, 0, (160, 90))
+        scene = roomy.scenes.get(case_hash(each))
+        assert scene is not None and roomy.scenes.total == scene.nbytes() > 1_000_000
+        sizes.append(scene.nbytes())
+    budget = max(sizes) + min(sizes) // 2  # room for either scene, never both
+    service = FrameService(cache_bytes=0, threads=1, scene_cache_bytes=budget)
+    service.frame(case, 0, (160, 90))
+    assert service.scenes.total == sizes[0] and len(service.scenes) == 1
     service.frame(other, 0, (160, 90))
-    assert service.scenes.total <= 10_000_000 and len(service.scenes) == 1
+    assert service.scenes.total == sizes[1] <= budget and len(service.scenes) == 1  # the first made room
 
 
 def test_the_roadside_cache_keeps_no_render_caches() -> None:
