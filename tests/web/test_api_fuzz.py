@@ -57,6 +57,7 @@ RELATIONAL_RULES: dict[str, tuple[str, ...]] = {
     "an envelope's version agrees with If-Match": ("If-Match says version",),
     "frame ranges lie in the case, in order, at most a request's worth": ("must satisfy 0 <= START < STOP",
                                                                           "frames per request"),
+    "a study's uploads each have a name of their own": ("give each file its own name",),
     "a study item is a frame or an upload, with its role's answer": (
         "give exactly one of case_id", "a gold item needs", "expect must be", "expect is only",
         "a trap item needs", "needs at least one scored", "no uploaded file is named", "no case with id",
