@@ -125,6 +125,7 @@ def _run_train(args: argparse.Namespace) -> int:
 def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
     from ..detect.learned import BUNDLED_MODELS
     from ..detect.model_spec import FAMILIES
+    from ..learn import ADAPT_METHODS
 
     parser.add_argument("--weights", required=True,
                         help=f"the model to adapt: a model folder of `lanevil train`, a shipped family "
@@ -132,8 +133,7 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frames", type=Path, required=True, action="append",
                         help="folder of your own unlabelled frames (png/jpg, searched recursively); repeatable")
     parser.add_argument("--out", type=Path, required=True, help="model folder to write")
-    parser.add_argument("--method", choices=("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann",
-                                             "dann+self-train"), default="adabn+self-train",
+    parser.add_argument("--method", choices=ADAPT_METHODS, default="adabn+self-train",
                         help="AdaBN (normalisation statistics re-estimated), self-training on confident "
                              "pseudo-labels, both in that order (default), or domain-adversarial training on "
                              "--source renders and your frames (dann; adabn+dann estimates the statistics after it, "

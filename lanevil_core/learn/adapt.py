@@ -45,13 +45,14 @@ from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_F
 from ..detect.split import IMAGE_SUFFIXES, read_rgb
 from ..files import write_atomic
 from ..labels.lanes import TUSIMPLE_H_SAMPLES
+from . import ADAPT_METHODS
 from .dann import adversarial_training
 from .data import LabelledFrames, _Frames, read_splits, resized
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
 
-METHODS = ("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann", "dann+self-train")
+METHODS = ADAPT_METHODS
 
 
 class AdaptError(ValueError):

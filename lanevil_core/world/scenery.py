@@ -272,10 +272,15 @@ STREETLIGHT_KINDS = ("urban", "suburban")  # the scene kinds with street lamps o
 STREET_LAMP_INTENSITY = 30.0  # radiance scale at 1 m of a roadside lamp: about 15 lux on the road below it
 
 
+def raised_strips(piece: RoadPiece) -> list[int]:
+    """The indices of a piece's raised strips (kerb, sidewalk) before the ground beyond its last strip."""
+    return [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+
+
 def sidewalk_kerb(piece: RoadPiece) -> tuple[float, float] | None:
     """(lateral distance from the reference line, height) of the kerb side of a piece's sidewalk (its first raised
     strip), or None where the piece has none."""
-    raised = [i for i, strip in enumerate(piece.strips[:-1]) if strip.height > 0.05]
+    raised = raised_strips(piece)
     if not raised:
         return None
     return piece.half_width + sum(strip.width for strip in piece.strips[:raised[0]]), piece.strips[raised[0]].height
@@ -361,8 +366,7 @@ WALKING_SHARE = 0.7  # of the people on a sidewalk, those walking along it (the 
 
 def sidewalk_width(piece: RoadPiece) -> float:
     """How wide a piece's sidewalk is from its kerb side: its raised strips before the ground beyond (0: none)."""
-    raised = [strip.width for strip in piece.strips[:-1] if strip.height > 0.05]
-    return float(sum(raised))
+    return float(sum(piece.strips[i].width for i in raised_strips(piece)))
 
 
 def passers_by(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
