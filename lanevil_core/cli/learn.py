@@ -137,7 +137,15 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
                         help="AdaBN (normalisation statistics re-estimated), self-training on confident "
                              "pseudo-labels, both in that order (default), or domain-adversarial training on "
                              "--source renders and your frames (dann; adabn+dann estimates the statistics after it, "
-                             "dann+self-train self-trains the model it leaves)")
+                             "dann+self-train self-trains the model it leaves), or view: the window of your camera "
+                             "that shows the model the view it was trained on (no training; see --camera-height)")
+    parser.add_argument("--camera-height", type=float, default=None,
+                        help="with --method view: your camera's height over the road in metres, which with "
+                             "--lane-width sets how wide the window is (without it the window keeps the frame's "
+                             "proportions)")
+    parser.add_argument("--lane-width", type=float, default=None,
+                        help="with --method view and --camera-height: the width of your roads' lanes in metres "
+                             "(default 3.5)")
     parser.add_argument("--source", type=Path, action="append", default=[],
                         help="with a dann method: a labelled split folder of renders (`lanevil dataset`, TuSimple "
                              "labels, as `lanevil train --data` reads) to keep the lanes learned on; repeatable")
@@ -158,19 +166,58 @@ def _adapt_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
+def _adapted_model(weights: str) -> Path:
+    """The model folder ``--weights`` names: a shipped family or model, or a folder (which must exist)."""
+    from ..detect.learned import BUNDLED_MODELS, shipped_model_dir
+    from ..detect.model_spec import FAMILIES
+
+    model = shipped_model_dir(weights) if weights in FAMILIES or weights in BUNDLED_MODELS else Path(weights)
+    if not model.is_dir():
+        raise UsageError(f"--weights {weights}: no such model folder")
+    return model
+
+
+def _run_adapt_view(args: argparse.Namespace) -> int:
+    from ..detect.view import ViewError
+    from ..learn.view import DEFAULT_LANE_M, adapt_view
+
+    if args.source:
+        raise UsageError("--source: only with a dann method (not view)")
+    if args.camera_height is not None and not 0.3 <= args.camera_height <= 10.0:
+        raise UsageError(f"--camera-height {args.camera_height}: give the height in metres, 0.3 to 10")
+    if args.lane_width is not None and args.camera_height is None:
+        raise UsageError("--lane-width: only with --camera-height")
+    lane_width = DEFAULT_LANE_M if args.lane_width is None else args.lane_width
+    if not 2.0 <= lane_width <= 6.0:
+        raise UsageError(f"--lane-width {lane_width}: give the width in metres, 2 to 6")
+    model = _adapted_model(args.weights)
+    for folder in args.frames:
+        if not folder.is_dir():
+            raise UsageError(f"--frames {folder}: no such folder")
+    try:
+        summary = adapt_view(model, tuple(args.frames), args.out, args.camera_height, lane_width, args.max_frames)
+    except ViewError as error:
+        raise UsageError(str(error)) from None
+    window = ", ".join(f"{value:.2f}" for value in summary["view"]["window"])
+    print(f"{args.out}: view of {summary['frames']} frames (vanishing point measured on {summary['view']['frames']}), "
+          f"window [{window}] in {summary['seconds']:.0f} s")
+    return 0
+
+
 def _run_adapt(args: argparse.Namespace) -> int:
+    if args.method == "view":
+        return _run_adapt_view(args)
+    for flag, value in (("--camera-height", args.camera_height), ("--lane-width", args.lane_width)):
+        if value is not None:
+            raise UsageError(f"{flag}: only with --method view")
     try:
         import torch  # noqa: F401
     except ImportError:
         raise UsageError("lanevil adapt needs PyTorch: pip install -e '.[learn]'") from None
-    from ..detect.learned import BUNDLED_MODELS, shipped_model_dir
-    from ..detect.model_spec import FAMILIES, ModelSpecError
+    from ..detect.model_spec import ModelSpecError
     from ..learn.adapt import AdaptError, AdaptSettings, adapt
 
-    shipped = args.weights in FAMILIES or args.weights in BUNDLED_MODELS
-    model = shipped_model_dir(args.weights) if shipped else Path(args.weights)
-    if not model.is_dir():
-        raise UsageError(f"--weights {args.weights}: no such model folder")
+    model = _adapted_model(args.weights)
     for flag, folders in (("--frames", args.frames), ("--source", args.source)):
         for folder in folders:
             if not folder.is_dir():
@@ -194,7 +241,7 @@ def _run_adapt(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Command] = {
-    "adapt": Command("adapt a learned detector to your own unlabelled frames (AdaBN, self-training, DANN)",
+    "adapt": Command("adapt a learned detector to your own unlabelled frames (AdaBN, self-training, DANN, view)",
                      _adapt_arguments, _run_adapt),
     "train": Command("train a learned lane detector (ufld, seg, laneatt, bezier, ganet or scnn) on a dataset's "
                      "clean train split",

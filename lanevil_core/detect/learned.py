@@ -30,6 +30,7 @@ from .lane_keypoints import decode_keypoints
 from .lane_slots import LaneLine, anchor_reach, decode_lane_masks, decode_row_anchors, tusimple_lanes
 from .line_anchors import decode_anchors, line_anchors
 from .model_spec import FAMILIES, ONNX_FILE, ModelSpec, ModelSpecError
+from .view import View, ViewError, view_input
 
 SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 # Models shipped beside the six families' own, each a `lanevil train` folder run as its family, by name:
@@ -45,10 +46,13 @@ def shipped_model_dir(name: str) -> Path:
     return SHIPPED_MODELS / name
 
 
-def network_input(rgb: UInt8Array, input_size: tuple[int, int]) -> Float32Array:
-    """(3, H, W) float32 in 0..1: the frame resized (area filter) to the network's input (width, height)."""
+def network_input(rgb: UInt8Array, input_size: tuple[int, int], view: View | None = None) -> Float32Array:
+    """(3, H, W) float32 in 0..1: the frame resized (area filter) to the network's input (width, height), or with a
+    ``view`` its window of the frame (``detect.view``)."""
     width, height = input_size
-    if rgb.shape[1] != width or rgb.shape[0] != height:
+    if view is not None:
+        rgb = view_input(rgb, view, input_size)
+    elif rgb.shape[1] != width or rgb.shape[0] != height:
         rgb = np.asarray(cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA), np.uint8)
     chw = np.ascontiguousarray(rgb.transpose(2, 0, 1), dtype=np.float32)
     return np.multiply(chw, np.float32(1.0 / 255.0), dtype=np.float32)
@@ -99,9 +103,13 @@ def decode_outputs(spec: ModelSpec, outputs: dict[str, FloatArray], index: int =
 
 
 def lanes_of(spec: ModelSpec, lines: list[LaneLine | None], h_samples: Sequence[float],
-             size: tuple[int, int]) -> list[list[int]]:
-    """TuSimple lanes at ``h_samples`` of an image of ``size`` from decoded lane slots."""
+             size: tuple[int, int], view: View | None = None) -> list[list[int]]:
+    """TuSimple lanes at ``h_samples`` of an image of ``size`` from decoded lane slots (read through ``view``'s
+    window of the image when given)."""
     reach = anchor_reach(spec.anchor_rows)
+    if view is not None:
+        lines = [None if line is None else view.to_frame(line) for line in lines]
+        reach *= view.window[3] - view.window[1]
     return tusimple_lanes(lines, h_samples, size, reach)
 
 
@@ -121,11 +129,17 @@ def inference_session(onnx_path: Path, threads: int = 0):  # noqa: ANN201 - onnx
 
 
 class LearnedDetector:
-    """An ONNX lane detector: ``detector(rgb, h_samples)`` -> TuSimple lanes in the frame's own pixels."""
+    """An ONNX lane detector: ``detector(rgb, h_samples)`` -> TuSimple lanes in the frame's own pixels.
+
+    A model folder with a ``view.json`` (``lanevil adapt --method view``) is shown that window of every frame."""
 
     def __init__(self, model_dir: str | Path, threads: int = 0) -> None:
         self.model_dir = Path(model_dir)
         self.spec = ModelSpec.load(self.model_dir)
+        try:
+            self.view = View.load(self.model_dir)
+        except ViewError as error:
+            raise ModelSpecError(str(error)) from None
         onnx_path = self.model_dir / ONNX_FILE
         if not onnx_path.is_file():
             raise ModelSpecError(f"{self.model_dir}: no {ONNX_FILE}")
@@ -135,18 +149,18 @@ class LearnedDetector:
 
     def outputs(self, rgb: UInt8Array) -> dict[str, FloatArray]:
         """The network's named outputs for one frame (batch of one)."""
-        batch = network_input(rgb, self.spec.input_size)[None]
+        batch = network_input(rgb, self.spec.input_size, self.view)[None]
         with self._lock:
             values = self._session.run(self._names, {"image": batch})
         return dict(zip(self._names, values, strict=True))
 
     def lines(self, rgb: UInt8Array) -> list[LaneLine | None]:
-        """The decoded lane slots of one frame (normalised image coordinates)."""
+        """The decoded lane slots of one frame (normalised coordinates of the network's input)."""
         return decode_outputs(self.spec, self.outputs(rgb))
 
     def __call__(self, rgb: UInt8Array, h_samples: list[int]) -> list[list[int]]:
         height, width = rgb.shape[:2]
-        return lanes_of(self.spec, self.lines(rgb), h_samples, (width, height))
+        return lanes_of(self.spec, self.lines(rgb), h_samples, (width, height), self.view)
 
 
 @functools.lru_cache(maxsize=8)

@@ -5,4 +5,4 @@ package imports torch.
 """
 
 # The methods of ``lanevil adapt`` (``learn/adapt.py``), here so that the command line offers them without torch.
-ADAPT_METHODS = ("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann", "dann+self-train")
+ADAPT_METHODS = ("adabn", "self-train", "adabn+self-train", "dann", "adabn+dann", "dann+self-train", "view")

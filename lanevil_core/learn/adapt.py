@@ -1,6 +1,8 @@
 """``lanevil adapt``: adapt a trained detector to a user's own unlabelled footage (a folder of their frames).
 
-Three methods (``--method``), combined as named:
+Three methods that change the weights (``--method``), combined as named, and one that does not (``view``,
+``learn/view.py``: the window of the user's camera that shows the model the view it was trained on; a model
+adapted so keeps its window through a later adaptation, which then reads the frames through it):
 
 - **AdaBN** (Li et al., "Revisiting Batch Normalization For Practical Domain Adaptation"): every batch-norm layer's
   running mean and variance are estimated again, as a cumulative average over the user's frames, with the weights
@@ -42,7 +44,8 @@ from torch.utils.data import DataLoader
 from ..detect.lane_slots import LaneLine, mirror_slots, tusimple_lanes
 from ..detect.learned import decode_outputs
 from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_FILE, ModelSpec
-from ..detect.split import IMAGE_SUFFIXES, read_rgb
+from ..detect.split import read_rgb
+from ..detect.view import View, view_input
 from ..files import write_atomic
 from ..labels.lanes import TUSIMPLE_H_SAMPLES
 from . import ADAPT_METHODS
@@ -51,8 +54,9 @@ from .data import LabelledFrames, _Frames, read_splits, resized
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
+from .view import frame_files
 
-METHODS = ADAPT_METHODS
+METHODS = tuple(method for method in ADAPT_METHODS if method != "view")  # view: learn.view.adapt_view, no torch
 
 
 class AdaptError(ValueError):
@@ -88,15 +92,6 @@ class AdaptSettings:
             raise AdaptError(f"--source: only with a dann method (not {self.method})")
         if self.domain_weight < 0:
             raise AdaptError(f"--domain-weight {self.domain_weight:g}: must be at least 0")
-
-
-def frame_files(folders: tuple[Path, ...], max_frames: int) -> list[Path]:
-    """The image files under ``folders`` (sorted), thinned evenly to ``max_frames``."""
-    files = sorted(path for folder in folders for path in folder.rglob("*")
-                   if path.is_file() and path.suffix.lower() in IMAGE_SUFFIXES)
-    if len(files) > max_frames:
-        files = [files[int(i)] for i in np.linspace(0, len(files) - 1, max_frames).round()]
-    return files
 
 
 def adapt_batch_norm(model: LaneNet, images: np.ndarray, device: torch.device, batch: int = 32) -> int:
@@ -195,7 +190,9 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     if not files:
         raise AdaptError("--frames: no png or jpg images under " + ", ".join(str(f) for f in settings.frames))
     started = time.perf_counter()
-    images = np.stack([resized(read_rgb(path), spec.input_size) for path in files])
+    view = View.load(settings.model)  # a model adapted with --method view keeps its window, and learns through it
+    images = np.stack([resized(read_rgb(path), spec.input_size) if view is None else
+                       view_input(read_rgb(path), view, spec.input_size) for path in files])
     model = build_model(spec)
     state = torch.load(weights, map_location="cpu", weights_only=True)
     model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in state.items()})
@@ -220,6 +217,8 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     write_atomic(out / CONFIG_FILE, spec.to_json().encode("utf-8"))
     _save({k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}, out / WEIGHTS_FILE)
     export_onnx(model, out / ONNX_FILE)
+    if view is not None:
+        view.save(out)
     summary.update(spec=asdict(spec), seconds=round(time.perf_counter() - started, 1), torch=torch.__version__)
     write_atomic(out / TRAINING_FILE, (json.dumps(summary, indent=2) + "\n").encode("utf-8"))
     return summary
