@@ -3,7 +3,8 @@ measured view, against the whole frame, and against the view measured from the l
 do).
 
 A ``lanevil dataset --vary-world --heldout`` split draws a camera per case (its fov, height, pitch, yaw and roll
-outside the train ranges) and renders 5 frames of each; a case's frames are one camera. Per case the view is
+outside the train ranges) and renders 5 frames of each; a case's frames are one camera. A split rendered through
+a car-height preset (``--vary-world --camera tusimple`` or ``dashcam``) asks the same of real cameras' geometry. Per case the view is
 measured from the reference detector's readings of its frames (``--reference``, no label read) and, for scale, from
 its labels; every model then reads the case's frames through each. Scored with the ego line match and TuSimple
 accuracy over the whole split. Synthetic frames only: this is what chooses whether and how the view is used.
@@ -48,8 +49,6 @@ def main() -> None:
     height, width = next(iter(images.values())).shape[:2]
     aspect = height / width
 
-    manifest = json.loads((args.split.parent / "manifest.json").read_text())
-    sources = {entry["case"]: entry["source"] for entry in manifest["cases"]}
     reference = LearnedDetector(shipped_model_dir(args.reference))
     views: dict[str, dict[str, View | None]] = {}
     for case, frames in cases.items():
@@ -65,7 +64,8 @@ def main() -> None:
             views[case][f"{mode}-vp"] = None if found_view is None or found_view.vanishing is None else \
                 View(window_for(found_view.vanishing, None), found_view.vanishing, None, found_view.frames)
         measured = views[case]["measured"]
-        wedge = aspect * sources[case]["lane_width"] / sources[case]["camera"]["z"]
+        case_file = json.loads((args.split / case / "case.json").read_text())  # the camera as rendered
+        wedge = aspect * case_file["road"]["lane_width"] / case_file["camera"]["z"]
         views[case]["measured-vp+height"] = None if measured is None or measured.vanishing is None else \
             View(window_for(measured.vanishing, wedge), measured.vanishing, wedge, measured.frames)
     found = {mode: sum(views[c][mode] is not None for c in cases) for mode in ("measured", "labels")}
