@@ -65,9 +65,10 @@ def preset_values(name: str) -> dict[str, dict[str, float]]:
 # fills these fields; fields given beside the preset win.
 CAMERA_PRESETS: Final[dict[str, dict[str, Any]]] = {
     # The paper's CARLA capture camera (1280x720, 90 deg, 1 m ahead and 3 m up, level) through CARLA's RGB camera
-    # post-processing: histogram auto-exposure, filmic tone curve, motion blur over a 1/200 s shutter.
+    # post-processing: histogram auto-exposure, filmic tone curve, motion blur over a 1/200 s shutter. No sensor
+    # noise: CARLA's RGB camera has no noise or grain attribute, so its frames carry none.
     "carla": {"width": 1280, "height": 720, "fov": 90.0, "x": 1.0, "y": 0.0, "z": 3.0, "pitch": 0.0,
-              "sensor": {"shutter": 0.005, "vignetting": 0.25, "noise": 0.6}},
+              "sensor": {"shutter": 0.005, "vignetting": 0.25, "noise": 0.0}},
     # A highway front camera behind the windscreen as in TuSimple's 1280x720 frames: the vanishing point near row
     # 290, about 62 deg across, a little barrel distortion, no bonnet in view.
     "tusimple": {"width": 1280, "height": 720, "fov": 62.0, "x": 1.6, "y": 0.0, "z": 1.55, "pitch": 3.5,

@@ -137,7 +137,8 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
                   bands: int) -> None:
     """Develops the rows of one band in five sweeps of a row: each pixel's streak (``_streak_row``, on whole
     vectors of pixels); its radiance (its streak's mean, else blended with its neighbours on an object edge, else
-    its own); its noise deviates; the sensor's arithmetic, on whole vectors of pixels; the tone curve's table
+    its own); its noise deviates (none drawn when ``shot`` and ``read`` are both 0: the deviates stay 0, so the
+    frame carries exactly no noise); the sensor's arithmetic, on whole vectors of pixels; the tone curve's table
     reads."""
     height, width, _ = hdr.shape
     depth, blur_cx, blur_cy, travel = streaks
@@ -148,7 +149,8 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
     mask = np.uint64(normals.size - 1)
     bits = np.uint64(NOISE_TABLE_BITS)
     radiance = np.empty(width * 3, np.float64)
-    noise = np.empty(width * 3, np.float64)
+    noise = np.zeros(width * 3, np.float64)
+    drawn = width if shot > 0.0 or read > 0.0 else 0  # columns whose deviates are drawn: none without noise
     index = np.empty(width * 3, np.uint16)  # unsigned: the table reads need no check for negative indices
     on_edge = np.zeros(width, np.bool_)
     taps, start_x, start_y, step_x, step_y = _streak_buffers(width)  # no streaks: every pixel stays sharp
@@ -168,7 +170,7 @@ def _develop_rows(hdr: np.ndarray, ids: np.ndarray, streaks: Streaks, gain: floa
             radiance[3 * col + 1] = g
             radiance[3 * col + 2] = b
         pixel = np.uint64(row * width)
-        for col in range(width):  # three table reads per pixel from one hash
+        for col in range(drawn):  # three table reads per pixel from one hash
             h = _hash(seed + (pixel + np.uint64(col)) * np.uint64(0x9E3779B97F4A7C15))
             noise[3 * col] = normals[h & mask]
             noise[3 * col + 1] = normals[(h >> bits) & mask]

@@ -236,6 +236,31 @@ def test_sensor_noise_has_the_modelled_sigma_and_independent_channels() -> None:
     assert np.array_equal(out, again)
 
 
+def test_a_sensor_without_noise_develops_a_flat_field_flat_for_any_seed() -> None:
+    """With shot and read noise 0 the sensor adds exactly nothing: every pixel of a flat field is the tone curve's
+    value of its level, whatever the seed."""
+    from lanevil_core.camera.sensor import TONE_LUT_SIZE
+    from lanevil_core.render.develop import develop
+
+    level = 0.4
+    hdr = np.full((90, 160, 3), level, np.float32)
+    linear = np.round(np.linspace(0.0, 255.0, TONE_LUT_SIZE)).astype(np.uint8)
+    frames = []
+    for seed in (11, 12):
+        out = np.empty(hdr.shape, np.uint8)
+        develop(hdr, 1.0, np.ones(3), 0.0, (80.0, 45.0), 0.0, 0.0, 1.0, seed, linear, out)
+        frames.append(out)
+    assert np.all(frames[0] == linear[round(level * (TONE_LUT_SIZE - 1))]) and np.array_equal(frames[0], frames[1])
+
+
+def test_the_papers_camera_has_no_sensor_noise_and_real_cameras_do() -> None:
+    """CARLA's RGB camera has no noise attribute: the ``carla`` preset's sensor adds none; the other presets stand
+    for real cameras and keep theirs."""
+    for name in CAMERA_PRESET_NAMES:
+        sensor = Camera.model_validate({"preset": name}).sensor
+        assert sensor is not None and (sensor.noise == 0.0) == (name == "carla"), name
+
+
 def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: Callable[..., Case]) -> None:
     """A metered camera shows sun-lit asphalt bright and its shadow dark: the ratio of the two is lower than the
     ideal render's, as on a photograph."""
