@@ -21,9 +21,9 @@ from ..world.environment import (
     sun_direction,
 )
 from ..world.primitives import pose_on_road, transformed
-from ..world.props import car, van
 from ..world.scene import PointLight, SurfaceLayer
 from ..world.structures import streetlight, streetlight_lamp_offset
+from ..world.vehicles import car, van
 from .base import RGB, Category, CompileContext, Illusion, Level, register
 
 PUDDLE_TEXEL_M = 0.1

@@ -22,7 +22,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, StrictBool, StrictFloat, StrictInt, field_validator
 
-from ..world import props
+from ..world import people, vehicles
 from ..world.primitives import pose_on_road, rotation_z, transformed
 from ..world.scene import Mesh
 from ..world.user_meshes import (  # noqa: F401  # the user-mesh names as this module has always offered them
@@ -295,7 +295,7 @@ class Pedestrian(TrafficIllusion):
         def person(index: int) -> Mesh:
             shirt = None if not self.shirt_colors else self.shirt_colors[index % len(self.shirt_colors)]
             height = self.height * float(rng.uniform(0.94, 1.06))
-            return props.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
+            return people.pedestrian(rng, shirt=shirt, height=height, walking=crossing)
 
         self.add_crowd(ctx, self.nested_crowd(ctx, rng, yaw_of), person, follow_grade=False)
 
@@ -339,7 +339,7 @@ class Bicycle(TrafficIllusion):
 
         def cyclist(index: int) -> Mesh:
             color = None if not self.frame_colors else self.frame_colors[index % len(self.frame_colors)]
-            return props.bicycle_with_rider(rng, frame_color=color)
+            return people.bicycle_with_rider(rng, frame_color=color)
 
         self.add_crowd(ctx, self.nested_crowd(ctx, rng, yaw_of), cyclist)
 
@@ -475,10 +475,10 @@ class Vehicle(TrafficIllusion):
         palette = self.colors or VEHICLE_COLORS
         color = palette[index % len(palette)] if self.colors else palette[int(rng.integers(len(palette)))]
         if kind == "truck":
-            return props.truck(color, lights_on=self.lights_on)
+            return vehicles.truck(color, lights_on=self.lights_on)
         if kind == "van":
-            return props.van(color, lights_on=self.lights_on)
-        return props.car(color, lights_on=self.lights_on)
+            return vehicles.van(color, lights_on=self.lights_on)
+        return vehicles.car(color, lights_on=self.lights_on)
 
 
 def scaled_to(mesh: Mesh, size: tuple[float, float, float]) -> Mesh:

@@ -1,2 +1,2 @@
-"""The world a case compiles into: road geometry and layout, the road mesh and paint, roadside props, vegetation
-and structures, the environment, and the compiled scene's types."""
+"""The world a case compiles into: road geometry and layout, the road mesh and paint, roadside props (street
+furniture, vehicles, people, buildings), vegetation and structures, the environment, and the compiled scene's types."""

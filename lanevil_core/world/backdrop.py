@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..typed import FloatArray
-from . import props
+from . import buildings, props
 from .facade import BRICK, RENDER, wall_finish
 from .facade import LEAVES as LEAVES_FINISH
 from .primitives import merge, pick, pose_on_road, transformed, with_finish
@@ -387,7 +387,7 @@ def house_shell(rng: np.random.Generator, width: float) -> Mesh:
     depth, eaves = float(rng.uniform(7.0, 10.0)), float(rng.uniform(3.0, 6.0))
     ridge = eaves + float(rng.uniform(0.3, 0.5)) * depth
     _, wall = wall_finish(rng, (BRICK, RENDER), (0.5, 0.5))  # far away: the finish's colour, not its courses
-    roof = pick(rng, props.ROOFS) * float(rng.uniform(0.8, 1.3))
+    roof = pick(rng, buildings.ROOFS) * float(rng.uniform(0.8, 1.3))
     gable = [(0.0, -0.5), (depth, -0.5), (depth, eaves), (depth / 2, ridge), (0.0, eaves)]
     vertices = [(x, y, z) for x in (0.0, width) for y, z in gable]  # 0-4 one end, 5-9 the other
     faces = [(0, 5, 9), (0, 9, 4), (4, 9, 8), (4, 8, 3)]  # the front wall, the roof's front slope

@@ -213,6 +213,15 @@ def quad(corners: PointsLike, color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     return to_mesh(trimesh.Trimesh(corners, [[0, 1, 2], [0, 2, 3]], process=False), color, **kw)
 
 
+def facing_quad(corners: PointsLike, outward: ColorLike, color: ColorLike, **kw) -> Mesh:
+    """A one-sided quad over (4, 3) ``corners`` (in order around it) facing ``outward`` (3,)."""
+    corners = np.asarray(corners, np.float64)
+    normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+    if np.dot(normal, outward) < 0:
+        corners = corners[::-1]
+    return quad(corners, color, **kw)
+
+
 def beam(p0: ColorLike, p1: ColorLike, width: float, depth: float | None = None,
          color: ColorLike = (0.2, 0.2, 0.2), **kw) -> Mesh:
     """A box of cross-section ``width`` x ``depth`` running from ``p0`` to ``p1`` (both (3,))."""

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..typed import FloatArray, SceneKind
-from . import props, vegetation
+from . import buildings, people, props, vegetation, vehicles
 from .primitives import merge, pose_on_road, swept, transformed
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh, PointLight
@@ -387,7 +387,7 @@ def passers_by(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, r
             t = side * (kerb[0] + float(rng.uniform(0.9, width - 0.5)))
             walking = bool(rng.random() < WALKING_SHARE)
             yaw = float(rng.choice([0.0, np.pi])) if walking else float(rng.uniform(-np.pi, np.pi))
-            person = props.pedestrian(own_rng(rng), height=float(rng.uniform(1.55, 1.9)), walking=walking)
+            person = people.pedestrian(own_rng(rng), height=float(rng.uniform(1.55, 1.9)), walking=walking)
             T_world_local = pose_on_road(piece.line, float(s), t, yaw, kerb[1])
             if not clear.on_road(T_world_local[None, :2, 3], margin=0.8, skip=0):
                 placed.append((float(s), transformed(person, T_world_local)))
@@ -423,7 +423,7 @@ def parked_cars(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, 
         placed: list[tuple[float, Mesh]] = []
         s = piece.s_start + float(rng.uniform(0.0, 6.0))
         while s < piece.line.length and occupancy > 0:
-            length, width, build = props.parked_vehicle(own_rng(rng))
+            length, width, build = vehicles.parked_vehicle(own_rng(rng))
             parks = rng.random() < occupancy
             gap = float(rng.uniform(*(DRIVEWAY_GAP_M if rng.random() < DRIVEWAY_SHARE else PARKED_GAP_M)))
             t = side * (corridor_half_width(piece) + PARKED_SETBACK_M + width / 2)
@@ -597,7 +597,7 @@ def _urban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
         width, depth = float(r.uniform(12.0, 28.0)), float(r.uniform(10.0, 18.0))
         height = float(r.choice([9.6, 12.8, 16.0, 19.2, 25.6]))
         shop = bool(r.random() < 0.5)
-        return width, depth, lambda: props.building(r, width, depth, height, shopfront=shop, lit=night)
+        return width, depth, lambda: buildings.building(r, width, depth, height, shopfront=shop, lit=night)
 
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
     if density > 0:  # a few street trees first, parked cars between them; the blocks fill the frontage behind
@@ -618,7 +618,7 @@ def _suburban(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Gener
 
     def home(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(8.0, 14.0)), float(r.uniform(7.0, 10.0))
-        return width, depth, lambda: props.house(r, width, depth, lit=night)
+        return width, depth, lambda: buildings.house(r, width, depth, lit=night)
 
     meshes = streetlights(network, clear, STREETLIGHT_SPACING_M, emissive=night)
     meshes += parked_cars(inputs, network, clear, own_rng(rng))  # on the verge; the trees and houses around them
@@ -646,7 +646,7 @@ def _rural(inputs: RoadsideInputs, network: RoadNetwork, rng: np.random.Generato
 
     def farm(r: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:
         width, depth = float(r.uniform(9.0, 16.0)), float(r.uniform(7.0, 11.0))
-        return width, depth, lambda: props.house(r, width, depth, storeys=1, lit=night, name="farmhouse")
+        return width, depth, lambda: buildings.house(r, width, depth, storeys=1, lit=night, name="farmhouse")
 
     meshes = utility_lines(inputs, network, clear, own_rng(rng), (1.0, 2.5), clear_under=True)
     meshes += greenery(inputs, network, clear, rng, 10.0 / density, (1.0, 30.0), bush_share=0.45)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.case import Road
-from lanevil_core.world import facade, props, vegetation
+from lanevil_core.world import buildings, facade, people, props, vegetation, vehicles
 from lanevil_core.world.primitives import box, cylinder, loft, merge, pose_on_road, prism, transformed
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.scene import Mesh
@@ -47,10 +47,10 @@ RNG = np.random.default_rng
 
 # (builder, expected length x width x height in m, tolerance)
 SIZED = {
-    "car": (lambda: props.car(), (4.5, 1.8, 1.45), 0.12),
-    "van": (lambda: props.van(), (5.2, 2.0, 2.3), 0.12),
-    "truck": (lambda: props.truck(), (8.0, 2.5, 3.4), 0.15),
-    "bicycle": (lambda: props.bicycle_with_rider(RNG(0)), (1.8, 0.55, 1.75), 0.12),
+    "car": (lambda: vehicles.car(), (4.5, 1.8, 1.45), 0.12),
+    "van": (lambda: vehicles.van(), (5.2, 2.0, 2.3), 0.12),
+    "truck": (lambda: vehicles.truck(), (8.0, 2.5, 3.4), 0.15),
+    "bicycle": (lambda: people.bicycle_with_rider(RNG(0)), (1.8, 0.55, 1.75), 0.12),
 }
 
 
@@ -74,7 +74,7 @@ def test_vehicles_wind_faces_outwards(name: str) -> None:
 
 
 def test_vehicle_lights_glow_only_when_on() -> None:
-    dark, lit = props.car(), props.car(lights_on=True)
+    dark, lit = vehicles.car(), vehicles.car(lights_on=True)
     assert dark.emission is None
     assert lit.emission is not None and lit.emission.shape == (len(lit.faces), 3)
     glowing = lit.emission.max(1) > 0
@@ -85,7 +85,7 @@ def test_vehicle_lights_glow_only_when_on() -> None:
 
 
 def test_vehicle_body_colour_and_dark_glass() -> None:
-    car = props.car((0.5, 0.0, 0.0))
+    car = vehicles.car((0.5, 0.0, 0.0))
     share_body = np.mean(np.all(np.isclose(car.colors, (0.5, 0.0, 0.0)), axis=1))
     assert share_body > 0.05
     tri = car.vertices[car.faces]
@@ -95,22 +95,22 @@ def test_vehicle_body_colour_and_dark_glass() -> None:
 
 def test_pedestrian_is_a_person_sized_standing_figure() -> None:
     for walking in (False, True):
-        person = props.pedestrian(RNG(3), walking=walking)
+        person = people.pedestrian(RNG(3), walking=walking)
         assert_renderable(person)
         size = extents(person)
         assert abs(size[2] - 1.75) < 0.03
         assert 0.4 < size[1] < 0.8 and size[0] < (1.0 if walking else 0.45)
         assert abs(person.vertices[:, 2].min()) < 0.01
-    tall = props.pedestrian(RNG(3), height=1.9)
+    tall = people.pedestrian(RNG(3), height=1.9)
     assert abs(extents(tall)[2] - 1.9) < 0.03
 
 
 def test_pedestrian_colours_come_from_rng_or_arguments() -> None:
-    a, b = props.pedestrian(RNG(1)), props.pedestrian(RNG(1))
+    a, b = people.pedestrian(RNG(1)), people.pedestrian(RNG(1))
     np.testing.assert_array_equal(a.colors, b.colors)
-    shirts = {tuple(props.pedestrian(RNG(seed)).colors.max(0).round(3)) for seed in range(8)}
+    shirts = {tuple(people.pedestrian(RNG(seed)).colors.max(0).round(3)) for seed in range(8)}
     assert len(shirts) > 2
-    red = props.pedestrian(RNG(1), shirt=(0.9, 0.0, 0.0))
+    red = people.pedestrian(RNG(1), shirt=(0.9, 0.0, 0.0))
     assert np.any(np.all(np.isclose(red.colors, (0.9, 0.0, 0.0)), axis=1))
 
 
@@ -142,7 +142,7 @@ def test_leaves_are_marked_for_the_renderer_and_bark_is_not() -> None:
 
 
 def test_a_house_roof_is_tiled_up_its_slopes() -> None:
-    roof = props.gable_roof(5.3, 4.4, 5.75, 3.0, props.ROOFS[0])
+    roof = buildings.gable_roof(5.3, 4.4, 5.75, 3.0, buildings.ROOFS[0])
     assert roof.finish is not None and roof.uv is not None
     tiled = roof.finish == facade.TILES
     assert tiled.sum() == 4  # two slopes, two triangles each; the soffit and gable ends stay plain
@@ -151,23 +151,23 @@ def test_a_house_roof_is_tiled_up_its_slopes() -> None:
         z, v = roof.vertices[face, 2], roof.uv[face, 1]
         np.testing.assert_allclose(v, np.where(z > 5.75 + 1e-6, slope, 0.0), atol=1e-5)  # up from the eaves
         np.testing.assert_allclose(roof.uv[face, 0], roof.vertices[face, 0], atol=1e-5)  # along them
-    home = props.house(RNG(2), 10.0, 8.0)
+    home = buildings.house(RNG(2), 10.0, 8.0)
     assert home.finish is not None and (home.finish == facade.TILES).sum() == 4
 
 
 def test_building_and_house_fill_their_footprint() -> None:
-    block = props.building(RNG(0), 20.0, 12.0, 16.0, shopfront=True)
+    block = buildings.building(RNG(0), 20.0, 12.0, 16.0, shopfront=True)
     assert_renderable(block)
     np.testing.assert_allclose(extents(block), (20.5, 12.5, 16.9), atol=0.1)  # cornice, footing
     assert outward_share(block) > 0.85  # all but the parapet's underside
     tri = block.vertices[block.faces]
     on_pane = (np.abs(np.abs(tri[..., 1]) - 6.02) < 1e-6).all(1) | (np.abs(np.abs(tri[..., 0]) - 10.02) < 1e-6).all(1)
     assert on_pane.sum() >= 2 * 2 * 4 * 5  # a grid of window panes (two triangles each) on the facades
-    sills = (np.abs(np.abs(tri[..., 1]) - 6.0 - props.SILL_DEPTH_M) < 1e-6).any(1) \
-        | (np.abs(np.abs(tri[..., 0]) - 10.0 - props.SILL_DEPTH_M) < 1e-6).any(1)
+    sills = (np.abs(np.abs(tri[..., 1]) - 6.0 - buildings.SILL_DEPTH_M) < 1e-6).any(1) \
+        | (np.abs(np.abs(tri[..., 0]) - 10.0 - buildings.SILL_DEPTH_M) < 1e-6).any(1)
     assert sills.sum() == on_pane.sum()  # each with a sill jutting out under it
     assert len(np.unique(block.colors[on_pane].round(4), axis=0)) > 10  # panes show the sky, rooms, curtains
-    home = props.house(RNG(1), 10.0, 8.0, storeys=2)
+    home = buildings.house(RNG(1), 10.0, 8.0, storeys=2)
     size = extents(home)
     assert 10.0 <= size[0] < 11.0 and 8.0 <= size[1] < 9.0 and 7.0 < size[2] < 10.0
 
@@ -176,7 +176,7 @@ def test_building_faces_carry_their_finish_and_facade_coordinates() -> None:
     walls, shops, doors = set(), 0, 0
     for seed in range(12):
         shop = seed % 2 == 0
-        block = props.building(RNG(seed), 20.0, 12.0, 16.0, shopfront=shop)
+        block = buildings.building(RNG(seed), 20.0, 12.0, 16.0, shopfront=shop)
         assert block.finish is not None and block.uv is not None
         assert block.finish.shape == (len(block.faces),) and block.uv.shape == (len(block.vertices), 2)
         tri = block.vertices[block.faces]
@@ -199,12 +199,12 @@ def test_building_faces_carry_their_finish_and_facade_coordinates() -> None:
             doors += int(front.sum() >= 2)
     assert walls == set(facade.WALL_FINISHES)  # brick, render and panels all occur
     assert shops == 6 and doors == 6  # every shop has its window, every other block its door
-    np.testing.assert_array_equal(props.building(RNG(5), 20.0, 12.0, 16.0).uv,
-                                  props.building(RNG(5), 20.0, 12.0, 16.0).uv)  # deterministic
+    np.testing.assert_array_equal(buildings.building(RNG(5), 20.0, 12.0, 16.0).uv,
+                                  buildings.building(RNG(5), 20.0, 12.0, 16.0).uv)  # deterministic
 
 
 def test_merge_and_transform_keep_the_finish() -> None:
-    block = props.building(RNG(2), 14.0, 10.0, 9.6)
+    block = buildings.building(RNG(2), 14.0, 10.0, 9.6)
     plain = box((1.0, 1.0, 1.0))
     both = merge([plain, block])
     assert both.finish is not None and both.uv is not None
@@ -236,7 +236,7 @@ def test_tunnel_portal_keeps_its_opening_clear() -> None:
 
 
 def test_props_are_deterministic() -> None:
-    for build in (vegetation.tree, vegetation.bush, props.pedestrian, props.bicycle_with_rider, props.house):
+    for build in (vegetation.tree, vegetation.bush, people.pedestrian, people.bicycle_with_rider, buildings.house):
         a, b = build(RNG(7)), build(RNG(7))
         np.testing.assert_array_equal(a.vertices, b.vertices)
         np.testing.assert_array_equal(a.colors, b.colors)
@@ -263,8 +263,8 @@ def test_pose_on_road_stands_upright_along_the_heading() -> None:
         heading = float(line.heading_at(s)) + 0.3
         np.testing.assert_allclose(T[:3, 0], (np.cos(heading), np.sin(heading), 0.0), atol=1e-12)
         np.testing.assert_allclose(T[:3, 3], line.to_world(s, -3.0, 0.1))
-    car = transformed(props.car(), pose_on_road(line, 100.0, -1.75))
-    assert signed_volume(car) == pytest.approx(signed_volume(props.car()))
+    car = transformed(vehicles.car(), pose_on_road(line, 100.0, -1.75))
+    assert signed_volume(car) == pytest.approx(signed_volume(vehicles.car()))
 
 
 def test_primitives_reuse_their_geometry_and_hand_out_meshes_of_their_own() -> None:
@@ -289,8 +289,8 @@ def test_primitives_reuse_their_geometry_and_hand_out_meshes_of_their_own() -> N
 
 
 @pytest.mark.parametrize(("build", "half"), [
-    (lambda rng, lit: props.building(rng, 22.0, 12.0, 19.2, shopfront=True, lit=lit), (11.0, 6.0)),
-    (lambda rng, lit: props.house(rng, 11.0, 8.0, storeys=2, lit=lit), (5.5, 4.0))])
+    (lambda rng, lit: buildings.building(rng, 22.0, 12.0, 19.2, shopfront=True, lit=lit), (11.0, 6.0)),
+    (lambda rng, lit: buildings.house(rng, 11.0, 8.0, storeys=2, lit=lit), (5.5, 4.0))])
 def test_lit_windows_glow_at_night_only(build, half) -> None:
     day, night = build(RNG(3), False), build(RNG(3), True)
     assert day.emission is None
@@ -309,7 +309,7 @@ def test_lit_windows_glow_at_night_only(build, half) -> None:
 def test_lit_share_varies_from_building_to_building() -> None:
     shares = []
     for seed in range(6):
-        night = props.house(RNG(seed), 12.0, 8.0, storeys=2, lit=True)
+        night = buildings.house(RNG(seed), 12.0, 8.0, storeys=2, lit=True)
         assert night.emission is not None
         shares.append(int((night.emission.max(1) > 0).sum()))  # same house, same windows: a drawn share lit
     assert max(shares) > 2 * min(shares)
@@ -318,14 +318,14 @@ def test_lit_share_varies_from_building_to_building() -> None:
 def test_parked_vehicles_are_cheap_and_painted_from_the_palette() -> None:
     paints = set()
     for seed in range(40):
-        length, width, build = props.parked_vehicle(RNG(seed))
+        length, width, build = vehicles.parked_vehicle(RNG(seed))
         vehicle = build()
         assert_renderable(vehicle)
         assert len(vehicle.faces) <= 215 and vehicle.emission is None  # lights off
         size = extents(vehicle)
         assert abs(size[0] - length) < 0.1 and abs(size[1] - width) < 0.1 and vehicle.vertices[:, 2].min() > -1e-6
         body = vehicle.colors[0]
-        paints.add(int(np.argmin([np.abs(body / np.asarray(p) - 1.0).max() for p in props.CAR_PAINTS])))
+        paints.add(int(np.argmin([np.abs(body / np.asarray(p) - 1.0).max() for p in vehicles.CAR_PAINTS])))
     assert len(paints) >= 4  # white, black, grey, silver and more
 
 
