@@ -4,13 +4,15 @@ do).
 
 A ``lanevil dataset --vary-world --heldout`` split draws a camera per case (its fov, height, pitch, yaw and roll
 outside the train ranges) and renders 5 frames of each; a case's frames are one camera. A split rendered through
-a car-height preset (``--vary-world --camera tusimple`` or ``dashcam``) asks the same of real cameras' geometry. Per case the view is
-measured from the reference detector's readings of its frames (``--reference``, no label read) and, for scale, from
-its labels; every model then reads the case's frames through each. Scored with the ego line match and TuSimple
-accuracy over the whole split. Synthetic frames only: this is what chooses whether and how the view is used.
+a car-height preset (``--vary-world --camera tusimple`` or ``dashcam``) asks the same of real cameras' geometry.
+Per case the view is measured from the reference detector's readings of its frames (``--reference``, no label read)
+and, for scale, from its labels; every model then reads the case's frames through each. Scored with the ego line
+match and TuSimple accuracy over the whole split. Synthetic frames only: this is what chooses whether and how the
+view is used.
 
     .venv/bin/python experiments/view_heldout.py --split out/transfer/val-heldout/train \\
-        [--models ufld laneatt scnn bezier ganet seg seg-transfer] [--reference seg-transfer]
+        [--models ufld laneatt scnn bezier ganet seg seg-transfer NAME=MODEL_DIR] [--reference seg-transfer]
+        [--modes frame measured-vp+height]
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ def main() -> None:
     parser.add_argument("--models", nargs="+", default=["ufld", "laneatt", "scnn", "bezier", "ganet", "seg",
                                                         "seg-transfer"])
     parser.add_argument("--reference", default="seg-transfer")
+    parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
     records = read_tusimple(next(args.split.glob("*label*.json")), "gt")
@@ -78,9 +81,10 @@ def main() -> None:
 
     table: dict[str, dict[str, dict[str, float]]] = {}
     for name in args.models:
-        detector = LearnedDetector(shipped_model_dir(name))
-        table[name] = {}
-        for mode in MODES:
+        label, _, folder = name.partition("=")  # NAME=MODEL_DIR scores a model folder that is not shipped
+        detector = LearnedDetector(Path(folder) if folder else shipped_model_dir(name))
+        table[name.partition("=")[0]] = {}
+        for mode in args.modes:
             scores, accuracy = [], []
             for case, frames in cases.items():
                 view = views[case][mode]
@@ -93,11 +97,11 @@ def main() -> None:
                     scores.append(ego_line_match(record, pred, width))
                     accuracy.append(_accuracy(record, pred, width))
             summary = summarize_ego(scores)
-            table[name][mode] = {"ego": round(100 * summary.match_share, 1),
+            table[name.partition("=")[0]][mode] = {"ego": round(100 * summary.match_share, 1),
                                  "points": round(100 * summary.point_accuracy, 1),
                                  "accuracy": round(100 * float(np.mean(accuracy)), 1)}
-        row = "  ".join(f"{mode}: {v['ego']:4.1f}/{v['accuracy']:4.1f}" for mode, v in table[name].items())
-        print(f"{name:13s} {row}", flush=True)
+        row = "  ".join(f"{mode}: {v['ego']:4.1f}/{v['accuracy']:4.1f}" for mode, v in table[label].items())
+        print(f"{label:13s} {row}", flush=True)
     if args.json is not None:
         args.json.write_text(json.dumps({"views": {c: {m: (v.as_dict() if v else None) for m, v in vs.items()}
                                                    for c, vs in views.items()}, "table": table}, indent=2))
