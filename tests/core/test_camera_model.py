@@ -261,6 +261,28 @@ def test_the_papers_camera_has_no_sensor_noise_and_real_cameras_do() -> None:
         assert sensor is not None and (sensor.noise == 0.0) == (name == "carla"), name
 
 
+def test_the_papers_camera_adapts_over_two_stops_and_keeps_a_night_dark() -> None:
+    """CARLA's histogram auto-exposure adapts between EV 10 and 12 only: the ``carla`` preset's gain window is two
+    stops wide, so a night through it is metered no brighter than a dim day, darker than through the same sensor
+    with the default window; a clear noon is metered inside the window (unchanged)."""
+    from lanevil_core.camera.sensor import metered_gain
+    from lanevil_core.library.stock import original_case
+    from lanevil_core.pipeline.bench import with_camera
+
+    sensor = Camera.model_validate({"preset": "carla"}).sensor
+    assert sensor is not None and sensor.max_gain / sensor.min_gain == pytest.approx(4.0)
+    wide = sensor.model_copy(update={"min_gain": Sensor().min_gain, "max_gain": Sensor().max_gain})
+    for index, night in ((0, True), (4, False)):  # streetlight_reflection 0: a night; 4: a clear sunset
+        case = with_camera(original_case("streetlight_reflection", index), "carla")
+        rgb_carla, rgb_wide = (render_frame(compile_scene(case.model_copy(update={"camera": case.camera.model_copy(
+            update={"width": 320, "height": 180, "sensor": chosen})})), 30).rgb for chosen in (sensor, wide))
+        if night:
+            assert rgb_carla.mean() < 0.7 * rgb_wide.mean()
+        else:
+            assert np.array_equal(rgb_carla, rgb_wide)
+    assert metered_gain(np.full((16, 16, 3), 1e-4, np.float32), sensor) == sensor.max_gain
+
+
 def test_auto_exposure_darkens_shadows_relative_to_the_ideal_render(make_case: Callable[..., Case]) -> None:
     """A metered camera shows sun-lit asphalt bright and its shadow dark: the ratio of the two is lower than the
     ideal render's, as on a photograph."""
