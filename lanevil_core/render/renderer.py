@@ -22,6 +22,7 @@ from .bands import run_bands
 from .develop import NO_STREAKS, Streaks, develop, motion_blur
 from .ground import ground_table
 from .lighting import LIGHT_COLUMNS, face_sun_terms, light_row
+from .materials import surface_table
 from .packed import PackedScene, pack_scene
 from .post import SRGB_LUT, blur_columns, finish, glare
 from .raster import per_pixel, rasterize_perspective
@@ -34,7 +35,6 @@ from .shading import (
     frame_lighting,
     shade,
     shade_mirror,
-    surface_table,
 )
 from .shadow_map import CascadeCache, ShadowMaps, build_shadow_maps
 from .textures import noise_textures

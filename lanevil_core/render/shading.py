@@ -4,14 +4,16 @@ Inputs are the rasterizer's fragments; output is linear HDR radiance. World posi
 and the pixel's camera ray, road coordinates from the face's vertex (s, t) and the barycentric weights.
 
 The kernel walks each row once; what differs between road materials and objects (roughness, Fresnel, water
-film) comes from a table (``surface_table``), not from branches, and one lighting path serves both. (Separate
+film) comes from a table (``materials.surface_table``), not from branches, and one lighting path serves both. (Separate
 sweeps per row for sky, road and objects measured slower in this scalar code: 2 ms more for the sky's own sweep
 at 1280x720, more again with the lighting duplicated for roads and objects.)
 The sky is smooth away from the sun and the horizon, so a row's sky radiance is evaluated every ``SKY_STEP`` columns
 and interpolated (exact near the sun and across the horizon): at most one level of 255 apart from a per-pixel sky
 on 0.1 % of pixels, 2.5 ms less ``shade`` at 1280x720 on the clean cases.
 The inputs travel in a few named bundles (``View``, ``Geometry``, ``RoadLook``, ``Lighting``, ``SunShadow``,
-``Reflection``) and every step of a pixel is a small inlined helper.
+``Reflection``) and every step of a pixel is a small inlined helper: where the pixel lies (``pixel_geometry``),
+what its surface is made of (``materials``, paint and layers in ``surface``, ``facades``, ``ground``, ``foliage``)
+and the light it receives (``light_terms``, sky and shadows in ``lighting``).
 """
 
 from __future__ import annotations
@@ -20,76 +22,77 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
+from ..typed import Float32Array, FloatArray, IntArray
 from ..world.facade import GLASS as GLASS_FINISH
 from ..world.facade import LEAVES as LEAVES_FINISH
-from ..world.paint import MATERIAL_ALBEDO
 from ._jit import kernel
 from .bands import band_rows
-from .facades import cell_hash, facade, footway
+from .facades import facade, footway
 from .foliage import leaf_cosine, leaf_sky, leaf_transmission
 from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
+from .light_terms import blend, lamp_light, shade_lit, sun_lit
 from .lighting import (
-    BEAM_LOW,
     FOOTPRINT_TAP_TEXELS,
-    LIGHT_BEAM,
-    LIGHT_POWER,
-    LIGHT_R,
     RETROREFLECTION,
     SKY_AMBIENT_GAIN,
     SUN_BIAS,
     SUN_OFFSET,
     SUN_SCALE,
     WET_RETRO_LOSS,
-    beam_weight,
     fresnel_schlick,
-    glossy_lobe,
-    lobe_shape,
     sky_openness,
     sky_radiance,
     sun_visibility,
     sun_visibility_over,
 )
-from .surface import CHIP_TEXEL_M, RAGGED_STRETCH, RAGGED_TEXEL_M, dash_coverage, paint, sample_layers, sample_noise
+from .materials import (
+    ALBEDO_R,
+    ASPHALT,
+    CLUMP_TEXEL_M,
+    CONCRETE,
+    F0,
+    HOLDS_WATER,
+    KERB,
+    MID_TEXEL_M,
+    MIRROR_F0,
+    OBJECT_ROW,
+    PUDDLE_RAGGED,
+    PUDDLE_SHORE_TEXEL_M,
+    ROUGHNESS,
+    SLAB,
+    albedo,
+    clumps,
+    puddle_depth,
+    slab_joints,
+    wet_surface,
+)
+from .pixel_geometry import (
+    facade_footprint,
+    facing_normal,
+    gradients_camera,
+    mirrored_ray,
+    object_plane,
+    pixel_ray,
+    pixel_steps,
+    road_coordinates,
+    road_footprint,
+)
+from .surface import (
+    CHIP_TEXEL_M,
+    RAGGED_STRETCH,
+    RAGGED_TEXEL_M,
+    boundaries_near,
+    paint,
+    sample_layers,
+    sample_noise,
+)
 from .textures import COARSE_TEXEL_M, FINE_TEXEL_M
 
 # env_f layout
 SUN_I, AMBIENT, WETNESS, PUDDLES, FOG_DENSITY, FOG_DISTANCE, CLOUD, PENUMBRA, DETAIL = range(9)
-ASPHALT = MATERIALS.index("asphalt")
-SLAB = MATERIALS.index("slab")
-CONCRETE = MATERIALS.index("concrete")  # footways: paving flags
-KERB = MATERIALS.index("kerb")
-MIN_SLOPE_SINE = 0.2  # a facade coordinate's footprint up a face no flatter than this (12 deg roofs and steeper)
-PAVED = ("asphalt", "concrete", "kerb", "slab")  # hold a water film; grass, gravel and dirt soak it up
-# surface_table columns; its rows are the road MATERIALS, then one for every object
-ALBEDO_R, ALBEDO_G, ALBEDO_B, ROUGHNESS, F0, HOLDS_WATER, MIRROR_F0, GRAIN = range(8)
-FLAG_GRAIN = 0.4  # paving flags and kerb stones are smoother than asphalt: this share of its grain and stains
-OBJECT_ROW = len(MATERIALS)
 WET_FILM_MIRROR = 0.45  # a wet film mirrors less than standing water
-FOOTPRINT_SCALE = 0.75  # box-filter width in pixels' worth of road coordinate
-MAX_FOOTPRINT_M = 50.0
 FOG_LUT_SIZE = 8192
 FOG_LUT_PER_M = 4.0
-STANDING_WATER_ROUGHNESS = 0.03
-PUDDLE_RAGGED = 0.3  # share of the puddle noise that is a finer octave: ragged shores
-PUDDLE_SHORE_TEXEL_M = 0.12  # texel of that octave (m)
-PUDDLE_SHORE_SLOPE = 4.0  # standing water deepens from its shore over 1 / PUDDLE_SHORE_SLOPE of the noise
-CLUMP_TEXEL_M = 0.1  # photographic texture: texel of the clumps (leaves, tufts, stains; ~4 texels across) (m)
-MID_TEXEL_M = 0.03  # ... and of its grain (m)
-CLUMP_SHARPNESS = 4.0  # the clump noise is scaled and clipped to +-1: sharp-edged patches
-CLUMP_DEPTH = 0.6
-GRAIN_DEPTH = 0.35
-# Jointed plain concrete pavement (FHWA TA 5040.30: transverse joints at most about 15 ft apart; longitudinal
-# joints along the lane lines): sawn joints filled with dark sealant, a wider band of sealant smeared over them
-# (the "tar seams" of concrete roads and bridge decks), slabs whose concrete weathered slightly differently.
-JOINT_SPACING_M = 4.5
-JOINT_WIDTH_M = 0.012
-SEAM_WIDTH_M = 0.07
-SEAM_OPACITY = 0.6
-SEALANT_ALBEDO = 0.03
-SLAB_TONE = 0.08  # each slab's albedo differs from the pavement's by up to this share
-DRIP_HALF_WIDTH_M = 0.35  # the oil-drip stain down the middle of every lane (engines and gearboxes leak there)
-DRIP_DARKENING = 0.22
 CHIP_STRETCH = 0.4  # worn paint's chips run about 2.5 times longer along the line than across it
 CHIP_FLAKES = 0.55  # share of the chip noise that is flakes (the rest: longer worn and kept stretches)
 STAIN_TEXEL_M = 0.8  # broad weathering stains on walls (m)
@@ -130,7 +133,7 @@ class Geometry(NamedTuple):
 class RoadLook(NamedTuple):
     """What the road surface looks like: material table, paint, surface layers, noise and sky openness."""
 
-    surface: FloatArray  # (materials, 6) see surface_table()
+    surface: FloatArray  # (materials + 1, 8) see materials.surface_table()
     stripes: FloatArray
     stripe_index: np.ndarray
     lanes: float
@@ -179,22 +182,6 @@ class Reflection(NamedTuple):
     depth: Float32Array
 
 
-def surface_table(albedo: np.ndarray = MATERIAL_ALBEDO) -> FloatArray:
-    """(materials + 1, 8) float64 per road material, then for objects: albedo r, g, b (objects: their faces'),
-    roughness, Fresnel f0 of highlights, holds a water film (0/1), Fresnel f0 of the mirror image, the share of
-    asphalt's grain and stains it shows."""
-    table = np.zeros((OBJECT_ROW + 1, 8))
-    table[:, GRAIN] = 1.0
-    table[[CONCRETE, KERB], GRAIN] = FLAG_GRAIN
-    table[:OBJECT_ROW, ALBEDO_R:ALBEDO_B + 1] = albedo
-    table[:, ROUGHNESS], table[:, F0], table[:, MIRROR_F0] = 0.35, 0.04, 0.02
-    table[ASPHALT, ROUGHNESS], table[ASPHALT, F0] = 0.55, 0.02
-    table[SLAB, ROUGHNESS], table[SLAB, F0] = 0.6, 0.03
-    table[[MATERIALS.index(name) for name in PAVED], HOLDS_WATER] = 1.0
-    table[OBJECT_ROW, ROUGHNESS], table[OBJECT_ROW, MIRROR_F0] = 0.25, 0.05  # glossy paint
-    return table
-
-
 def fog_table(density: float, start_m: float) -> np.ndarray:
     """(FOG_LUT_SIZE,) float64 share of fog at distance (i + 0.5) / FOG_LUT_PER_M metres."""
     distance_m = (np.arange(FOG_LUT_SIZE) + 0.5) / FOG_LUT_PER_M
@@ -209,273 +196,6 @@ def frame_lighting(env_f: FloatArray, sun_dir: FloatArray, sun_color: FloatArray
     sun = SUN_SCALE * env_f[SUN_I] * sun_color
     return Lighting(env_f, sun_dir, sun_color, zenith, horizon, np.ascontiguousarray(lights, np.float64),
                     fog_table(env_f[FOG_DENSITY], env_f[FOG_DISTANCE]), ambient, fog_color, sun)
-
-
-@kernel(inline="always")
-def pixel_ray(R_world_camera: np.ndarray, x_cam: float, y_cam: float) -> tuple[float, float, float, float]:
-    """(dx, dy, dz, norm): the unit world direction through camera-plane point (x_cam, y_cam, 1) and that
-    point's length (camera z to distance along the ray)."""
-    R = R_world_camera
-    norm = np.sqrt(x_cam * x_cam + y_cam * y_cam + 1.0)
-    inv_norm = 1.0 / norm
-    dx = (R[0, 0] * x_cam + R[0, 1] * y_cam + R[0, 2]) * inv_norm
-    dy = (R[1, 0] * x_cam + R[1, 1] * y_cam + R[1, 2]) * inv_norm
-    dz = (R[2, 0] * x_cam + R[2, 1] * y_cam + R[2, 2]) * inv_norm
-    return dx, dy, dz, norm
-
-
-@kernel(inline="always")
-def facing_normal(normal: np.ndarray, f: int, dx: float, dy: float,
-                  dz: float) -> tuple[float, float, float, float]:
-    """(nx, ny, nz, n.v): the face's world normal turned towards the viewer (faces are two-sided)."""
-    nx, ny, nz = normal[f, 0], normal[f, 1], normal[f, 2]
-    n_dot_v = -(nx * dx + ny * dy + nz * dz)
-    if n_dot_v < 0.0:
-        return -nx, -ny, -nz, -n_dot_v
-    return nx, ny, nz, n_dot_v
-
-
-@kernel(inline="always")
-def gradients_camera(R_world_camera: np.ndarray, grad_st: np.ndarray,
-                     f: int) -> tuple[float, float, float, float, float, float]:
-    """The world gradients of s and of t on road face ``f`` in camera axes: (s_x, s_y, s_z, t_x, t_y, t_z)."""
-    R = R_world_camera
-    sx, sy, sz, tx, ty, tz = grad_st[f, 0], grad_st[f, 1], grad_st[f, 2], grad_st[f, 3], grad_st[f, 4], grad_st[f, 5]
-    return (sx * R[0, 0] + sy * R[1, 0] + sz * R[2, 0], sx * R[0, 1] + sy * R[1, 1] + sz * R[2, 1],
-            sx * R[0, 2] + sy * R[1, 2] + sz * R[2, 2], tx * R[0, 0] + ty * R[1, 0] + tz * R[2, 0],
-            tx * R[0, 1] + ty * R[1, 1] + tz * R[2, 1], tx * R[0, 2] + ty * R[1, 2] + tz * R[2, 2])
-
-
-@kernel(inline="always")
-def coordinate_step(g_x_cam: float, g_y_cam: float, g_z_cam: float, x_cam: float, y_cam: float, k_u: float,
-                    k_v: float, su: float, sv: float) -> float:
-    """How much a road coordinate with gradient g (camera axes) changes across one pixel: its steps along the
-    pixel's ray differentials u = su (x - r k_u) and v = sv (y - r k_v) on the face's plane, r = (x_cam, y_cam, 1)."""
-    g_dot_r = g_x_cam * x_cam + g_y_cam * y_cam + g_z_cam
-    step = abs(su * (g_x_cam - g_dot_r * k_u)) + abs(sv * (g_y_cam - g_dot_r * k_v))
-    return min(FOOTPRINT_SCALE * step + 1e-3, MAX_FOOTPRINT_M)
-
-
-@kernel(inline="always")
-def road_footprint(R_world_camera: np.ndarray, fx: float, fy: float,
-                   grad_cam: tuple[float, float, float, float, float, float], depth: float, norm: float,
-                   x_cam: float, y_cam: float, nx: float, ny: float, nz: float, n_dot_v: float) -> tuple[float, float]:
-    """(fs, ft): how much s and t change across the pixel, by ray differentials on the face's plane (exact for
-    the affine (s, t) of a road triangle); ``grad_cam`` is the face's ``gradients_camera``."""
-    R = R_world_camera
-    n_dot_r = -max(n_dot_v, 1e-4) * norm  # n faces the viewer, so n.ray < 0
-    k_u = (nx * R[0, 0] + ny * R[1, 0] + nz * R[2, 0]) / n_dot_r
-    k_v = (nx * R[0, 1] + ny * R[1, 1] + nz * R[2, 1]) / n_dot_r
-    su, sv = depth / fx, depth / fy
-    fs = coordinate_step(grad_cam[0], grad_cam[1], grad_cam[2], x_cam, y_cam, k_u, k_v, su, sv)
-    ft = coordinate_step(grad_cam[3], grad_cam[4], grad_cam[5], x_cam, y_cam, k_u, k_v, su, sv)
-    return fs, ft
-
-
-@kernel(inline="always")
-def pixel_steps(R_world_camera: np.ndarray, fx: float, fy: float, depth: float, norm: float, dx: float, dy: float,
-                dz: float, nx: float, ny: float, nz: float,
-                n_dot_v: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """(du, dv): the world steps on the face's plane (normal n, facing the viewer) between the pixel and its
-    neighbours across and down, by ray differentials (see ``road_footprint``)."""
-    R = R_world_camera
-    n_dot_r = -max(n_dot_v, 1e-4) * norm
-    k_u = (nx * R[0, 0] + ny * R[1, 0] + nz * R[2, 0]) / n_dot_r
-    k_v = (nx * R[0, 1] + ny * R[1, 1] + nz * R[2, 1]) / n_dot_r
-    su, sv = depth / fx, depth / fy
-    rx, ry, rz = dx * norm, dy * norm, dz * norm  # the pixel's ray (camera z = 1) in world axes
-    return ((su * (R[0, 0] - k_u * rx), su * (R[1, 0] - k_u * ry), su * (R[2, 0] - k_u * rz)),
-            (sv * (R[0, 1] - k_v * rx), sv * (R[1, 1] - k_v * ry), sv * (R[2, 1] - k_v * rz)))
-
-
-@kernel(inline="always")
-def facade_footprint(du: tuple[float, float, float], dv: tuple[float, float, float], nx: float, ny: float,
-                     nz: float) -> tuple[float, float]:
-    """(fu, fv): how far the pixel's footprint (world steps du, dv on the face's plane) reaches along a wall or
-    roof (the horizontal in the face's plane) and up it (up a roof's slope: its rise over the slope's sine)."""
-    hx, hy = -ny, nx
-    h = np.sqrt(hx * hx + hy * hy)
-    if h > 1e-6:
-        hx, hy = hx / h, hy / h
-    else:  # a horizontal face: "along" is any horizontal, x
-        hx, hy = 1.0, 0.0
-    fu = abs(du[0] * hx + du[1] * hy) + abs(dv[0] * hx + dv[1] * hy)
-    fv = (abs(du[2]) + abs(dv[2])) / max(np.sqrt(max(1.0 - nz * nz, 0.0)), MIN_SLOPE_SINE)
-    return min(FOOTPRINT_SCALE * fu + 1e-3, MAX_FOOTPRINT_M), min(FOOTPRINT_SCALE * fv + 1e-3, MAX_FOOTPRINT_M)
-
-
-@kernel(inline="always")
-def road_coordinates(faces: np.ndarray, vertex_st: np.ndarray, bary: np.ndarray, row: int, col: int,
-                     f: int) -> tuple[float, float]:
-    """(s, t) of the pixel on road face ``f`` from its perspective-correct barycentric weights."""
-    b1 = bary[row, col, 0]
-    b2 = bary[row, col, 1]
-    b0 = 1.0 - b1 - b2
-    i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
-    s = b0 * vertex_st[i0, 0] + b1 * vertex_st[i1, 0] + b2 * vertex_st[i2, 0]
-    t = b0 * vertex_st[i0, 1] + b1 * vertex_st[i1, 1] + b2 * vertex_st[i2, 1]
-    return s, t
-
-
-@kernel(inline="always")
-def albedo(surface: np.ndarray, material: int, grain: float, blotch: float,
-           detail: float) -> tuple[float, float, float]:
-    """(r, g, b): the road material's colour toned by its grain and stains (noise samples in [-1, 1]), as much as
-    the material shows (``GRAIN``); ``detail`` (0 = the ideal render) deepens both as a photograph shows them."""
-    share = surface[material, GRAIN]
-    tone = (1.0 + 0.35 * share * (1.0 + detail) * grain) * (1.0 + 0.18 * share * (1.0 + 1.5 * detail) * blotch)
-    return surface[material, ALBEDO_R] * tone, surface[material, ALBEDO_G] * tone, surface[material, ALBEDO_B] * tone
-
-
-@kernel(inline="always")
-def slab_joints(s: float, t: float, fs: float, ft: float, lane_width: float, stain: float, r: float, g: float,
-                b: float) -> tuple[float, float, float]:
-    """(r, g, b) of concrete slabs: each slab's own tone and the oil-drip stain down its lane's middle, then the
-    sealed joints (transverse every ``JOINT_SPACING_M``, longitudinal on the lane boundaries) and their sealant
-    bands, box-filtered over the pixel's footprint (fs, ft); ``stain`` (noise in [-1, 1]) varies the smeared
-    sealant and the drip."""
-    i, j = np.floor(s / JOINT_SPACING_M), np.floor(t / lane_width)
-    fade = max(1.0 - 2.0 * max(fs, ft) / JOINT_SPACING_M, 0.0)  # far away a pixel spans many slabs
-    tone = 1.0 + SLAB_TONE * fade * cell_hash(i, j)
-    across = (t / lane_width - j - 0.5) * lane_width / DRIP_HALF_WIDTH_M
-    spread = min(ft / lane_width, 1.0)  # a footprint across the lane sees the drip's lane-wide mean
-    drip = np.exp(-across * across) * (1.0 - spread) + np.sqrt(np.pi) * DRIP_HALF_WIDTH_M / lane_width * spread
-    tone *= 1.0 - DRIP_DARKENING * (0.6 + 0.4 * stain) * drip
-    joint = max(dash_coverage(s + 0.5 * JOINT_WIDTH_M, fs, JOINT_WIDTH_M, JOINT_SPACING_M),
-                dash_coverage(t + 0.5 * JOINT_WIDTH_M, ft, JOINT_WIDTH_M, lane_width))
-    seam = max(dash_coverage(s + 0.5 * SEAM_WIDTH_M, fs, SEAM_WIDTH_M, JOINT_SPACING_M),
-               dash_coverage(t + 0.5 * SEAM_WIDTH_M, ft, SEAM_WIDTH_M, lane_width))
-    cover = max(joint, SEAM_OPACITY * (0.5 + 0.5 * stain) * seam)
-    keep = tone * (1.0 - cover)
-    sealant = SEALANT_ALBEDO * cover
-    return r * keep + sealant, g * keep + sealant, b * keep + sealant
-
-
-@kernel(inline="always")
-def clumps(strength: float, mid: float, fine: float) -> float:
-    """Albedo factor of the photographic texture: sharp-edged clumps (the mid-scale noise pushed towards +-1) and
-    grain, both scaled by ``strength`` (0 = none); never below 0.1."""
-    clump = min(max(CLUMP_SHARPNESS * mid, -1.0), 1.0)
-    return max(1.0 + strength * (CLUMP_DEPTH * clump + GRAIN_DEPTH * fine), 0.1)
-
-
-@kernel(inline="always")
-def object_plane(px: float, py: float, pz: float, nx: float, ny: float, nz: float) -> tuple[float, float]:
-    """Two world coordinates (m) across an object's face: the pair the face's normal is least aligned with."""
-    ax, ay, az = abs(nx), abs(ny), abs(nz)
-    if az >= ax and az >= ay:
-        return px, py
-    if ax >= ay:
-        return py, pz
-    return px, pz
-
-
-@kernel(inline="always")
-def boundaries_near(lanes: float, lane_width: float, last: int, t: float, ft: float) -> tuple[int, int]:
-    """(k0, k1): the lane boundaries whose paint can reach a pixel at ``t`` (boundary k: t = (n - k) w)."""
-    k0 = max(int(np.floor(lanes - (t + ft + 0.5) / lane_width + 0.5)), 0)
-    k1 = min(int(np.floor(lanes - (t - ft - 0.5) / lane_width + 0.5)), last - 1)
-    return k0, k1
-
-
-@kernel(inline="always")
-def puddle_depth(shape: float, puddles: float) -> float:
-    """Standing water in [0, 1] where the puddle noise is ``shape``, for the weather's puddle coverage."""
-    return min(max((shape - (0.55 - 1.2 * puddles)) * PUDDLE_SHORE_SLOPE, 0.0), 1.0)
-
-
-@kernel(inline="always")
-def wet_surface(r: float, g: float, b: float, roughness: float, surface_wet: float,
-                standing: float) -> tuple[float, float, float, float]:
-    """(r, g, b, roughness) of a surface under a water film ``surface_wet`` (darker, smoother; mirror-smooth
-    where ``standing`` water is deep)."""
-    if surface_wet <= 0.0:
-        return r, g, b, roughness
-    darken = 1.0 - 0.5 * surface_wet
-    roughness = roughness * (1.0 - surface_wet) + 0.09 * surface_wet
-    if standing > 0.5:
-        roughness = STANDING_WATER_ROUGHNESS
-    return r * darken, g * darken, b * darken, roughness
-
-
-@kernel(inline="always")
-def sun_lit(sun_dir: np.ndarray, sun: np.ndarray, visibility: float, n_dot_l: float, nx: float, ny: float,
-            nz: float, dx: float, dy: float, dz: float, roughness: float, fresnel: float,
-            shiny: float) -> tuple[float, float, float, float, float, float]:
-    """(diffuse irradiance rgb, specular radiance rgb) of the sun seen with ``visibility``."""
-    sun_x, sun_y, sun_z = sun_dir[0], sun_dir[1], sun_dir[2]  # read before any branch (see ``_jit``)
-    sun_r, sun_g, sun_b = sun[0], sun[1], sun[2]
-    k = n_dot_l * visibility
-    spec = 0.0
-    if visibility > 0.0 and shiny > 0.0:
-        hx, hy, hz = sun_x - dx, sun_y - dy, sun_z - dz
-        n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-        exponent, normalisation, cutoff = lobe_shape(roughness)
-        spec = visibility * glossy_lobe(n_dot_h, exponent, normalisation, cutoff) * fresnel * 0.25 * shiny
-    return sun_r * k, sun_g * k, sun_b * k, sun_r * spec, sun_g * spec, sun_b * spec
-
-
-@kernel(inline="always")
-def lamp_light(lights: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float, dx: float,
-               dy: float, dz: float, roughness: float, fresnel: float, shiny: float,
-               retro: float) -> tuple[float, float, float, float, float, float]:
-    """(diffuse irradiance rgb, specular radiance rgb) of every lamp at world point p, each through its beam
-    (``beam_weight``); the ego's low beams also come back from the road by ``retro`` (its retroreflection, as a
-    share of the beam's irradiance square to it; 0 off the road)."""
-    light_r = light_g = light_b = 0.0
-    spec_r = spec_g = spec_b = 0.0
-    if lights.shape[0] == 0:
-        return light_r, light_g, light_b, spec_r, spec_g, spec_b
-    lobe = lobe_shape(roughness)
-    for i in range(lights.shape[0]):
-        lx = lights[i, 0] - px
-        ly = lights[i, 1] - py
-        lz = lights[i, 2] - pz
-        d2 = lx * lx + ly * ly + lz * lz
-        inv_dl = 1.0 / np.sqrt(d2)
-        ndl = (nx * lx + ny * ly + nz * lz) * inv_dl
-        if ndl <= 0.0:
-            continue
-        power = lights[i, LIGHT_POWER] / (d2 + 1.0) * beam_weight(lights, i, -lx * inv_dl, -ly * inv_dl,
-                                                                  -lz * inv_dl)
-        if power <= 0.0:
-            continue
-        hx, hy, hz = lx * inv_dl - dx, ly * inv_dl - dy, lz * inv_dl - dz
-        n_dot_h = (nx * hx + ny * hy + nz * hz) / np.sqrt(hx * hx + hy * hy + hz * hz)
-        k_spec = power * glossy_lobe(n_dot_h, lobe[0], lobe[1], lobe[2]) * fresnel * (0.1 + shiny)
-        k_diff = power * (ndl + (retro if lights[i, LIGHT_BEAM] == BEAM_LOW else 0.0))
-        light_r += lights[i, LIGHT_R] * k_diff
-        light_g += lights[i, LIGHT_R + 1] * k_diff
-        light_b += lights[i, LIGHT_R + 2] * k_diff
-        spec_r += lights[i, LIGHT_R] * k_spec
-        spec_g += lights[i, LIGHT_R + 1] * k_spec
-        spec_b += lights[i, LIGHT_R + 2] * k_spec
-    return light_r, light_g, light_b, spec_r, spec_g, spec_b
-
-
-@kernel(inline="always")
-def shade_lit(color: tuple[float, float, float], ambient: np.ndarray, up: float, emission: np.ndarray, f: int,
-              glow: float, sun: tuple[float, float, float, float, float, float],
-              lamps: tuple[float, float, float, float, float, float]) -> tuple[float, float, float]:
-    """Albedo ``color`` under the sun, the lamps and the sky's ambient (times ``up``), plus specular and the face's
-    emission times ``glow`` (the share of a lit window that is glass, not bars; else 1)."""
-    return (color[0] * (sun[0] + lamps[0] + ambient[0] * up) + sun[3] + lamps[3] + emission[f, 0] * glow,
-            color[1] * (sun[1] + lamps[1] + ambient[1] * up) + sun[4] + lamps[4] + emission[f, 1] * glow,
-            color[2] * (sun[2] + lamps[2] + ambient[2] * up) + sun[5] + lamps[5] + emission[f, 2] * glow)
-
-
-@kernel(inline="always")
-def blend(r: float, g: float, b: float, ref: tuple[float, float, float], strength: float) -> tuple[float, float, float]:
-    """(r, g, b) mixed towards the reflected colour ``ref`` by ``strength``."""
-    return (r * (1.0 - strength) + ref[0] * strength, g * (1.0 - strength) + ref[1] * strength,
-            b * (1.0 - strength) + ref[2] * strength)
-
-
-@kernel(inline="always")
-def mirrored_ray(dx: float, dy: float, dz: float, nx: float, ny: float, nz: float) -> tuple[float, float, float]:
-    """The view ray reflected about the normal."""
-    dot = dx * nx + dy * ny + dz * nz
-    return dx - 2.0 * dot * nx, dy - 2.0 * dot * ny, dz - 2.0 * dot * nz
 
 
 @kernel(inline="always")

@@ -189,6 +189,14 @@ def paint(stripes: np.ndarray, lo: int, hi: int, s: float, t: float, fs: float, 
 
 
 @kernel(inline="always")
+def boundaries_near(lanes: float, lane_width: float, last: int, t: float, ft: float) -> tuple[int, int]:
+    """(k0, k1): the lane boundaries whose paint can reach a pixel at ``t`` (boundary k: t = (n - k) w)."""
+    k0 = max(int(np.floor(lanes - (t + ft + 0.5) / lane_width + 0.5)), 0)
+    k1 = min(int(np.floor(lanes - (t - ft - 0.5) / lane_width + 0.5)), last - 1)
+    return k0, k1
+
+
+@kernel(inline="always")
 def _bilinear5(texels: np.ndarray, table: np.ndarray, level: int, s: float, t: float, s0: float,
                t0: float) -> tuple[float, float, float, float, float]:
     """Bilinear sample (premultiplied r, g, b, alpha, wet) of one mip level at road point (s, t)."""

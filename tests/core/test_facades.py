@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lanevil_core.render import facades as fc
-from lanevil_core.render.shading import ASPHALT, CONCRETE, GRAIN, KERB, SLAB, surface_table
+from lanevil_core.render.materials import ASPHALT, CONCRETE, GRAIN, KERB, SLAB, surface_table
 from lanevil_core.world import facade
 
 WALL = (0.3, 0.12, 0.07)

@@ -15,7 +15,7 @@ from lanevil_core.dataset.plan import train_variation
 from lanevil_core.labels import lanes as L
 from lanevil_core.pipeline.compile import compile_scene
 from lanevil_core.render import render_frame
-from lanevil_core.render.shading import JOINT_SPACING_M, SEALANT_ALBEDO, slab_joints
+from lanevil_core.render.materials import JOINT_SPACING_M, SEALANT_ALBEDO, slab_joints
 from lanevil_core.typed import MATERIALS, SCENE_KINDS, SceneKind
 from lanevil_core.world.road_layout import build_network
 from lanevil_core.world.road_mesh import road_surface
