@@ -134,6 +134,8 @@ def test_adapt_view_measures_the_stock_camera_as_the_stock_camera(tmp_path: Path
     view = View.load(out)
     assert view is not None and view.frames >= 2
     assert view.window == pytest.approx((0.0, 0.0, 1.0, 1.0), abs=0.08)  # the stock camera: 3 m up, level
+    with Image.open(out / "view.png") as picture:  # the window drawn on one of the frames, to check by eye
+        assert picture.size == (640, 360)
     summary = json.loads((out / "training.json").read_text())
     assert summary["method"] == "view" and summary["camera_height"] == 3.0
     labels = tmp_path / "labels.json"
