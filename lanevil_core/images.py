@@ -95,6 +95,15 @@ def encode_image(rgb: UInt8Array, image_format: str, jpeg_quality: int) -> bytes
     raise ValueError(f"unknown image format {image_format!r} (choose from {', '.join(IMAGE_FORMATS)})")
 
 
+def frame_files(folders: tuple[Path, ...], max_frames: int) -> list[Path]:
+    """The image files under ``folders`` (sorted), thinned evenly to ``max_frames``."""
+    files = sorted(path for folder in folders for path in folder.rglob("*")
+                   if path.is_file() and path.suffix.lower() in IMAGE_SUFFIXES)
+    if len(files) > max_frames:
+        files = [files[int(i)] for i in np.linspace(0, len(files) - 1, max_frames).round()]
+    return files
+
+
 def read_rgb(path: Path, error: type[Exception] = ValueError) -> UInt8Array:
     """(H, W, 3) uint8 RGB pixels of an image file (alpha dropped, grey expanded); an unreadable file raises
     ``error`` (the caller's own error type) with the path in its message."""

@@ -177,6 +177,14 @@ def _adapted_model(weights: str) -> Path:
     return model
 
 
+def _check_folders(flags: tuple[tuple[str, list[Path]], ...]) -> None:
+    """Every folder given with each flag exists, else a usage error naming the flag and the folder."""
+    for flag, folders in flags:
+        for folder in folders:
+            if not folder.is_dir():
+                raise UsageError(f"{flag} {folder}: no such folder")
+
+
 def _run_adapt_view(args: argparse.Namespace) -> int:
     from ..detect.view import ViewError
     from ..learn.view import DEFAULT_LANE_M, adapt_view
@@ -191,9 +199,7 @@ def _run_adapt_view(args: argparse.Namespace) -> int:
     if not 2.0 <= lane_width <= 6.0:
         raise UsageError(f"--lane-width {lane_width}: give the width in metres, 2 to 6")
     model = _adapted_model(args.weights)
-    for folder in args.frames:
-        if not folder.is_dir():
-            raise UsageError(f"--frames {folder}: no such folder")
+    _check_folders((("--frames", args.frames),))
     try:
         summary = adapt_view(model, tuple(args.frames), args.out, args.camera_height, lane_width, args.max_frames)
     except ViewError as error:
@@ -218,10 +224,7 @@ def _run_adapt(args: argparse.Namespace) -> int:
     from ..learn.adapt import AdaptError, AdaptSettings, adapt
 
     model = _adapted_model(args.weights)
-    for flag, folders in (("--frames", args.frames), ("--source", args.source)):
-        for folder in folders:
-            if not folder.is_dir():
-                raise UsageError(f"{flag} {folder}: no such folder")
+    _check_folders((("--frames", args.frames), ("--source", args.source)))
     try:
         settings = AdaptSettings(model=model, frames=tuple(args.frames), out=args.out, method=args.method,
                                  source=tuple(args.source), epochs=args.epochs,

@@ -47,6 +47,7 @@ from ..detect.model_spec import CONFIG_FILE, ONNX_FILE, TRAINING_FILE, WEIGHTS_F
 from ..detect.split import read_rgb
 from ..detect.view import View, view_input
 from ..files import write_atomic
+from ..images import frame_files
 from ..labels.lanes import TUSIMPLE_H_SAMPLES
 from . import ADAPT_METHODS
 from .dann import adversarial_training
@@ -54,7 +55,6 @@ from .data import LabelledFrames, _Frames, read_splits, resized
 from .export import export_onnx
 from .losses import detector_loss
 from .models import Deployed, LaneNet, build_model
-from .view import frame_files
 
 METHODS = tuple(method for method in ADAPT_METHODS if method != "view")  # view: learn.view.adapt_view, no torch
 

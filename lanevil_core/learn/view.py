@@ -18,14 +18,13 @@ import time
 from pathlib import Path
 from typing import Any, Final
 
-import numpy as np
 from PIL import Image, ImageDraw
 
 from ..detect.learned import LearnedDetector, shipped_model_dir
 from ..detect.model_spec import CONFIG_FILE, TRAINING_FILE
-from ..detect.view import VIEW_FILE, View, ViewError, measure_view, window_for
+from ..detect.view import STOCK_VANISHING, STOCK_WEDGE, VIEW_FILE, View, ViewError, measure_view, window_for
 from ..files import write_atomic
-from ..images import IMAGE_SUFFIXES, read_rgb
+from ..images import frame_files, read_rgb
 from ..typed import UInt8Array
 
 VIEW_REFERENCE: Final = "seg-transfer"
@@ -33,15 +32,6 @@ DEFAULT_LANE_M: Final = 3.5
 VIEW_PICTURE: Final = "view.png"
 OUTLINE = (255, 200, 0)  # the window
 MARK = (0, 220, 255)  # the vanishing point and the ego lane the window expects
-
-
-def frame_files(folders: tuple[Path, ...], max_frames: int) -> list[Path]:
-    """The image files under ``folders`` (sorted), thinned evenly to ``max_frames``."""
-    files = sorted(path for folder in folders for path in folder.rglob("*")
-                   if path.is_file() and path.suffix.lower() in IMAGE_SUFFIXES)
-    if len(files) > max_frames:
-        files = [files[int(i)] for i in np.linspace(0, len(files) - 1, max_frames).round()]
-    return files
 
 
 def camera_view(files: list[Path], camera_height: float | None, lane_width: float = DEFAULT_LANE_M) -> View:
@@ -90,8 +80,6 @@ def adapt_view(model: Path, frames: tuple[Path, ...], out: Path, camera_height: 
 def view_picture(rgb: UInt8Array, view: View) -> Image.Image:
     """``rgb`` with the window's outline, the vanishing point and the stock camera's ego lane as the window places
     it (its two lines from the vanishing point to the window's bottom corners' share of the lane)."""
-    from ..detect.view import STOCK_VANISHING, STOCK_WEDGE
-
     image = Image.fromarray(rgb)
     draw = ImageDraw.Draw(image)
     height, width = rgb.shape[:2]

@@ -19,7 +19,8 @@ from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.lane_slots import LaneLine, lane_lines  # noqa: E402
 from lanevil_core.detect.learned import LearnedDetector  # noqa: E402
 from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
-from lanevil_core.learn.adapt import adapt_batch_norm, agreeing_lanes, frame_files  # noqa: E402
+from lanevil_core.images import frame_files  # noqa: E402
+from lanevil_core.learn.adapt import adapt_batch_norm, agreeing_lanes  # noqa: E402
 from lanevil_core.learn.backbone import BackboneWeightsError, ResNet, load_backbone_weights  # noqa: E402
 from lanevil_core.learn.dann import reversal_weight, reverse_gradient, target_batches  # noqa: E402
 from lanevil_core.learn.data import LabelledFrames, read_splits  # noqa: E402
