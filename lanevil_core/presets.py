@@ -69,9 +69,11 @@ CAMERA_PRESETS: Final[dict[str, dict[str, Any]]] = {
     # noise: CARLA's RGB camera has no noise or grain attribute, so its frames carry none. Its histogram
     # auto-exposure adapts over two stops only (ExposureMinEV 10 to ExposureMaxEV 12): the gain window is two stops
     # wide, its low end the gain our meter sets on the brightest clear-noon stock scenes (0.47-0.55), so daylight
-    # is metered as before and a night is not brightened beyond what a dim day gets.
+    # is metered as before and a night is not brightened beyond what a dim day gets. No sharpening: CARLA renders
+    # the image, no camera ISP processes it, and none of `sensor.camera.rgb`'s attributes sharpens.
     "carla": {"width": 1280, "height": 720, "fov": 90.0, "x": 1.0, "y": 0.0, "z": 3.0, "pitch": 0.0,
-              "sensor": {"shutter": 0.005, "vignetting": 0.25, "noise": 0.0, "min_gain": 0.45, "max_gain": 1.8}},
+              "sensor": {"shutter": 0.005, "vignetting": 0.25, "noise": 0.0, "sharpen": 0.0, "min_gain": 0.45,
+                         "max_gain": 1.8}},
     # A highway front camera behind the windscreen as in TuSimple's 1280x720 frames: the vanishing point near row
     # 290, about 62 deg across, a little barrel distortion, no bonnet in view.
     "tusimple": {"width": 1280, "height": 720, "fov": 62.0, "x": 1.6, "y": 0.0, "z": 1.55, "pitch": 3.5,
