@@ -111,10 +111,12 @@ models: $(STAMP)
 	     out/models/$$family/weights.pt $(SHIPPED)/$$family/; done
 
 # The transfer study (docs/learning.md, "Training that transfers"): domain randomisation and photometric ablation,
-# the published-size ufld and a randomised seg, validated on a held-out synthetic split only. Meant for a GPU
-# machine (about 8 minutes with 16 cores: WORKERS=15 LOADERS=3 THREADS=2 DEVICE=cuda); hours on two CPU cores.
+# the published-size ufld and a randomised seg, validated on a held-out synthetic split only; and scnn and laneatt
+# fine-tuned on drawn cameras (MODELS_DATA_VARIED), validated on synthetic car-height and held-out splits. Makes the
+# shipped seg-transfer, scnn-transfer and laneatt-transfer again (SHIP=0 keeps them). Meant for a GPU machine
+# (about 8 minutes with 16 cores: WORKERS=15 LOADERS=3 THREADS=2 DEVICE=cuda); hours on two CPU cores.
 models-transfer: $(STAMP)
-	PY=$(PY) scripts/models-transfer
+	PY=$(PY) MODELS_DATA_VARIED=$(MODELS_DATA_VARIED) scripts/models-transfer
 
 # The five other families fine-tuned on structured worlds, chosen and compared on held-out synthetic splits
 # (docs/learning.md); measured, not shipped. About an hour on two CPU cores.

@@ -78,12 +78,14 @@ def _detect_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("split", type=Path, help="split folder (e.g. DATASET/test) with its *_label.json or "
                                                  "images; a dataset folder stands for its test split (for its only "
                                                  "split, with a note, when it has no test split)")
+    from ..detect.learned import BUNDLED_MODELS
     from ..detect.split import METHODS
 
     parser.add_argument("--method", required=True, action="append", metavar="METHOD",
                         help=f"built-in: {', '.join(METHODS)} (learned ufld: row anchors, seg: segmentation, laneatt: "
                              "line anchors, bezier: Bézier curves, ganet: keypoints, scnn: message-passing "
-                             "segmentation; ONNX; hough, birdseye: classical); a plug-in's name "
+                             "segmentation; ONNX; hough, birdseye: classical); a shipped named model, run as its "
+                             f"family, for other cameras and roads: {', '.join(BUNDLED_MODELS)}; a plug-in's name "
                              "(LANEVIL_DETECTORS, LANEVIL_DETECTORS_FILE, installed lanevil.detectors); or a "
                              "source: http://HOST:PORT/PATH (a detector server) or onnx:PATH (a model with a sidecar "
                              "JSON); repeat to run several over one reading of the images")

@@ -10,7 +10,8 @@ import pytest
 
 from lanevil_core.cli import main
 from lanevil_core.detect.catalog import available_detector, detector_info, detector_infos
-from lanevil_core.detect.learned import BUNDLED_MODELS
+from lanevil_core.detect.learned import BUNDLED_MODELS, LearnedDetector, shipped_model_dir
+from lanevil_core.detect.model_spec import ModelSpec
 from lanevil_core.detect.polylines import checked_polylines, polyline_lanes, scaled_polylines
 from lanevil_core.detect.registry import (
     ENV_DETECTORS,
@@ -100,16 +101,26 @@ def test_a_malformed_environment_is_one_clear_error(monkeypatch, value, message)
         detector_names()
 
 
-def test_the_bundled_model_is_a_named_detector_a_configured_one_may_take_over(monkeypatch, stripes) -> None:
-    assert BUNDLED_MODELS == ("seg-transfer",) and detector_names()[-1] == "seg-transfer"
-    info = detector_info("seg-transfer")
+def test_the_bundled_models_are_listed_after_the_methods() -> None:
+    assert detector_names() == (*METHODS, *BUNDLED_MODELS)
+    assert {"seg-transfer", "scnn-transfer", "laneatt-transfer"} <= set(BUNDLED_MODELS)
+
+
+@pytest.mark.parametrize("name", BUNDLED_MODELS)
+def test_a_bundled_model_is_a_named_detector_a_configured_one_may_take_over(monkeypatch, stripes, name) -> None:
+    info = detector_info(name)
     assert info.available and info.kind == "onnx" and not info.real_trained
-    assert info.source == "onnx:detect/models/seg-transfer"  # not the path of the installation's disk
+    assert info.source == f"onnx:detect/models/{name}"  # not the path of the installation's disk
     assert info.model is not None and info.model["input_size"] == [320, 180]
-    lanes = detector_for("seg-transfer")(stripes([60, 100]), ROWS)  # runs as its family, seg
-    assert isinstance(lanes, list)
-    monkeypatch.setenv(ENV_DETECTORS, "seg-transfer=onnx:missing.onnx")
-    assert detector_names().count("seg-transfer") == 1 and not detector_info("seg-transfer").available
+    folder = shipped_model_dir(name)
+    family = ModelSpec.load(folder).family
+    assert name == f"{family}-transfer"  # named after the family it runs as
+    detector = detector_for(name)
+    assert isinstance(detector, LearnedDetector) and detector.spec.family == family
+    rgb = stripes([60, 100])
+    assert detector(rgb, ROWS) == detector_for(family, folder)(rgb, ROWS)  # as `--method FAMILY --weights FOLDER`
+    monkeypatch.setenv(ENV_DETECTORS, f"{name}=onnx:missing.onnx")
+    assert detector_names().count(name) == 1 and not detector_info(name).available
 
 
 def test_a_malformed_config_file_names_the_field(monkeypatch, tmp_path) -> None:
@@ -243,11 +254,12 @@ def test_lanevil_detectors_lists_built_ins_and_plugins(monkeypatch, lane_server,
     assert main(["detectors"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert [line.split()[0] for line in lines] == [*METHODS, "mine", "gone", *BUNDLED_MODELS]
-    assert lines[-3].split()[1:3] == ["http", "available"] and lane_server.url() in lines[-3]
-    assert "not available: gone: no ONNX model at missing.onnx" in lines[-2]
+    mine, gone = len(METHODS), len(METHODS) + 1
+    assert lines[mine].split()[1:3] == ["http", "available"] and lane_server.url() in lines[mine]
+    assert "not available: gone: no ONNX model at missing.onnx" in lines[gone]
     assert main(["detectors", "--json"]) == 0
     entries = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert entries[-3] == {"name": "mine", "kind": "http", "available": True, "reason": None, "model": None,
+    assert entries[mine] == {"name": "mine", "kind": "http", "available": True, "reason": None, "model": None,
                            "source": lane_server.url(), "real_trained": False}
     monkeypatch.setenv(ENV_DETECTORS, "mine")
     assert main(["detectors"]) == 2

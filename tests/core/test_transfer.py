@@ -17,7 +17,7 @@ from test_learn import TINY_SPEC, _train, straight_record, tiny_dataset  # noqa:
 
 from lanevil_core.cli import main  # noqa: E402
 from lanevil_core.detect.lane_slots import LaneLine, lane_lines  # noqa: E402
-from lanevil_core.detect.learned import LearnedDetector  # noqa: E402
+from lanevil_core.detect.learned import BUNDLED_MODELS, LearnedDetector, shipped_model_dir  # noqa: E402
 from lanevil_core.detect.model_spec import FAMILIES, ModelSpec  # noqa: E402
 from lanevil_core.images import frame_files  # noqa: E402
 from lanevil_core.learn.adapt import adapt_batch_norm, agreeing_lanes  # noqa: E402
@@ -281,9 +281,23 @@ def test_a_model_folder_is_a_named_detector_everywhere(tiny_dataset, tmp_path, m
     assert "gone" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("name", BUNDLED_MODELS)
+def test_adapt_takes_a_bundled_model_by_name_and_keeps_its_family(tiny_dataset, tmp_path, capsys, name):  # noqa: F811
+    frames = _my_frames(tiny_dataset, tmp_path / "my_frames", 2)
+    out = tmp_path / "adapted"
+    code = main(["adapt", "--weights", name, "--frames", str(frames), "--out", str(out), "--method", "adabn",
+                 "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    family = ModelSpec.load(shipped_model_dir(name)).family
+    assert ModelSpec.load(out).family == family
+    assert json.loads((out / "training.json").read_text())["adapted_from"] == name
+    assert main(["detect", str(tiny_dataset / "train"), "--method", family, "--weights", str(out),
+                 "--out", str(tmp_path / "pred.json")]) == 0
+
+
 def test_adapt_errors_exit_2(tmp_path, capsys):
     (tmp_path / "empty").mkdir()
-    for shipped in ("ufld", "seg-transfer"):  # a family's and a bundled model's name both name a shipped folder
+    for shipped in ("ufld", *BUNDLED_MODELS):  # a family's and a bundled model's name both name a shipped folder
         assert main(["adapt", "--weights", shipped, "--frames", str(tmp_path / "empty"),
                      "--out", str(tmp_path / "o")]) == 2
         assert "no png or jpg" in capsys.readouterr().err
