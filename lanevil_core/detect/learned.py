@@ -40,7 +40,8 @@ SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 # - seg-transfer runs as `seg`: fine-tuned with --randomise --photometric, chosen on held-out synthetic worlds
 #   ("Selection on held-out synthetic worlds");
 # - scnn-transfer and laneatt-transfer run as `scnn` and `laneatt`: fine-tuned from the family's shipped weights on
-#   drawn cameras (the --vary-camera split of `make models`, 3 epochs at 5e-4), each keeping its best epoch on
+#   drawn cameras (the --vary-camera split of `make models`, 3 epochs at 5e-4; scnn-transfer then 2 more with
+#   --randomise --photometric, the stage more accurate on the validation splits), each keeping its best epoch on
 #   synthetic validation splits; shipped because each reads at least 50 % of the ego lines on both car-height
 #   synthetic preset splits (`tusimple`, `dashcam`), a rule on synthetic frames only ("Drawn cameras for the
 #   stock-camera families").
