@@ -129,18 +129,19 @@ def _read(model: LaneNet, images: np.ndarray, device: torch.device, batch: int =
 
 
 def agreeing_lanes(direct: list[LaneLine | None], flipped: list[LaneLine | None], agreement: float) -> list[LaneLine]:
-    """The lanes read alike in a frame and in its mirror (``flipped``: slots read on the mirrored image)."""
-    back = mirror_slots(flipped)
-    kept = []
-    for a, b in zip(direct, back, strict=True):
-        if a is None or b is None:
-            continue
-        rows = a.points[:, 1]
-        xb = b.x_at(rows)
-        both = ~np.isnan(xb)
-        if both.sum() >= 3 and float(np.mean(np.abs(a.points[both, 0] - xb[both]))) < agreement:
-            kept.append(a)
-    return kept
+    """The lanes read alike in a frame and in its mirror (``flipped``: the lanes read on the mirrored image): each
+    lane of ``direct`` that some mirrored-back lane follows. Families with fixed slots read a lane in the mirrored
+    slot; anchor and curve families read however many lanes they find, in their own order, so lanes are matched
+    by position, not by slot."""
+    back = [b for b in mirror_slots(flipped) if b is not None]
+    return [a for a in direct if a is not None and any(_follows(a, b, agreement) for b in back)]
+
+
+def _follows(a: LaneLine, b: LaneLine, agreement: float) -> bool:
+    """Whether ``b`` lies within ``agreement`` (mean |dx|, a share of the width) of ``a`` on at least 3 of a's rows."""
+    xb = b.x_at(a.points[:, 1])
+    both = ~np.isnan(xb)
+    return bool(both.sum() >= 3 and float(np.mean(np.abs(a.points[both, 0] - xb[both]))) < agreement)
 
 
 def pseudo_labels(model: LaneNet, images: np.ndarray, device: torch.device, agreement: float,

@@ -150,6 +150,19 @@ def test_mirror_agreement_keeps_lanes_read_alike_and_drops_the_rest():
     assert len(kept) == 1 and kept[0] is left
 
 
+def test_mirror_agreement_matches_lanes_by_position_when_the_counts_differ():
+    """Anchor and curve families read however many lanes they find, in score order: a frame and its mirror may
+    give different counts, and the lanes are matched by where they lie."""
+    rows = np.linspace(0.5, 1.0, 11)
+    left = LaneLine(np.stack([0.45 - 0.6 * (rows - 0.5), rows], axis=1))
+    right = LaneLine(np.stack([0.55 + 0.6 * (rows - 0.5), rows], axis=1))
+    mirrored_left = LaneLine(np.stack([0.55 + 0.6 * (rows - 0.5), rows], axis=1))
+    stray = LaneLine(np.stack([np.full(11, 0.1), rows], axis=1))
+    assert agreeing_lanes([right, left], [mirrored_left], 0.015) == [left]
+    assert agreeing_lanes([left], [stray, mirrored_left, None], 0.015) == [left]
+    assert agreeing_lanes([left, right], [], 0.015) == []
+
+
 def test_adabn_re_estimates_the_normalization_statistics_only():
     model = build_model(ModelSpec(family="seg", width=0.125, input_size=(128, 72)))
     statistics = ("running", "num_batches")
