@@ -438,6 +438,12 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     return parse_case(text, source=str(path))
 
 
+def seen_through(case: Case, preset: str) -> Case:
+    """``case`` seen through camera preset ``preset`` (``presets.CAMERA_PRESETS``: its image size, lens, mount and
+    sensor replace the case's camera; the world and the drive are unchanged). Raises KeyError naming the presets."""
+    return case.model_copy(update={"camera": Camera.model_validate(camera_preset_values(preset))})
+
+
 def case_json(case: Case) -> str:
     """Canonical JSON text of a case (stable key order, trailing newline)."""
     return case.model_dump_json(indent=2) + "\n"

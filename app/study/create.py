@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lanevil_core.case import Case
+from lanevil_core.case import Case, seen_through
 from lanevil_core.files import write_atomic
 from lanevil_core.images import png_bytes
 
@@ -80,11 +80,11 @@ def prepare_items(spec: StudySpec, uploads: Mapping[str, CheckedUpload], store: 
     items = spec.all_items(sorted(uploads))
     if not any(item.role == "test" for item in items):
         raise SpecError("spec.items", "a study needs at least one scored (role 'test') item")
-    return [_prepare(position, item, uploads, store) for position, item in enumerate(items)]
+    return [_prepare(position, item, uploads, store, spec.camera) for position, item in enumerate(items)]
 
 
-def _prepare(position: int, item: ItemSpec, uploads: Mapping[str, CheckedUpload],
-             store: CaseStore) -> PreparedItem:
+def _prepare(position: int, item: ItemSpec, uploads: Mapping[str, CheckedUpload], store: CaseStore,
+             camera: str | None) -> PreparedItem:
     field = f"spec.items.{position}"
     if item.case_id is not None:
         try:
@@ -94,7 +94,8 @@ def _prepare(position: int, item: ItemSpec, uploads: Mapping[str, CheckedUpload]
         if item.frame >= record.case.ego.frames:
             raise SpecError(f"{field}.frame", f"frame {item.frame} is outside 0..{record.case.ego.frames - 1} "
                                               f"of case {item.case_id!r}")
-        return PreparedItem(position, item, f"{position:03d}.png", "image/png", case=record.case,
+        case = record.case if camera is None else seen_through(record.case, camera)
+        return PreparedItem(position, item, f"{position:03d}.png", "image/png", case=case,
                             case_version=record.version, illusion_type=record.illusion_type,
                             category=record.category, severity=record.severity)
     upload = uploads.get(item.upload or "")
@@ -141,9 +142,9 @@ def insert_study(db: sqlite3.Connection, study_id: str, spec: StudySpec, items: 
     """The study row and its item rows, in one transaction."""
     with transaction(db):
         db.execute("INSERT INTO studies (id, title, question, consent_text, instructions, viewing_ms, width, "
-                   "height, status, created_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                   "height, camera, status, created_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                    (study_id, spec.title, spec.question, spec.consent_text, spec.instructions,
-                    round(spec.viewing_seconds * 1000), spec.width, spec.height, status, time.time()))
+                    round(spec.viewing_seconds * 1000), spec.width, spec.height, spec.camera, status, time.time()))
         db.executemany(
             "INSERT INTO items (study_id, position, role, source, case_id, case_version, frame, upload_name, "
             "illusion_type, category, severity, garbled, gold_min, gold_max, trap_answer, file, media_type) "

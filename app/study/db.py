@@ -28,6 +28,7 @@ CREATE TABLE IF NOT EXISTS studies (
     viewing_ms INTEGER NOT NULL,
     width INTEGER NOT NULL,
     height INTEGER NOT NULL,
+    camera TEXT,
     status TEXT NOT NULL CHECK (status IN ('rendering', 'ready', 'failed')),
     error TEXT,
     job_id TEXT,
@@ -114,9 +115,22 @@ def _ensure_schema(path: Path) -> None:
         try:
             connection.execute("PRAGMA journal_mode = WAL")
             connection.executescript(SCHEMA)
+            _add_missing_columns(connection)
         finally:
             connection.close()
         _ready.add(key)
+
+
+ADDED_COLUMNS = {"studies": {"camera": "TEXT"}}  # columns added since a table was first made: (table, name, type)
+
+
+def _add_missing_columns(connection: sqlite3.Connection) -> None:
+    """Bring a file made by an earlier version up to ``SCHEMA``: add the columns it lacks (null in old rows)."""
+    for table, columns in ADDED_COLUMNS.items():
+        present = {row[1] for row in connection.execute(f"PRAGMA table_info({table})")}
+        for name, kind in columns.items():
+            if name not in present:
+                connection.execute(f"ALTER TABLE {table} ADD COLUMN {name} {kind}")
 
 
 @contextmanager

@@ -34,6 +34,7 @@ class Study:
     viewing_ms: int
     width: int
     height: int
+    camera: str | None  # the camera preset generated items are seen through; None: each case's own
     status: str
     error: str | None
     job_id: str | None

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..case import Case, load_case
+from ..case import Case, load_case, seen_through
 
 if TYPE_CHECKING:
     from ..render import Frame
@@ -56,11 +56,7 @@ def _row_key(size: tuple[int, int], threads: int, thread_counts: Sequence[int], 
 
 def with_camera(case: Case, preset: str) -> Case:
     """``case`` seen through camera preset ``preset`` (its lens, mount and sensor; ``CASE_CAMERA``: unchanged)."""
-    if preset == CASE_CAMERA:
-        return case
-    from ..presets import camera_preset_values
-
-    return case.model_copy(update={"camera": type(case.camera).model_validate(camera_preset_values(preset))})
+    return case if preset == CASE_CAMERA else seen_through(case, preset)
 
 
 def run_benchmark(

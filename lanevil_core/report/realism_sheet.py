@@ -17,10 +17,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from ..case import Case
+from ..case import Case, seen_through
 from ..library.stock import clean_cases, original_case, original_folder
 from ..metrics.realism import RealismError, image_files, read_rgb
-from ..pipeline.bench import with_camera
 from ..pipeline.compile import compile_scene
 from ..render import render_frame
 from ..typed import UInt8Array
@@ -150,7 +149,7 @@ def realism_sheet(real: Path | None = None, camera: str = SHEET_CAMERA, size: tu
         y = HEADER_H + i * row_h
         draw.text((8, y + height // 2 - 8), row.kind.replace("_", " "), fill=(240, 240, 240), font=title)
         case = row.case()
-        ours = render_frame(compile_scene(with_camera(case, camera)), frame, size).rgb
+        ours = render_frame(compile_scene(seen_through(case, camera)), frame, size).rgb
         tiles: list[tuple[Image.Image | None, tuple[str, str]]] = [
             (Image.fromarray(ours), (scene_words(case), row.case_name))]
         if real is not None:

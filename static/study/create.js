@@ -19,6 +19,18 @@ function element(tag, props = {}, children = []) {
   return node;
 }
 
+// --- cameras: the presets a study may see its cases through, as the API's schema lists them ------------------------
+
+async function loadCameras() {
+  const select = byId("spec-camera");
+  if (select.options.length > 1) return;
+  const response = await fetch("/openapi.json");
+  if (!response.ok) return;
+  const presets = (await response.json()).components.schemas.StudySpec.properties.camera.enum.filter(Boolean);
+  select.append(...presets.map((name) => element("option", {
+    value: name, textContent: name === "carla" ? "carla (the paper's capture camera)" : name})));
+}
+
 // --- cases -----------------------------------------------------------------------------------------------------
 
 async function loadCases() {
@@ -161,6 +173,7 @@ function buildSpec() {
   }
   const cases = chosenCases();
   if (cases.length) spec.generated = {cases, frames: parseFrames(byId("spec-frames").value)};
+  if (byId("spec-camera").value) spec.camera = byId("spec-camera").value;
   return spec;
 }
 
@@ -266,4 +279,5 @@ document.addEventListener("DOMContentLoaded", () => {
     button.addEventListener("click", () => addItem(button.dataset.add));
   }
   document.addEventListener("organiser-ready", loadCases);
+  document.addEventListener("organiser-ready", loadCameras);
 });

@@ -21,7 +21,7 @@ from pydantic import TypeAdapter
 from app.main import create_app
 from app.state import AppState
 from app.study import bodies
-from app.study.db import db_path
+from app.study.db import SCHEMA, connect, db_path
 from app.study.order import participant_order
 from app.study.records import StudyItem
 
@@ -125,6 +125,42 @@ def test_json_spec_without_uploads(client) -> None:
     assert [item["case_id"] for item in response.json()["items"]] == ["clean-00_straight_urban"]
 
 
+def test_a_study_sees_its_cases_through_one_camera_preset(client) -> None:
+    """``camera``: every generated item through a preset (the paper's `carla` camera here), recorded with the
+    study; without it each case keeps its own camera."""
+    images = {}
+    for camera in (None, "carla"):
+        spec = {"title": f"through {camera}", **SIZE, "camera": camera,
+                "generated": {"cases": ["clean-00_straight_urban"], "frames": [20]}}
+        response = client.post("/api/study/studies", headers=ADMIN, json=spec)
+        assert response.status_code == 201, response.text
+        study = response.json()
+        assert study["camera"] == camera
+        assert client.get(f"/api/study/studies/{study['id']}", headers=ADMIN).json()["camera"] == camera
+        images[camera] = np.asarray(Image.open(io.BytesIO(client.get(study["items"][0]["image_url"]).content)))
+    assert images[None].shape == images["carla"].shape == (90, 160, 3)
+    # the carla camera sits 3 m up on a 90 deg lens with a sensor: another picture of the same drive
+    assert np.abs(images[None].astype(int) - images["carla"].astype(int)).mean() > 5.0
+
+
+def test_a_study_file_of_an_earlier_version_gains_the_camera_column(tmp_path) -> None:
+    path = tmp_path / "old" / "study.sqlite3"
+    path.parent.mkdir()
+    old = sqlite3.connect(path)
+    old.executescript(SCHEMA.replace("    camera TEXT,\n", ""))
+    old.execute("INSERT INTO studies (id, title, question, consent_text, instructions, viewing_ms, width, height, "
+                "status, created_at) VALUES ('a1b2c3d4e5f6', 't', 'q', 'c', 'i', 500, 160, 90, 'ready', 0)")
+    old.commit()
+    old.close()
+    db = connect(path)
+    try:
+        columns = [row[1] for row in db.execute("PRAGMA table_info(studies)")]
+        assert "camera" in columns
+        assert tuple(db.execute("SELECT camera, title FROM studies").fetchone()) == (None, "t")
+    finally:
+        db.close()
+
+
 def test_a_case_of_two_illusion_types_is_its_own_study_group(client) -> None:
     case = client.get("/api/cases/fence_shadow-00_uphill_rural_noon-03_level3").json()["case"]
     case["illusions"].append({"type": "road_crack", "severity": 2, "s": 60.0})
@@ -165,6 +201,7 @@ def test_admin_routes_need_the_token(client, state) -> None:
      "spec.generated.frames.0"),
     ({"title": "x", "items": [{"case_id": "clean-00_straight_urban", "frame": "3"}]}, {}, 422, "spec.items.0.frame"),
     ({"title": "x", "width": True}, {}, 422, "spec.width"),
+    ({"title": "x", "camera": "gopro"}, {}, 422, "spec.camera"),
 ])
 def test_bad_specs_name_the_field(client, spec, files, status, field) -> None:
     response = create(client, spec, files)

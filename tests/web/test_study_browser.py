@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from app.study.db import connect, db_path
-from app.study.records import set_status, study_items
+from app.study.records import get_study, set_status, study_items
 
 FENCE = "fence_shadow-00_uphill_rural_noon"  # the fence shadow's representative original
 
@@ -80,6 +80,8 @@ def test_organiser_creates_a_study_in_the_browser(page, live_server, screenshot_
     page.fill("#case-filter", "")
     page.check("#case-list input[value='clean-00_straight_urban']")
     page.fill("#spec-frames", "0, 10")
+    page.wait_for_selector("#spec-camera option[value=carla]", state="attached", timeout=TIMEOUT_MS)
+    page.select_option("#spec-camera", "carla")  # the presets come from the API's schema
     page.set_input_files("#spec-files", [
         {"name": "road_a.png", "mimeType": "image/png", "buffer": photo(1)},
         {"name": "road_b.png", "mimeType": "image/png", "buffer": photo(2)},
@@ -115,8 +117,10 @@ def test_organiser_creates_a_study_in_the_browser(page, live_server, screenshot_
     db = database(live_server)
     try:
         items = study_items(db, study_id)
+        camera = get_study(db, study_id).camera
     finally:
         db.close()
+    assert camera == "carla"
     assert [(item.role, item.case_id or item.upload_name) for item in items] == [
         ("training", f"{FENCE}-01_level1"), ("gold", "clean-01_bend_suburban"), ("trap", "road_b.png"),
         ("test", "clean-00_straight_urban"), ("test", "clean-00_straight_urban"), ("test", f"{FENCE}-03_level3"),
