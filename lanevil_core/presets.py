@@ -6,7 +6,7 @@ A case always stores the numbers; a preset name is only a way to fill them.
 from __future__ import annotations
 
 import copy
-from typing import Any, Final
+from typing import Any, Final, Literal, get_args
 
 # name: (cloudiness, precipitation, precipitation_deposits, sun_altitude, fog_density, wetness)
 _TABLE: Final[dict[str, tuple[float, float, float, float, float, float]]] = {
@@ -94,6 +94,9 @@ CAMERA_PRESETS: Final[dict[str, dict[str, Any]]] = {
 }
 
 CAMERA_PRESET_NAMES: Final[tuple[str, ...]] = tuple(CAMERA_PRESETS)
+# The preset names as a type, for models whose schema must list them (a study's ``camera``); kept equal to the keys.
+CameraPreset = Literal["carla", "tusimple", "culane", "dashcam"]
+assert get_args(CameraPreset) == CAMERA_PRESET_NAMES, "CameraPreset must name every camera preset, in order"
 
 
 def camera_preset_values(name: str) -> dict[str, Any]:

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, model_validator
 
-from lanevil_core.presets import CAMERA_PRESET_NAMES
+from lanevil_core.presets import CameraPreset
 
 from ..api.openapi import SERVER_LIMIT
 from ..store import ID_PATTERN
@@ -107,18 +107,11 @@ class StudySpec(_Strict):
                              json_schema_extra={SERVER_LIMIT: "max_width"})
     height: StrictInt = Field(720, ge=16, description="render height of generated items (at most the server's "
                               "largest)", json_schema_extra={SERVER_LIMIT: "max_height"})
-    camera: str | None = Field(None, description="the camera preset every generated item is seen through (carla is "
-                               "the paper's capture camera, the others real cameras'); empty = each case's own",
-                               json_schema_extra={"enum": [*CAMERA_PRESET_NAMES, None]})
+    camera: CameraPreset | None = Field(None, description="the camera preset every generated item is seen through "
+                                        "(carla is the paper's capture camera, the others real cameras'); empty = "
+                                        "each case's own")
     items: list[ItemSpec] = Field(default_factory=list)
     generated: GeneratedSet | None = None
-
-    @field_validator("camera")
-    @classmethod
-    def _known_camera(cls, camera: str | None) -> str | None:
-        if camera is not None and camera not in CAMERA_PRESET_NAMES:
-            raise ValueError(f"unknown camera preset {camera!r}; choose one of {', '.join(CAMERA_PRESET_NAMES)}")
-        return camera
     uploads_as_items: StrictBool = Field(True, description="uploads no item names become scored real items")
 
     def all_items(self, upload_names: list[str]) -> list[ItemSpec]:

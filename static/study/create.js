@@ -26,7 +26,8 @@ async function loadCameras() {
   if (select.options.length > 1) return;
   const response = await fetch("/openapi.json");
   if (!response.ok) return;
-  const presets = (await response.json()).components.schemas.StudySpec.properties.camera.enum.filter(Boolean);
+  const schema = (await response.json()).components.schemas.StudySpec.properties.camera;
+  const presets = (schema.anyOf || [schema]).flatMap((option) => option.enum || []).filter(Boolean);
   select.append(...presets.map((name) => element("option", {
     value: name, textContent: name === "carla" ? "carla (the paper's capture camera)" : name})));
 }
