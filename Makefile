@@ -9,7 +9,8 @@ TORCH ?= torch==2.13.0
 # Every extra: the library alone needs none of them (pip install -e . gives cases, renderer, labels, dataset, metrics).
 EXTRAS ?= web,dask,report,learn,test
 
-.PHONY: run preview test lint test-fast test-slow test-browser bench models models-transfer models-world clean
+.PHONY: run preview test lint test-fast test-slow test-browser bench models models-transfer models-transfer-world \
+  models-world clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -117,6 +118,13 @@ models: $(STAMP)
 # (about 8 minutes with 16 cores: WORKERS=15 LOADERS=3 THREADS=2 DEVICE=cuda); hours on two CPU cores.
 models-transfer: $(STAMP)
 	PY=$(PY) MODELS_DATA_VARIED=$(MODELS_DATA_VARIED) scripts/models-transfer
+
+# The six families' transfer stage on drawn worlds and cameras (docs/learning.md, "All six families on drawn worlds
+# and cameras"): each fine-tuned from its best shipped model, chosen on the synthetic validation splits; SHIP=1
+# copies a chosen run into place as FAMILY-transfer. About 8 minutes on a 16-core GPU machine (WORKERS=15
+# LOADERS=1 DEVICE=cuda), hours on two CPU cores.
+models-transfer-world: $(STAMP)
+	PY=$(PY) scripts/models-transfer-world
 
 # The five other families fine-tuned on structured worlds, chosen and compared on held-out synthetic splits
 # (docs/learning.md); measured, not shipped. About an hour on two CPU cores.

@@ -52,9 +52,9 @@ from ..labels.lanes import TUSIMPLE_H_SAMPLES
 from . import ADAPT_METHODS
 from .dann import adversarial_training
 from .data import LabelledFrames, _Frames, read_splits, resized
-from .export import export_onnx
+from .export import export_onnx, load_weights
 from .losses import detector_loss
-from .models import Deployed, LaneNet, build_model
+from .models import Deployed, LaneNet
 
 METHODS = tuple(method for method in ADAPT_METHODS if method != "view")  # view: learn.view.adapt_view, no torch
 
@@ -194,10 +194,7 @@ def adapt(settings: AdaptSettings, show_progress: bool = True) -> dict[str, Any]
     view = View.load(settings.model)  # a model adapted with --method view keeps its window, and learns through it
     images = np.stack([resized(read_rgb(path), spec.input_size) if view is None else
                        view_input(read_rgb(path), view, spec.input_size) for path in files])
-    model = build_model(spec)
-    state = torch.load(weights, map_location="cpu", weights_only=True)
-    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in state.items()})
-    model = model.to(device)
+    model = load_weights(settings.model).to(device)
     recorded = {k: (str(v) if isinstance(v, Path) else v)
                 for k, v in asdict(settings).items() if k not in ("frames", "out", "source")}
     summary: dict[str, Any] = {"adapted_from": settings.model.name, "frames": len(files), "settings": recorded}

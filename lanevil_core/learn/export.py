@@ -7,9 +7,26 @@ from pathlib import Path
 
 import torch
 
-from .models import Deployed, LaneNet
+from ..detect.model_spec import ONNX_FILE, WEIGHTS_FILE, ModelSpec
+from .models import Deployed, LaneNet, build_model
 
 OPSET = 17
+
+
+def load_weights(model_dir: str | Path) -> LaneNet:
+    """The network of a model folder (``config.json`` and ``weights.pt``, stored in half precision) in float32,
+    on the CPU."""
+    model_dir = Path(model_dir)
+    model = build_model(ModelSpec.load(model_dir))
+    state = torch.load(model_dir / WEIGHTS_FILE, map_location="cpu", weights_only=True)
+    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in state.items()})
+    return model.eval()
+
+
+def export_model_dir(model_dir: str | Path) -> Path:
+    """Write a model folder's ``model.onnx`` again from its ``config.json`` and ``weights.pt``: for weights trained
+    elsewhere and copied back without it (``scripts/models-transfer-world``)."""
+    return export_onnx(load_weights(model_dir), Path(model_dir) / ONNX_FILE)
 
 
 def export_onnx(model: LaneNet, path: str | Path) -> Path:

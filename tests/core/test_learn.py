@@ -131,6 +131,24 @@ def test_training_writes_a_model_folder_whose_onnx_matches_torch(tiny_dataset, t
     assert all(len(lane) == 13 for lane in lanes)
 
 
+def test_a_folder_of_weights_alone_is_exported_again_and_reads_as_its_weights(tiny_dataset, tmp_path):
+    from lanevil_core.learn.export import export_model_dir, load_weights
+    from lanevil_core.learn.models import Deployed
+
+    assert _train(tiny_dataset, tmp_path, "scnn") == 0
+    (tmp_path / "model.onnx").unlink()  # weights trained elsewhere, copied back without their ONNX
+    assert export_model_dir(tmp_path) == tmp_path / "model.onnx"
+    model = load_weights(tmp_path)
+    assert not model.training and all(p.dtype == torch.float32 for p in model.parameters())
+    spec = ModelSpec.load(tmp_path)
+    image = np.random.default_rng(1).random((1, 3, spec.input_size[1], spec.input_size[0]), dtype=np.float32)
+    with torch.no_grad():
+        expected = [t.numpy() for t in Deployed(model)(torch.from_numpy(image))]
+    got = LearnedDetector(tmp_path)._session.run(None, {"image": image})
+    for want, out in zip(expected, got, strict=True):
+        assert np.max(np.abs(want - out)) < 1e-4
+
+
 def test_same_seed_same_weights_and_resume_continues(tiny_dataset, tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     assert _train(tiny_dataset, a, "seg", "--seed", "3") == 0

@@ -336,3 +336,18 @@ def test_train_settings_hold_their_own_rules(tmp_path, changes, message):
     with pytest.raises(TrainError, match=message):
         TrainSettings(data=(tmp_path,), out=tmp_path / "m", **changes)
     TrainSettings(data=(tmp_path,), out=tmp_path / "m")  # the defaults hold every rule
+
+
+def test_a_run_ships_only_with_half_the_ego_lines_on_both_car_height_splits_and_more_accuracy(load_script):
+    choose = load_script("experiments/transfer_choice.py").choose
+
+    def table(**models: tuple[float, float]) -> dict:
+        return {name: {"frame": {"ego": ego, "accuracy": accuracy}} for name, (ego, accuracy) in models.items()}
+
+    tusimple = table(start=(60, 70), a=(70, 75), b=(40, 90), c=(55, 69))
+    dashcam = table(start=(60, 70), a=(55, 75), b=(80, 90), c=(55, 69))
+    heldout = table(start=(20, 50), a=(10, 52), b=(30, 60), c=(30, 55))
+    chosen, mean = choose([tusimple, dashcam, heldout], "start")
+    assert chosen == "a"  # b is more accurate but misses half the ego lines on tusimple
+    assert mean["start"] == pytest.approx(190 / 3) and mean["c"] == pytest.approx(193 / 3)
+    assert choose([tusimple, dashcam, heldout], "start", ego=80)[0] == "start"  # none qualifies
