@@ -28,7 +28,7 @@ from ..world.facade import LEAVES as LEAVES_FINISH
 from ._jit import kernel
 from .bands import band_rows
 from .facades import facade, footway
-from .foliage import leaf_cosine, leaf_sky, leaf_transmission
+from .foliage import LEAF_MIN_COSINE, leaf_clumps, leaf_cosine, leaf_sky, leaf_transmission
 from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
 from .light_terms import blend, lamp_light, shade_lit, sun_lit
 from .lighting import (
@@ -278,6 +278,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         glow = 1.0  # the share of the face's emission the pixel shows: a lit window's bars hide its light
         up = 0.6 + 0.4 * nz
         leafy = False  # a crown's face, lit as a volume of leaves (``foliage``)
+        lx, ly, lz = nx, ny, nz  # the normal the sun's cosine is taken on (a crown's clumps tilt it)
         if material >= 0:
             if f != grad_face:
                 grad_cam = gradients_camera(R, grad_st, f)
@@ -332,8 +333,10 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             texture = face_texture[f]
             finish = face_finish[f]
             leafy = finish == LEAVES_FINISH
-            if leafy:
-                up = leaf_sky(nz)
+            if leafy:  # clumps of leaves in world space, filtered over the footprint along the face
+                tr, tg, tb, lx, ly, lz = leaf_clumps(px, py, pz, nx, ny, nz, dist / fx / max(n_dot_v, LEAF_MIN_COSINE))
+                r, g, b = r * tr, g * tg, b * tb
+                up = leaf_sky(lz)
             elif finish > 0:  # brick, render, panels, window glass: drawn in facade coordinates over the footprint
                 u, v = road_coordinates(faces, vertex_st, bary, row, col, f)
                 du, dv = pixel_steps(R, fx, fy, depth, norm, dx, dy, dz, nx, ny, nz, n_dot_v)
@@ -356,7 +359,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
         r, g, b, roughness = wet_surface(r, g, b, surface[kind, ROUGHNESS], surface_wet, wet)
         shiny = surface_wet + gloss
         fresnel = fresnel_schlick(n_dot_v, max(surface[kind, F0], gloss * 0.08))
-        n_dot_l = nx * sun_dir[0] + ny * sun_dir[1] + nz * sun_dir[2]
+        n_dot_l = lx * sun_dir[0] + ly * sun_dir[1] + lz * sun_dir[2]
         through = 0.0  # the share of the sun seen through a crown's leaves
         if leafy:
             through = leaf_transmission(n_dot_l)
@@ -417,6 +420,7 @@ def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.nda
     a reflection is never brighter than what it reflects. ``lamp_spill`` is the lamps' light on objects at night."""
     height, width = face_buf.shape
     R = view.R_world_camera
+    c_world = view.p_world_camera
     sun_x, sun_y, sun_z = sun_dir[0], sun_dir[1], sun_dir[2]
     for row in band_rows(height, band, bands):
         y_cam = (row + 0.5 - view.cy) / view.fy
@@ -424,15 +428,24 @@ def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.nda
             f = face_buf[row, col]
             if f < 0:
                 continue
-            dx, dy, dz, _ = pixel_ray(R, (col + 0.5 - view.cx) / view.fx, y_cam)
-            nx, ny, nz, _ = facing_normal(face_normal, f, dx, dy, -dz)
+            dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - view.cx) / view.fx, y_cam)
+            nx, ny, nz, n_dot_v = facing_normal(face_normal, f, dx, dy, -dz)
             n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
             up = 0.6 + 0.4 * nz
+            tone = (1.0, 1.0, 1.0)
             if face_finish[f] == LEAVES_FINISH:  # a crown: lit as a volume of leaves, as ``shade_row`` lights it
+                # its clumps at the real crown's point (the mirrored one flipped back up; the ground's height is
+                # a shift of the pattern, which the mirror's blur hides)
+                dist = depth_buf[row, col] * norm
+                p_world = (c_world[0] + dx * dist, c_world[1] + dy * dist, -(c_world[2] + dz * dist))
+                tr, tg, tb, nx, ny, nz = leaf_clumps(p_world[0], p_world[1], p_world[2], nx, ny, nz,
+                                                     dist / view.fx / max(n_dot_v, LEAF_MIN_COSINE))
+                tone = (tr, tg, tb)
+                n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
                 up = leaf_sky(nz)
                 n_dot_l = leaf_cosine(n_dot_l) + leaf_transmission(n_dot_l)
             n_dot_l = max(n_dot_l, 0.0)
             for c in range(3):
                 amb = env_f[AMBIENT] * (0.5 * horizon[c] + 0.5 * zenith[c]) * SKY_AMBIENT_GAIN * up + lamp_spill
-                out[row, col, c] = face_color[f, c] * (SUN_SCALE * env_f[SUN_I] * sun_color[c] * n_dot_l + amb) \
-                    + face_emission[f, c]
+                out[row, col, c] = face_color[f, c] * tone[c] * (SUN_SCALE * env_f[SUN_I] * sun_color[c] * n_dot_l
+                                                                 + amb) + face_emission[f, c]
