@@ -69,6 +69,13 @@ def leaf_sky(nz: float) -> float:
 
 
 @kernel(inline="always")
+def leaf_footprint(dist: float, focal: float, n_dot_v: float) -> float:
+    """The footprint (m) along a crown's face of a pixel at distance ``dist`` through a lens of ``focal`` pixels,
+    the face at cosine ``n_dot_v`` to the view (an edge-on face's no wider than at ``LEAF_MIN_COSINE``)."""
+    return dist / focal / max(n_dot_v, LEAF_MIN_COSINE)
+
+
+@kernel(inline="always")
 def resolved(step_m: float, foot_m: float) -> float:
     """The share of a pattern of lattice step ``step_m`` drawn at a pixel of footprint ``foot_m``: 1 where a step
     spans twice ``LEAF_RESOLVED_PX`` pixels or more, 0 (its mean) under ``LEAF_RESOLVED_PX``."""

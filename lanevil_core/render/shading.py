@@ -28,7 +28,7 @@ from ..world.facade import LEAVES as LEAVES_FINISH
 from ._jit import kernel
 from .bands import band_rows
 from .facades import facade, footway
-from .foliage import LEAF_MIN_COSINE, leaf_clumps, leaf_cosine, leaf_sky, leaf_transmission
+from .foliage import leaf_clumps, leaf_cosine, leaf_footprint, leaf_sky, leaf_transmission
 from .ground import GRASS, NO_LAND, PATCH_TEXEL_M, ground
 from .light_terms import blend, lamp_light, shade_lit, sun_lit
 from .lighting import (
@@ -334,7 +334,7 @@ def shade_row(face: np.ndarray, depth_buf: np.ndarray, bary: np.ndarray, view: V
             finish = face_finish[f]
             leafy = finish == LEAVES_FINISH
             if leafy:  # clumps of leaves in world space, filtered over the footprint along the face
-                tr, tg, tb, lx, ly, lz = leaf_clumps(px, py, pz, nx, ny, nz, dist / fx / max(n_dot_v, LEAF_MIN_COSINE))
+                tr, tg, tb, lx, ly, lz = leaf_clumps(px, py, pz, nx, ny, nz, leaf_footprint(dist, fx, n_dot_v))
                 r, g, b = r * tr, g * tg, b * tb
                 up = leaf_sky(lz)
             elif finish > 0:  # brick, render, panels, window glass: drawn in facade coordinates over the footprint
@@ -430,19 +430,20 @@ def shade_mirror(face_buf: np.ndarray, depth_buf: np.ndarray, face_color: np.nda
                 continue
             dx, dy, dz, norm = pixel_ray(R, (col + 0.5 - view.cx) / view.fx, y_cam)
             nx, ny, nz, n_dot_v = facing_normal(face_normal, f, dx, dy, -dz)
-            n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
             up = 0.6 + 0.4 * nz
             tone = (1.0, 1.0, 1.0)
-            if face_finish[f] == LEAVES_FINISH:  # a crown: lit as a volume of leaves, as ``shade_row`` lights it
+            leafy = face_finish[f] == LEAVES_FINISH
+            if leafy:  # a crown: lit as a volume of leaves, as ``shade_row`` lights it
                 # its clumps at the real crown's point (the mirrored one flipped back up; the ground's height is
                 # a shift of the pattern, which the mirror's blur hides)
                 dist = depth_buf[row, col] * norm
                 p_world = (c_world[0] + dx * dist, c_world[1] + dy * dist, -(c_world[2] + dz * dist))
                 tr, tg, tb, nx, ny, nz = leaf_clumps(p_world[0], p_world[1], p_world[2], nx, ny, nz,
-                                                     dist / view.fx / max(n_dot_v, LEAF_MIN_COSINE))
+                                                     leaf_footprint(dist, view.fx, n_dot_v))
                 tone = (tr, tg, tb)
-                n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
                 up = leaf_sky(nz)
+            n_dot_l = nx * sun_x + ny * sun_y + nz * sun_z
+            if leafy:
                 n_dot_l = leaf_cosine(n_dot_l) + leaf_transmission(n_dot_l)
             n_dot_l = max(n_dot_l, 0.0)
             for c in range(3):
