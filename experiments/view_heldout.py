@@ -32,7 +32,8 @@ from lanevil_core.metrics.ego import ego_line_match, summarize_ego
 from lanevil_core.metrics.formats import LaneRecord, read_tusimple
 from lanevil_core.metrics.tusimple import score_image
 
-MODES = ("frame", "measured", "labels", "measured-vp", "labels-vp", "measured-vp+height")
+MODES = ("frame", "measured", "labels", "measured-vp", "labels-vp", "measured-vp+height", "crop", "half")
+KEEP = {"crop": 1.0, "half": 0.5}  # how much of the network's proportions a fixed window keeps
 
 
 def main() -> None:
@@ -87,7 +88,7 @@ def main() -> None:
         for mode in args.modes:
             scores, accuracy = [], []
             for case, frames in cases.items():
-                view = views[case][mode]
+                view = _kept(aspect, detector, KEEP[mode]) if mode in KEEP else views[case][mode]
                 for record in frames:
                     lines = detector.lines(images[record.raw_file]) if view is None else \
                         _read_through(detector, images[record.raw_file], view)
@@ -115,6 +116,12 @@ def _accuracy(gt: LaneRecord, pred: LaneRecord, width: int) -> float:
         return [[x * k if x >= 0 else x for x in lane] for lane in lanes]
 
     return score_image(scaled(pred.lanes), scaled(gt.lanes), [h * k for h in gt.h_samples], 0.0).accuracy
+
+
+def _kept(aspect: float, detector: LearnedDetector, keep: float) -> View:
+    in_w, in_h = detector.spec.input_size
+    width = (aspect / (in_h / in_w)) ** keep
+    return View((0.5 - width / 2, 0.0, 0.5 + width / 2, 1.0))
 
 
 def _read_through(detector: LearnedDetector, rgb: np.ndarray, view: View) -> list:

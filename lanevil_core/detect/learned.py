@@ -35,19 +35,12 @@ from .view import View, ViewError, view_input
 
 SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 # Models shipped beside the six families' own, each a `lanevil train` folder run as the family its config.json names,
-# by name; they read other cameras and roads better than the benchmark's six, which keep their models
-# (docs/learning.md, "Which model to use when"); `make models-transfer` makes all four again:
-# - seg-transfer runs as `seg`: fine-tuned with --randomise --photometric, chosen on held-out synthetic worlds
-#   ("Selection on held-out synthetic worlds");
-# - scnn-transfer and laneatt-transfer run as `scnn` and `laneatt`: fine-tuned from the family's shipped weights on
-#   drawn cameras (the --vary-camera split of `make models`, 3 epochs at 5e-4; scnn-transfer then 2 more with
-#   --randomise --photometric, the stage more accurate on the validation splits), each keeping its best epoch on
-#   synthetic validation splits; shipped because each reads at least 50 % of the ego lines on both car-height
-#   synthetic preset splits (`tusimple`, `dashcam`), a rule on synthetic frames only ("Drawn cameras for the
-#   stock-camera families");
-# - ufld-transfer runs as `ufld`: the shipped ufld (already trained on drawn cameras) 2 epochs more with --randomise
-#   --photometric on the same split, its best epoch on the same validation splits, shipped by the same rule.
-BUNDLED_MODELS: tuple[str, ...] = ("seg-transfer", "scnn-transfer", "laneatt-transfer", "ufld-transfer")
+# by name; they read other cameras and roads better than the benchmark's six, which keep their models. How each was
+# trained and chosen (on synthetic validation splits only: at least 50 % of the ego lines on both car-height preset
+# splits, and more accurate than the model it started from) is in docs/learning.md ("Which model to use when");
+# `make models-transfer` and then `make models-transfer-world` make them again.
+BUNDLED_MODELS: tuple[str, ...] = ("seg-transfer", "scnn-transfer", "laneatt-transfer", "ufld-transfer",
+                                   "ganet-transfer")
 
 
 def shipped_model_dir(name: str) -> Path:

@@ -364,13 +364,18 @@ def sun_visibility_over(px: float, py: float, pz: float, nx: float, ny: float, n
 
 @kernel(inline="always")
 def sky_openness(openness: np.ndarray, params: np.ndarray, px: float, py: float) -> float:
-    """Share of the sky's light reaching ground point (px, py): 1 in the open, less under roofs and decks."""
+    """Share of the sky's light reaching ground point (px, py): 1 in the open, less under roofs and decks and
+    beside what stands on the ground (bilinear between the map's cell centres)."""
     height, width = openness.shape
-    x = int((px - params[0]) * params[2])
-    y = int((py - params[1]) * params[2])
-    if x < 0 or y < 0 or x >= width or y >= height:
+    x = (px - params[0]) * params[2] - 0.5
+    y = (py - params[1]) * params[2] - 0.5
+    if x < 0.0 or y < 0.0 or x >= width - 1 or y >= height - 1:
         return 1.0
-    return openness[y, x]
+    i, j = int(y), int(x)
+    fy, fx = y - i, x - j
+    top = openness[i, j] + (openness[i, j + 1] - openness[i, j]) * fx
+    below = openness[i + 1, j] + (openness[i + 1, j + 1] - openness[i + 1, j]) * fx
+    return top + (below - top) * fy
 
 
 @kernel(inline="always")

@@ -16,6 +16,7 @@ from ..world.paint import MATERIAL_ALBEDO, stripe_index
 from ..world.road_layout import RoadNetwork
 from ..world.road_mesh import RoadSurface, road_surface
 from ..world.scene import FIRST_OBJECT_ID, ID_ROAD, ID_ROADSIDE, CompiledScene, Mesh
+from ._jit import kernel
 from .lighting import DOWN, LIGHT_COLUMNS, light_row
 from .raster import depth_orthographic
 
@@ -124,28 +125,112 @@ OVERHEAD_MAX_CELLS = 2048
 OVERHEAD_MARGIN_M = 25.0
 COVER_HEIGHT_M = 1.5
 COVERED_AMBIENT = 0.3  # share of the sky's light that reaches ground under a roof
+# Ambient occlusion of the ground by what stands on it or hangs over it (walls, parked cars, hedges, crowns): the
+# sky a ground cell sees past the casters around it, in AO_DIRECTIONS directions out to the last of AO_REACH_M.
+# Casters narrower than two cells (poles, wires, lamp arms, trunks, boards) are left out: one ray would stand
+# for their sliver of sky as for a wall's half.
+AO_DIRECTIONS = 12
+AO_REACH_M = (0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0)
 
 
-def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
-    """Top-down map of how much sky the ground near the carriageways sees (1 = open sky).
-
-    A cell is covered where the highest shadow caster above it stands more than COVER_HEIGHT_M over the road
-    surface there (a bridge deck, a tunnel roof, a tree crown); covered ground gets COVERED_AMBIENT of the
-    sky's light, and a 3x3 box blur softens the edges.
-    """
+def _overhead_grid(road: RoadSurface) -> tuple[FloatArray, float, tuple[int, int]]:
+    """(corner (2,), cell (m), (W, H) cells) of the top-down maps over the ground near the carriageways."""
     near_road = road.vertices[np.abs(road.st[:, 1]) < np.abs(road.st[:, 1]).min() + OVERHEAD_MARGIN_M + 20.0]
     lo, hi = near_road[:, :2].min(axis=0) - OVERHEAD_MARGIN_M, near_road[:, :2].max(axis=0) + OVERHEAD_MARGIN_M
     cell = max(OVERHEAD_CELL_M, float(max(hi - lo)) / OVERHEAD_MAX_CELLS)
-    size = (int(np.ceil((hi[0] - lo[0]) / cell)) + 1, int(np.ceil((hi[1] - lo[1]) / cell)) + 1)
+    return lo, cell, (int(np.ceil((hi[0] - lo[0]) / cell)) + 1, int(np.ceil((hi[1] - lo[1]) / cell)) + 1)
+
+
+def _heights(packed: PackedScene, road: RoadSurface, casters: IntArray) -> tuple[Float32Array, Float32Array,
+                                                                                 Float32Array]:
+    """(top, bottom, ground) (H, W) on the ``_overhead_grid``: the highest and lowest point of the faces
+    ``casters`` over each cell and the road surface's height there (-inf, inf and -inf where none)."""
+    lo, cell, size = _overhead_grid(road)
     v_down = np.stack([packed.vertices[:, 0], packed.vertices[:, 1], -packed.vertices[:, 2]], axis=-1)
     road_faces = np.arange(len(road.faces), dtype=np.int32)  # the road surface comes first in the packed faces
-    top = -depth_orthographic(v_down, packed.faces, packed.shadow_faces, size, 1.0 / cell, lo[0], lo[1])
+    top = -depth_orthographic(v_down, packed.faces, casters, size, 1.0 / cell, lo[0], lo[1])
+    bottom = depth_orthographic(packed.vertices, packed.faces, casters, size, 1.0 / cell, lo[0], lo[1])
     ground = -depth_orthographic(v_down, packed.faces, road_faces, size, 1.0 / cell, lo[0], lo[1])
+    return top, bottom, ground
+
+
+def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
+    """Top-down map of how much sky the ground near the carriageways sees under roofs (1 = open sky), and its
+    (x0, y0, cells per metre).
+
+    A cell is covered where the highest shadow caster above it stands more than COVER_HEIGHT_M over the road
+    surface there (a bridge deck, a tunnel roof, a tree crown); covered ground gets COVERED_AMBIENT of the
+    sky's light, and a 3x3 box blur softens the edges. ``ground_occlusion`` is the sky the roadside hides.
+    """
+    lo, cell, _ = _overhead_grid(road)
+    top, _, ground = _heights(packed, road, packed.shadow_faces)
     covered = (top > np.where(np.isfinite(ground), ground, -np.inf) + COVER_HEIGHT_M).astype(np.float32)
-    padded = np.pad(covered, 1, mode="edge")
-    blurred = sum(padded[i:i + covered.shape[0], j:j + covered.shape[1]] for i in range(3) for j in range(3)) / 9.0
-    openness = 1.0 - (1.0 - COVERED_AMBIENT) * blurred
+    openness = 1.0 - (1.0 - COVERED_AMBIENT) * _box3(covered)
     return np.ascontiguousarray(openness, np.float32), np.array([lo[0], lo[1], 1.0 / cell])
+
+
+def ground_occlusion(packed: PackedScene, road: RoadSurface, roadside_faces: int) -> Float32Array:
+    """(H, W) on the ``_overhead_grid``: the share of the sky's light the ground receives past what stands on it
+    or hangs over it in the roadside (``sky_past``: the darkening at the foot of walls, under and around parked
+    cars, along hedges and bins), from the shadow casters among the first ``roadside_faces`` packed faces. The
+    roadside is what an edit leaves as it was, so the map is built once per roadside; an illusion's objects
+    (fences, vehicles, pedestrians) occlude no sky."""
+    _, cell, _ = _overhead_grid(road)
+    top, bottom, ground = _heights(packed, road, packed.shadow_faces[packed.shadow_faces < roadside_faces])
+    return np.ascontiguousarray(_box3(sky_past(*_wide_columns(top, bottom, ground), cell)), np.float32)
+
+
+def _box3(values: Float32Array) -> Float32Array:
+    """A 3x3 box blur (edges repeated)."""
+    padded = np.pad(values, 1, mode="edge")
+    total = np.zeros(values.shape, np.float32)
+    for i in range(3):
+        for j in range(3):
+            total += padded[i:i + values.shape[0], j:j + values.shape[1]]
+    return total / np.float32(9.0)
+
+
+def _wide_columns(top: np.ndarray, bottom: np.ndarray, ground: np.ndarray) -> tuple[FloatArray, FloatArray]:
+    """(tops, bottoms) (H, W) of the casters over the ground (m above it; 0 where none), only where a caster is at
+    least two cells wide each way (a 2x2 opening of where casters stand)."""
+    there = np.isfinite(top) & np.isfinite(bottom) & np.isfinite(ground)
+    core = there[:-1, :-1] & there[1:, :-1] & there[:-1, 1:] & there[1:, 1:]  # 2x2 blocks of casters
+    wide = np.zeros_like(there)
+    for i in (0, 1):
+        for j in (0, 1):
+            wide[i:i + core.shape[0], j:j + core.shape[1]] |= core
+    tops, bottoms = np.zeros(top.shape), np.zeros(top.shape)
+    tops[wide] = np.maximum(top[wide] - ground[wide], 0.0)
+    bottoms[wide] = np.clip(bottom[wide] - ground[wide], 0.0, tops[wide])
+    return tops, bottoms
+
+
+@kernel
+def sky_past(tops: FloatArray, bottoms: FloatArray, cell: float) -> Float32Array:
+    """(H, W) share of the sky's cosine-weighted light each ground cell receives past the casters around it (each
+    a column from ``bottoms`` to ``tops`` over the ground, m; both 0 where none). In each of AO_DIRECTIONS
+    azimuths the sky is blocked between the elevations a column spans, the most of any column out to
+    AO_REACH_M's last reach: the cosine-weighted light of the sky above elevation h is cos^2 h of the open sky's,
+    so a column blocks sin^2 of its top's elevation less sin^2 of its bottom's."""
+    rows, cols = tops.shape
+    out = np.ones((rows, cols), np.float32)
+    reach = np.array(AO_REACH_M)
+    cos_k = np.cos(2.0 * np.pi * np.arange(AO_DIRECTIONS) / AO_DIRECTIONS)
+    sin_k = np.sin(2.0 * np.pi * np.arange(AO_DIRECTIONS) / AO_DIRECTIONS)
+    for i in range(rows):
+        for j in range(cols):
+            blocked = 0.0
+            for d in range(AO_DIRECTIONS):
+                most = 0.0
+                for k in range(len(reach)):
+                    y = int(round(i + sin_k[d] * reach[k] / cell))
+                    x = int(round(j + cos_k[d] * reach[k] / cell))
+                    if 0 <= y < rows and 0 <= x < cols and tops[y, x] > 0.0:
+                        high, low = tops[y, x] / reach[k], bottoms[y, x] / reach[k]
+                        most = max(most, high * high / (1.0 + high * high) - low * low / (1.0 + low * low))
+                blocked += most
+            out[i, j] = 1.0 - blocked / AO_DIRECTIONS
+    return out
 
 
 def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_faces: int) -> Float32Array:
@@ -168,7 +253,7 @@ def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_fa
     return grads
 
 
-REUSED_ENTRIES = 8  # road surfaces and sky-openness maps kept for scenes recompiled from the same road
+REUSED_ENTRIES = 12  # road surfaces, sky-openness and ground-occlusion maps kept for scenes of the same road
 _reused: OrderedDict[tuple[str, Any], tuple[Any, Any]] = OrderedDict()
 _reused_lock = threading.Lock()
 T = TypeVar("T")
@@ -314,8 +399,11 @@ def pack_scene(scene: CompiledScene) -> PackedScene:
         layers=layer_atlas(scene), lights=lights,
         overhead=np.zeros((1, 1), np.float32), overhead_params=np.zeros(3),
     )
-    packed.overhead, packed.overhead_params = _reuse(("overhead", (id(scene.network), casters.hexdigest())),
-                                                     scene.network, lambda: overhead_map(packed, road))
+    cover, packed.overhead_params = _reuse(("overhead", (id(scene.network), casters.hexdigest())), scene.network,
+                                           lambda: overhead_map(packed, road))
+    occlusion = _reuse(("occlusion", (id(scene.network), roadside.casters.hexdigest())), scene.network,
+                       lambda: ground_occlusion(packed, road, len(roadside.normals)))
+    packed.overhead = cover * occlusion
     scene.cache["packed"] = packed
     return packed
 

@@ -23,7 +23,7 @@ from .primitives import merge, pick, pose_on_road, transformed, with_finish
 from .road_layout import RoadNetwork, RoadPiece
 from .scene import Mesh
 from .scenery import Clearance, RoadsideInputs, corridor_half_width, ground_h, own_rng
-from .vegetation import LEAVES
+from .vegetation import LEAVES, tree
 
 MAX_HILL_ELEVATION_DEG = 3.0  # the distant hills' crest seen from any point of the road, 1.5 m above it
 HILL_MARGIN_M = 350.0  # the nearest ring of hills stands this far beyond the farthest road point from its centre
@@ -352,7 +352,7 @@ def field_hedges(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance,
 
 def back_rows(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rng: np.random.Generator) -> list[Mesh]:
     """The houses and garden trees massing behind a suburb's first row of houses, along the main road ahead of
-    the ego: stretches (``SUBURB_BEHIND``) of houses (``house_shell``) and crowns (``crown_lump``) side by side,
+    the ego: stretches (``SUBURB_BEHIND``) of houses (``house_shell``) and garden trees (``garden_tree``) side by side,
     one mesh per side."""
     piece = network.main
     reach = corridor_half_width(piece)
@@ -373,7 +373,7 @@ def back_rows(inputs: RoadsideInputs, network: RoadNetwork, clear: Clearance, rn
                     # turned to face the road: on the right, local +X runs back along it, from the far end
                     T_world_local = pose_on_road(piece.line, s if side > 0 else s + width, t,
                                                  0.0 if side > 0 else np.pi, ground_h(piece))
-                    parts.append(transformed(house_shell(own, width) if house else crown_lump(own, width),
+                    parts.append(transformed(house_shell(own, width) if house else garden_tree(own, width),
                                              T_world_local))
                 s += width + float(rng.uniform(1.0, 6.0))
         if parts:
@@ -398,19 +398,14 @@ def house_shell(rng: np.random.Generator, width: float) -> Mesh:
                 kind="building")
 
 
-def crown_lump(rng: np.random.Generator, width: float) -> Mesh:
-    """A garden tree seen from afar over the houses in front (local frame, along +X from the origin): a lumpy
-    octahedron from 2 m up (its trunk hidden) to its crown's top."""
-    r = width / 2
-    h = float(rng.uniform(*SUBURB_BEHIND.height))
-    mid = float(rng.uniform(0.5, 0.65)) * h
-    ring = [(r + r * np.cos(a) * float(rng.uniform(0.8, 1.1)), r * np.sin(a) * float(rng.uniform(0.8, 1.1)), mid)
-            for a in np.arange(4) * np.pi / 2 + float(rng.uniform(0.0, 0.8))]
-    vertices = np.array([*ring, (r, 0.0, h), (r, 0.0, 2.0)])
-    faces = [(k, (k + 1) % 4, 4) for k in range(4)] + [((k + 1) % 4, k, 5) for k in range(4)]
-    green = pick(rng, LEAVES)
-    colors = (green * rng.uniform(0.75, 1.25, (8, 1))).astype(np.float32)
-    return with_finish(Mesh(vertices, np.array(faces), colors, name="garden tree behind", kind="tree"), LEAVES_FINISH)
+def garden_tree(rng: np.random.Generator, width: float) -> Mesh:
+    """A garden tree behind the first row (local frame, along +X from the origin, its foot ``width / 2`` along):
+    a tree of ``vegetation.tree`` as seen from afar (``near=False``: trunk, branches and leaf clusters, fewer of
+    them, no sprigs), ``SUBURB_BEHIND``'s heights tall, so its outline is a tree's, not a lump's."""
+    T_local_tree = np.eye(4)
+    T_local_tree[0, 3] = width / 2
+    planted = tree(rng, height=float(rng.uniform(*SUBURB_BEHIND.height)), near=False, name="garden tree behind")
+    return transformed(planted, T_local_tree)
 
 
 RIDGE_HALF_LENGTH_M = 900.0  # the ridge a tunnel enters runs this far to both sides of the road
