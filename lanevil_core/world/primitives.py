@@ -176,14 +176,17 @@ def cylinder(
 
 
 def prism(profile: PointsLike, lo: float, hi: float, color: ColorLike = (0.2, 0.2, 0.2), *, axis: str = "y",
-          **kw) -> Mesh:
+          inset: PointsLike | None = None, **kw) -> Mesh:
     """A closed prism: the convex polygon ``profile`` (k, 2) extruded from ``lo`` to ``hi`` along ``axis``.
 
-    ``axis="y"``: profile points are (x, z); ``axis="x"``: profile points are (y, z).
+    ``axis="y"``: profile points are (x, z); ``axis="x"``: profile points are (y, z). ``inset`` (k,): how far each
+    profile point is drawn in from both ends (a car body's rounded shoulders, a cabin's sides leaning in).
     """
     profile = np.asarray(profile, np.float64)
     k = len(profile)
+    pulled = np.zeros(k) if inset is None else np.asarray(inset, np.float64)
     ring = np.concatenate([_lift(profile, lo, axis), _lift(profile, hi, axis)])
+    ring[:, 1 if axis == "y" else 0] += np.concatenate([pulled, -pulled]) * np.sign(hi - lo)
     sides = [[i, (i + 1) % k, k + (i + 1) % k] for i in range(k)] + [[i, k + (i + 1) % k, k + i] for i in range(k)]
     caps = [[0, i + 1, i] for i in range(1, k - 1)] + [[k, k + i, k + i + 1] for i in range(1, k - 1)]
     faces = np.array(sides + caps, np.int32)

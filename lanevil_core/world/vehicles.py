@@ -17,6 +17,11 @@ from .primitives import ColorLike, PointsLike, box, cylinder, facing_quad, merge
 from .props import GLASS, RIM, TRIM, TYRE
 from .scene import Mesh
 
+# A saloon's body is drawn in at its sill and shoulders (the profile's points, m from each side), and its cabin's
+# sides lean in towards the roof: a rounded car, not two boxes.
+BODY_INSET = (0.05, 0.05, 0.02, 0.09, 0.09, 0.03)
+TUMBLEHOME = 0.14
+
 # Linear albedos of the lamps, and the radiance of the lit ones.
 HEADLIGHT = (0.8, 0.8, 0.75)
 TAILLIGHT = (0.55, 0.01, 0.01)
@@ -25,26 +30,30 @@ TAILLIGHT_GLOW = (2.5, 0.05, 0.02)
 
 
 def _slanted_panel(a_xz: ColorLike, b_xz: ColorLike, half_y: float, inset: float, outward_xz: ColorLike,
-                   color: ColorLike) -> Mesh:
-    """A window on the slanted face through (x, z) points a and b, across |y| < half_y, inset along the edge
-    by ``inset`` and lifted 2.5 cm off the face."""
+                   color: ColorLike, narrow: tuple[float, float] = (0.0, 0.0)) -> Mesh:
+    """A window on the slanted face through (x, z) points a and b, across |y| < half_y (less ``narrow`` at a and
+    at b: a cabin whose sides lean in), inset along the edge by ``inset`` and lifted 2.5 cm off the face."""
     a, b = np.asarray(a_xz, np.float64), np.asarray(b_xz, np.float64)
     n = np.asarray(outward_xz, np.float64)
     n = n / np.linalg.norm(n)
     edge = (b - a) / np.linalg.norm(b - a)
     a, b = a + edge * inset + 0.025 * n, b - edge * inset + 0.025 * n
-    corners = [(a[0], -half_y, a[1]), (b[0], -half_y, b[1]), (b[0], half_y, b[1]), (a[0], half_y, a[1])]
+    ya, yb = half_y - narrow[0], half_y - narrow[1]
+    corners = [(a[0], -ya, a[1]), (b[0], -yb, b[1]), (b[0], yb, b[1]), (a[0], ya, a[1])]
     return facing_quad(corners, (n[0], 0.0, n[1]), color)
 
 
-def _side_panels(polygon_xz: PointsLike, half_y: float, color: ColorLike) -> list[Mesh]:
-    """The same (4, 2) window outline on both sides (|y| = half_y + 2 cm), each facing outwards."""
+def _side_panels(polygon_xz: PointsLike, half_y: float, color: ColorLike,
+                 lean: tuple[float, float, float] = (0.0, 1.0, 0.0)) -> list[Mesh]:
+    """The same (4, 2) window outline on both sides (|y| = half_y + 2 cm), each facing outwards; ``lean`` (z0, z1,
+    inset): a side leaning in by ``inset`` from height z0 to z1 carries its window on its slope."""
     polygon_xz = np.asarray(polygon_xz, np.float64)
+    z0, z1, inset = lean
     panels = []
     for side in (-1.0, 1.0):
-        y = side * (half_y + 0.02)
-        corners = [(x, y, z) for x, z in polygon_xz]
-        panels.append(facing_quad(corners, (0.0, side, 0.0), color))
+        corners = [(x, side * (half_y + 0.02 - inset * (z - z0) / (z1 - z0)), z) for x, z in polygon_xz]
+        outward = (0.0, side * (z1 - z0), inset)
+        panels.append(facing_quad(corners, outward, color))
     return panels
 
 
@@ -72,22 +81,25 @@ def _lamps(x: float, z: float, half_y: float, extents: ColorLike, color: ColorLi
 
 def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, length: float = 4.5,
         width: float = 1.8, height: float = 1.45, wheel_sections: int = 12, name: str = "car") -> Mesh:
-    """A saloon car (about 440 faces; 210 with 6 ``wheel_sections``): body, glasshouse with dark windows, four
+    """A saloon car (about 440 faces; 320 with 8 ``wheel_sections``): body, glasshouse with dark windows, four
     wheels, head and tail lights."""
     hx, hy = length / 2, width / 2
     body = prism([(-hx, 0.22), (hx - 0.05, 0.22), (hx, 0.5), (hx - 0.2, 0.8), (-hx + 0.1, 0.86), (-hx, 0.6)],
-                 -hy, hy, color)
+                 -hy, hy, color, inset=BODY_INSET)
     zb, zt = 0.82, height
     rear_b, front_b, front_t, rear_t = -0.41 * length, 0.19 * length, 0.0, -0.32 * length
     cabin_hy = hy - 0.07
-    cabin = prism([(rear_b, zb), (front_b, zb), (front_t, zt), (rear_t, zt)], -cabin_hy, cabin_hy, color)
+    cabin = prism([(rear_b, zb), (front_b, zb), (front_t, zt), (rear_t, zt)], -cabin_hy, cabin_hy, color,
+                  inset=(0.0, 0.0, TUMBLEHOME, TUMBLEHOME))
+    lean = (0.0, TUMBLEHOME - 0.01)  # the screens' ends: at the cabin's foot, at its roof
     parts = [body, cabin,
-             _slanted_panel((front_b, zb), (front_t, zt), cabin_hy - 0.06, 0.05, (zt - zb, front_b - front_t), GLASS),
-             _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (zb - zt, rear_t - rear_b), GLASS)]
-    parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, True),
-                          cabin_hy, GLASS)
-    parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length, False),
-                          cabin_hy, GLASS)
+             _slanted_panel((front_b, zb), (front_t, zt), cabin_hy - 0.06, 0.05, (zt - zb, front_b - front_t), GLASS,
+                            lean),
+             _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (zb - zt, rear_t - rear_b), GLASS,
+                            lean[::-1])]
+    for front_window in (True, False):
+        parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length,
+                                              front_window), cabin_hy, GLASS, (zb, zt, TUMBLEHOME))
     parts += _wheels((0.3 * length, -0.3 * length), 0.33, hy + 0.01, 0.22, wheel_sections)
     parts += _lamps(hx - 0.1, 0.63, hy - 0.28, (0.18, 0.36, 0.12), HEADLIGHT, HEADLIGHT_GLOW if lights_on else None)
     parts += _lamps(-hx + 0.02, 0.72, hy - 0.22, (0.1, 0.34, 0.13), TAILLIGHT, TAILLIGHT_GLOW if lights_on else None)
@@ -113,7 +125,7 @@ def _window_outline(rear: tuple[float, float], front: tuple[float, float], zb: f
 
 def van(color: ColorLike = (0.6, 0.6, 0.6), *, lights_on: bool = False, length: float = 5.2, width: float = 2.0,
         height: float = 2.3, wheel_sections: int = 12, name: str = "van") -> Mesh:
-    """A panel van (about 410 faces; 190 with 6 ``wheel_sections``): tall body with a short sloped nose, cab
+    """A panel van (about 410 faces; 300 with 8 ``wheel_sections``): tall body with a short sloped nose, cab
     windows, four wheels, lamps."""
     hx, hy = length / 2, width / 2
     nose_z, shield_x = 1.15, hx - 0.95
@@ -163,7 +175,7 @@ CAR_PAINT_SHARES = (0.25, 0.2, 0.17, 0.16, 0.09, 0.08, 0.03, 0.02)
 VAN_SHARE = 0.15  # the parked vehicles that are panel vans
 
 
-PARKED_WHEEL_SECTIONS = 6  # parked vehicles stand in rows by the hundred: hexagonal wheels keep them cheap
+PARKED_WHEEL_SECTIONS = 8  # parked vehicles stand in rows by the hundred: octagonal wheels (with hubs) keep them cheap
 
 
 def parked_vehicle(rng: np.random.Generator) -> tuple[float, float, Callable[[], Mesh]]:

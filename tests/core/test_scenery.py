@@ -69,9 +69,10 @@ def test_nothing_stands_on_the_road(kind: SceneKind, road: str) -> None:
     assert intrusions(network, props, lambda piece: corridor_half_width(piece) - 0.05) == set()
 
 
-TRIANGLE_BUDGET = 34_000  # the roadside of a crossroad at density 1 (twice that at 3): the people on a town's
+TRIANGLE_BUDGET = 36_000  # the roadside of a crossroad at density 1 (twice that at 3): the people on a town's
 # sidewalks (200 faces each) took it past the 30 000 it was before, the suburbs' garden trees behind the first row
-# (trees of about 200 faces, no longer 8-face lumps) past 32 000
+# (trees of about 200 faces, no longer 8-face lumps) past 32 000, parked cars' octagonal wheels with hubs (no longer
+# hexagons) to 35 240
 
 
 @pytest.mark.parametrize("kind", SCENE_KINDS)
