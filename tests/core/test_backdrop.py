@@ -10,7 +10,13 @@ from lanevil_core.case import Case
 from lanevil_core.pipeline.compile import compile_scene, roadside_inputs
 from lanevil_core.render import render_frame
 from lanevil_core.typed import SceneKind
-from lanevil_core.world.backdrop import CAMERA_HEIGHT_M, MAX_HILL_ELEVATION_DEG, backdrop_meshes
+from lanevil_core.world.backdrop import (
+    CAMERA_HEIGHT_M,
+    MAX_HILL_ELEVATION_DEG,
+    SUBURB_BEHIND,
+    backdrop_meshes,
+    garden_tree,
+)
 from lanevil_core.world.road_layout import RoadNetwork, build_network
 from lanevil_core.world.scene import FIRST_OBJECT_ID, Mesh
 from lanevil_core.world.scenery import Clearance, corridor_half_width, roadside_meshes
@@ -107,3 +113,14 @@ def test_night_hills_are_dark_silhouettes() -> None:
     sky_above = luminance[max(rows.min() - 6, 0):rows.min()][frame.object_id[max(rows.min() - 6, 0):rows.min()] == 0]
     assert luminance[hills].mean() < 40.0
     assert luminance[hills].mean() <= sky_above.mean() + 2.0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_garden_tree_behind_the_houses_is_a_tree_on_its_own_foot(seed: int) -> None:
+    width = 6.0
+    mesh = garden_tree(np.random.default_rng(seed), width)
+    low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    assert low[2] < 0.0 < 2.0 < high[2] <= SUBURB_BEHIND.height[1] * 1.35  # from the ground up, trunk and crown
+    foot = mesh.vertices[mesh.vertices[:, 2] < 0.5]
+    assert np.allclose(foot[:, :2].mean(axis=0), (width / 2, 0.0), atol=0.6)  # its trunk at the middle of its plot
+    assert len(mesh.faces) > 100  # branches and leaf clusters, not a lump
