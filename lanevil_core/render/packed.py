@@ -141,17 +141,19 @@ def _overhead_grid(road: RoadSurface) -> tuple[FloatArray, float, tuple[int, int
     return lo, cell, (int(np.ceil((hi[0] - lo[0]) / cell)) + 1, int(np.ceil((hi[1] - lo[1]) / cell)) + 1)
 
 
-def _heights(packed: PackedScene, road: RoadSurface, casters: IntArray) -> tuple[Float32Array, Float32Array,
-                                                                                 Float32Array]:
-    """(top, bottom, ground) (H, W) on the ``_overhead_grid``: the highest and lowest point of the faces
-    ``casters`` over each cell and the road surface's height there (-inf, inf and -inf where none)."""
+def _heights(packed: PackedScene, road: RoadSurface, faces: IntArray, lowest: bool = False) -> Float32Array:
+    """(H, W) on the ``_overhead_grid``: the highest point of ``faces`` over each cell (-inf where none), or with
+    ``lowest`` their lowest (inf where none)."""
     lo, cell, size = _overhead_grid(road)
+    if lowest:
+        return depth_orthographic(packed.vertices, packed.faces, faces, size, 1.0 / cell, lo[0], lo[1])
     v_down = np.stack([packed.vertices[:, 0], packed.vertices[:, 1], -packed.vertices[:, 2]], axis=-1)
-    road_faces = np.arange(len(road.faces), dtype=np.int32)  # the road surface comes first in the packed faces
-    top = -depth_orthographic(v_down, packed.faces, casters, size, 1.0 / cell, lo[0], lo[1])
-    bottom = depth_orthographic(packed.vertices, packed.faces, casters, size, 1.0 / cell, lo[0], lo[1])
-    ground = -depth_orthographic(v_down, packed.faces, road_faces, size, 1.0 / cell, lo[0], lo[1])
-    return top, bottom, ground
+    return -depth_orthographic(v_down, packed.faces, faces, size, 1.0 / cell, lo[0], lo[1])
+
+
+def _road_faces(road: RoadSurface) -> IntArray:
+    """The road surface's faces: they come first in the packed faces."""
+    return np.arange(len(road.faces), dtype=np.int32)
 
 
 def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
@@ -163,7 +165,7 @@ def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, 
     sky's light, and a 3x3 box blur softens the edges. ``ground_occlusion`` is the sky the roadside hides.
     """
     lo, cell, _ = _overhead_grid(road)
-    top, _, ground = _heights(packed, road, packed.shadow_faces)
+    top, ground = _heights(packed, road, packed.shadow_faces), _heights(packed, road, _road_faces(road))
     covered = (top > np.where(np.isfinite(ground), ground, -np.inf) + COVER_HEIGHT_M).astype(np.float32)
     openness = 1.0 - (1.0 - COVERED_AMBIENT) * _box3(covered)
     return np.ascontiguousarray(openness, np.float32), np.array([lo[0], lo[1], 1.0 / cell])
@@ -174,9 +176,11 @@ def ground_occlusion(packed: PackedScene, road: RoadSurface, roadside_faces: int
     or hangs over it in the roadside (``sky_past``: the darkening at the foot of walls, under and around parked
     cars, along hedges and bins), from the shadow casters among the first ``roadside_faces`` packed faces. The
     roadside is what an edit leaves as it was, so the map is built once per roadside; an illusion's objects
-    (fences, vehicles, pedestrians) occlude no sky."""
+    (fences, vehicles, pedestrians) add none (their shadows, and the cover term's roofs, are drawn as before)."""
     _, cell, _ = _overhead_grid(road)
-    top, bottom, ground = _heights(packed, road, packed.shadow_faces[packed.shadow_faces < roadside_faces])
+    casters = packed.shadow_faces[packed.shadow_faces < roadside_faces]
+    top, bottom = _heights(packed, road, casters), _heights(packed, road, casters, lowest=True)
+    ground = _heights(packed, road, _road_faces(road))
     return np.ascontiguousarray(_box3(sky_past(*_wide_columns(top, bottom, ground), cell)), np.float32)
 
 
