@@ -13,8 +13,7 @@ Built-ins are ``detect.split.METHODS`` (six learned families, two classical base
 
 - the installed Python plug-ins of the entry-point group ``lanevil.detectors`` (``detect.plugin``);
 - and, unless one of those takes the name, the model folders shipped beside the families' own
-  (``learned.BUNDLED_MODELS``: ``seg-transfer``, ``scnn-transfer``, ``laneatt-transfer``, ``ufld-transfer``,
-  ``ganet-transfer``).
+  (``learned.BUNDLED_MODELS``, the ``FAMILY-transfer`` models).
 
 A SOURCE is ``http://HOST:PORT/PATH`` (or https: ``detect.http_detector``) or ``onnx:PATH`` (an ONNX model with a
 sidecar: ``detect.onnx_detector``; or a model folder of ``lanevil train`` / ``lanevil adapt``, run as its family).
