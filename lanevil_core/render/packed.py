@@ -9,6 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+import cv2
 import numpy as np
 
 from ..typed import MATERIALS, Float32Array, FloatArray, IntArray
@@ -151,9 +152,11 @@ def _heights(packed: PackedScene, road: RoadSurface, faces: IntArray, lowest: bo
     return -depth_orthographic(v_down, packed.faces, faces, size, 1.0 / cell, lo[0], lo[1])
 
 
-def _road_faces(road: RoadSurface) -> IntArray:
-    """The road surface's faces: they come first in the packed faces."""
-    return np.arange(len(road.faces), dtype=np.int32)
+def _ground(packed: PackedScene, road: RoadSurface) -> Float32Array:
+    """(H, W) on the ``_overhead_grid``: the road surface's height over each cell (-inf where none), drawn once per
+    road surface (its faces come first in the packed faces) for the cover and the occlusion maps alike."""
+    return _reuse(("ground", id(road)), road,
+                  lambda: _heights(packed, road, np.arange(len(road.faces), dtype=np.int32)))
 
 
 def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, FloatArray]:
@@ -165,7 +168,7 @@ def overhead_map(packed: PackedScene, road: RoadSurface) -> tuple[Float32Array, 
     sky's light, and a 3x3 box blur softens the edges. ``ground_occlusion`` is the sky the roadside hides.
     """
     lo, cell, _ = _overhead_grid(road)
-    top, ground = _heights(packed, road, packed.shadow_faces), _heights(packed, road, _road_faces(road))
+    top, ground = _heights(packed, road, packed.shadow_faces), _ground(packed, road)
     covered = (top > np.where(np.isfinite(ground), ground, -np.inf) + COVER_HEIGHT_M).astype(np.float32)
     openness = 1.0 - (1.0 - COVERED_AMBIENT) * _box3(covered)
     return np.ascontiguousarray(openness, np.float32), np.array([lo[0], lo[1], 1.0 / cell])
@@ -180,18 +183,13 @@ def ground_occlusion(packed: PackedScene, road: RoadSurface, roadside_faces: int
     _, cell, _ = _overhead_grid(road)
     casters = packed.shadow_faces[packed.shadow_faces < roadside_faces]
     top, bottom = _heights(packed, road, casters), _heights(packed, road, casters, lowest=True)
-    ground = _heights(packed, road, _road_faces(road))
+    ground = _ground(packed, road)
     return np.ascontiguousarray(_box3(sky_past(*_wide_columns(top, bottom, ground), cell)), np.float32)
 
 
 def _box3(values: Float32Array) -> Float32Array:
     """A 3x3 box blur (edges repeated)."""
-    padded = np.pad(values, 1, mode="edge")
-    total = np.zeros(values.shape, np.float32)
-    for i in range(3):
-        for j in range(3):
-            total += padded[i:i + values.shape[0], j:j + values.shape[1]]
-    return total / np.float32(9.0)
+    return np.asarray(cv2.blur(values, (3, 3), borderType=cv2.BORDER_REPLICATE), np.float32)
 
 
 def _wide_columns(top: np.ndarray, bottom: np.ndarray, ground: np.ndarray) -> tuple[FloatArray, FloatArray]:
@@ -257,7 +255,7 @@ def _st_gradients(vertices: FloatArray, faces: IntArray, st: FloatArray, road_fa
     return grads
 
 
-REUSED_ENTRIES = 12  # road surfaces, sky-openness and ground-occlusion maps kept for scenes of the same road
+REUSED_ENTRIES = 16  # road surfaces, their heights, sky-openness and ground-occlusion maps of the same road
 _reused: OrderedDict[tuple[str, Any], tuple[Any, Any]] = OrderedDict()
 _reused_lock = threading.Lock()
 T = TypeVar("T")

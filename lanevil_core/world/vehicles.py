@@ -91,12 +91,12 @@ def car(color: ColorLike = (0.45, 0.03, 0.03), *, lights_on: bool = False, lengt
     cabin_hy = hy - 0.07
     cabin = prism([(rear_b, zb), (front_b, zb), (front_t, zt), (rear_t, zt)], -cabin_hy, cabin_hy, color,
                   inset=(0.0, 0.0, TUMBLEHOME, TUMBLEHOME))
-    lean = (0.0, TUMBLEHOME - 0.01)  # the screens' ends: at the cabin's foot, at its roof
+    narrow = (0.0, TUMBLEHOME - 0.01)  # the screens' ends: at the cabin's foot, at its roof
     parts = [body, cabin,
              _slanted_panel((front_b, zb), (front_t, zt), cabin_hy - 0.06, 0.05, (zt - zb, front_b - front_t), GLASS,
-                            lean),
+                            narrow),
              _slanted_panel((rear_t, zt), (rear_b, zb), cabin_hy - 0.06, 0.05, (zb - zt, rear_t - rear_b), GLASS,
-                            lean[::-1])]
+                            narrow[::-1])]
     for front_window in (True, False):
         parts += _side_panels(_window_outline((rear_b, rear_t), (front_b, front_t), zb, zt, -0.12 * length,
                                               front_window), cabin_hy, GLASS, (zb, zt, TUMBLEHOME))
